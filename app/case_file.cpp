@@ -1,0 +1,345 @@
+#include "app/case_file.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <set>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+namespace vrelab::app {
+namespace {
+
+constexpr double kArcsec = std::numbers::pi / (180.0 * 3600.0);
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+std::size_t edit_distance(std::string_view a, std::string_view b) {
+  std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) prev[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+nlohmann::json to_json(const toml::node& n) {
+  if (auto t = n.as_table()) {
+    nlohmann::json j = nlohmann::json::object();
+    for (auto&& [k, v] : *t) j[std::string(k.str())] = to_json(v);
+    return j;
+  }
+  if (auto a = n.as_array()) {
+    nlohmann::json j = nlohmann::json::array();
+    for (auto&& v : *a) j.push_back(to_json(v));
+    return j;
+  }
+  if (auto v = n.as_integer()) return v->get();
+  if (auto v = n.as_floating_point()) {
+    const double x = v->get();
+    return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(std::to_string(x));
+  }
+  if (auto v = n.as_boolean()) return v->get();
+  if (auto v = n.as_string()) return v->get();
+  // Dates and times: recorded by their type only (vrelab uses none).
+  return std::string("<date/time>");
+}
+
+// One TOML table with the keys it allows; every access marks the key as used.
+class Table {
+ public:
+  Table(const toml::table& t, std::string name, const std::string& file)
+      : t_(t), name_(std::move(name)), file_(file) {}
+
+  bool has(std::string_view key) const { return t_.contains(key); }
+  int line(const toml::node* n) const { return n ? static_cast<int>(n->source().begin.line) : 0; }
+
+  [[noreturn]] void fail(const toml::node* n, std::string_view key, const std::string& what) const {
+    std::ostringstream s;
+    s << file_;
+    const int l = line(n ? n : &t_);
+    if (l > 0) s << ":" << l;
+    s << ": " << qualified(key) << ": " << what;
+    throw InputError(s.str());
+  }
+
+  std::string qualified(std::string_view key) const {
+    return name_.empty() ? std::string(key) : "[" + name_ + "] " + std::string(key);
+  }
+
+  const toml::node* get(std::string_view key, bool required) {
+    used_.insert(std::string(key));
+    const toml::node* n = t_.get(key);
+    if (!n && required) fail(nullptr, key, "missing (required)");
+    return n;
+  }
+
+  double number_of(const toml::node* n, std::string_view key) const {
+    if (!n->is_number()) fail(n, key, std::string("expected a number, got ") + type_name(*n));
+    const double x = n->value<double>().value();
+    if (!std::isfinite(x)) fail(n, key, "must be a finite number, got " + std::to_string(x));
+    return x;
+  }
+  double number(std::string_view key) { return number_of(get(key, true), key); }
+  std::optional<double> opt_number(std::string_view key) {
+    const toml::node* n = get(key, false);
+    return n ? std::optional<double>(number_of(n, key)) : std::nullopt;
+  }
+  double non_negative(std::string_view key, double fallback) {
+    const auto x = opt_number(key);
+    if (x && *x < 0) fail(t_.get(key), key, "must not be negative, got " + std::to_string(*x));
+    return x.value_or(fallback);
+  }
+  std::int64_t integer(std::string_view key, bool required, std::int64_t fallback, std::int64_t min) {
+    const toml::node* n = get(key, required);
+    if (!n) return fallback;
+    if (!n->is_integer()) fail(n, key, std::string("expected an integer, got ") + type_name(*n));
+    const std::int64_t v = n->as_integer()->get();
+    if (v < min) fail(n, key, "must be at least " + std::to_string(min) + ", got " + std::to_string(v));
+    return v;
+  }
+  std::string string(std::string_view key, std::string fallback) {
+    const toml::node* n = get(key, false);
+    if (!n) return fallback;
+    if (!n->is_string()) fail(n, key, std::string("expected a string, got ") + type_name(*n));
+    return n->as_string()->get();
+  }
+  Vec3 vec3_of(const toml::node* n, std::string_view key) const {
+    const toml::array* a = n->as_array();
+    if (!a || a->size() != 3) fail(n, key, "expected an array of 3 numbers [IA, PA, OA]");
+    Vec3 v;
+    for (int i = 0; i < 3; ++i) v[i] = number_of(a->get(static_cast<std::size_t>(i)), key);
+    return v;
+  }
+  Vec3 vec3(std::string_view key) { return vec3_of(get(key, true), key); }
+  std::optional<Vec3> opt_vec3(std::string_view key) {
+    const toml::node* n = get(key, false);
+    return n ? std::optional<Vec3>(vec3_of(n, key)) : std::nullopt;
+  }
+  std::optional<Table> subtable(std::string_view key, bool required) {
+    const toml::node* n = get(key, required);
+    if (!n) return std::nullopt;
+    if (!n->is_table()) fail(n, key, std::string("expected a table, got ") + type_name(*n));
+    return Table(*n->as_table(), name_.empty() ? std::string(key) : name_ + "." + std::string(key), file_);
+  }
+
+  // Any key not read is a typo or a key of another version: say so, with the closest match.
+  void check_unknown(const std::vector<std::string_view>& allowed) const {
+    for (auto&& [k, v] : t_) {
+      const std::string key(k.str());
+      if (used_.count(key)) continue;
+      std::string best;
+      std::size_t best_d = 4;
+      for (auto a : allowed) {
+        const std::size_t d = edit_distance(key, a);
+        if (d < best_d) best_d = d, best = std::string(a);
+      }
+      std::string msg = "unknown key";
+      if (!best.empty()) msg += " (did you mean '" + best + "'?)";
+      fail(&v, key, msg);
+    }
+  }
+
+  const toml::table& raw() const { return t_; }
+  const std::string& name() const { return name_; }
+
+ private:
+  static const char* type_name(const toml::node& n) {
+    switch (n.type()) {
+      case toml::node_type::string: return "a string";
+      case toml::node_type::integer: return "an integer";
+      case toml::node_type::floating_point: return "a number";
+      case toml::node_type::boolean: return "a boolean";
+      case toml::node_type::array: return "an array";
+      case toml::node_type::table: return "a table";
+      default: return "a date or time";
+    }
+  }
+  const toml::table& t_;
+  std::string name_;
+  std::string file_;
+  std::set<std::string> used_;
+};
+
+void read_coefficients(Table t, Case& c) {
+  plant::Coefficients k;
+  std::vector<std::string_view> names;
+  for (int i = 0; i < plant::kNumCoefficients; ++i) {
+    names.push_back(plant::coefficient_name(i));
+    k[i] = t.number(plant::coefficient_name(i));
+  }
+  if (k[plant::K1] <= 0) t.fail(t.raw().get("K1"), "K1", "must be positive (output units per g)");
+  t.check_unknown(names);
+  c.coefficients = k;
+}
+
+void read_vibration(Table t, Case& c) {
+  const std::string type = t.string("type", "");
+  if (type == "sine") {
+    vibration::SineVibration v;
+    v.amplitude_g = t.vec3("amplitude_g");
+    v.phase_rad = t.opt_vec3("phase_deg").value_or(Vec3::Zero()) * kDeg;
+    v.frequency_Hz = t.non_negative("frequency_Hz", 0.0);
+    for (int i = 0; i < 3; ++i)
+      if (v.amplitude_g[i] < 0)
+        t.fail(t.raw().get("amplitude_g"), "amplitude_g",
+               "amplitudes must not be negative (reverse an axis with phase_deg = 180)");
+    t.check_unknown({"type", "amplitude_g", "phase_deg", "frequency_Hz"});
+    c.vibration = v;
+  } else if (type == "random") {
+    vibration::RandomVibration v;
+    v.rms_g = t.vec3("rms_g");
+    if (const toml::node* n = t.get("correlation", false)) {
+      const toml::array* rows = n->as_array();
+      if (!rows || rows->size() != 3) t.fail(n, "correlation", "expected a 3 x 3 array of numbers");
+      for (int i = 0; i < 3; ++i) v.correlation.row(i) = t.vec3_of(rows->get(static_cast<std::size_t>(i)), "correlation");
+    }
+    try {
+      vibration::validate(v);
+    } catch (const std::invalid_argument& e) {
+      t.fail(t.raw().get("rms_g"), "rms_g/correlation", e.what());
+    }
+    t.check_unknown({"type", "rms_g", "correlation"});
+    c.vibration = v;
+  } else {
+    t.fail(t.raw().get("type"), "type", "must be \"sine\" or \"random\", got \"" + type + "\"");
+  }
+}
+
+void read_dividing_head(Table t, Case& c) {
+  DividingHead h;
+  const int modes = t.has("positions_per_series") + t.has("positions") + t.has("orientations_g");
+  if (modes != 1)
+    t.fail(nullptr, "positions_per_series",
+           "give exactly one of positions_per_series, positions or orientations_g");
+  if (t.has("positions_per_series")) {
+    const auto n = t.integer("positions_per_series", true, 8, 1);
+    std::vector<int> series{1, 2, 3};
+    if (const toml::node* s = t.get("series", false)) {
+      series.clear();
+      const toml::array* a = s->as_array();
+      if (!a || a->empty()) t.fail(s, "series", "expected a non-empty array of series numbers (1, 2, 3)");
+      for (auto&& x : *a) {
+        const auto v = x.value<std::int64_t>();
+        if (!v || *v < 1 || *v > 3) t.fail(&x, "series", "series numbers are 1, 2 or 3");
+        series.push_back(static_cast<int>(*v));
+      }
+    }
+    h.positions = validation::equally_spaced_positions(static_cast<int>(n), series);
+    h.description = std::to_string(series.size()) + " series x " + std::to_string(n) + " positions";
+  } else if (const toml::node* p = t.get("positions", false)) {
+    const toml::array* a = p->as_array();
+    if (!a || a->empty()) t.fail(p, "positions", "the position set is empty");
+    for (auto&& x : *a) {
+      const toml::table* e = x.as_table();
+      if (!e) t.fail(&x, "positions", "each position is a table {series = 1, angle_deg = 45.0}");
+      const toml::node* s = e->get("series");
+      const toml::node* ang = e->get("angle_deg");
+      if (!s || !s->is_integer() || s->as_integer()->get() < 1 || s->as_integer()->get() > 3)
+        t.fail(&x, "positions", "each position needs series = 1, 2 or 3");
+      if (!ang || !ang->is_number() || !std::isfinite(ang->value<double>().value()))
+        t.fail(&x, "positions", "each position needs a finite angle_deg");
+      for (auto&& [k, v] : *e)
+        if (k.str() != "series" && k.str() != "angle_deg")
+          t.fail(&v, "positions", "unknown key '" + std::string(k.str()) + "' in a position");
+      h.positions.push_back(validation::series_position(static_cast<int>(s->as_integer()->get()),
+                                                        ang->value<double>().value() * kDeg));
+    }
+    h.description = std::to_string(h.positions.size()) + " listed positions";
+  } else {
+    const toml::node* o = t.get("orientations_g", true);
+    const toml::array* a = o->as_array();
+    if (!a || a->empty()) t.fail(o, "orientations_g", "the position set is empty");
+    for (auto&& x : *a) {
+      const Vec3 v = t.vec3_of(&x, "orientations_g");
+      if (std::abs(v.norm() - 1) > 1e-6)
+        t.fail(&x, "orientations_g", "each orientation is gravity in sensor axes and must have norm 1 g, got " +
+                                         std::to_string(v.norm()));
+      h.positions.push_back(validation::vector_position(v));
+    }
+    h.description = std::to_string(h.positions.size()) + " listed orientations";
+  }
+  h.errors.initial_error_rad = t.opt_vec3("initial_error_arcsec").value_or(Vec3::Zero()) * kArcsec;
+  h.errors.angle_sigma_rad = t.non_negative("angle_sigma_arcsec", 0.0) * kArcsec;
+  h.errors.noise_sigma_g = t.non_negative("noise_sigma_ug", 0.0) * 1e-6;
+  h.errors.repeats = static_cast<int>(t.integer("repeats", false, 1, 1));
+  t.check_unknown({"positions_per_series", "series", "positions", "orientations_g", "initial_error_arcsec",
+                   "angle_sigma_arcsec", "noise_sigma_ug", "repeats"});
+  c.dividing_head = std::move(h);
+}
+
+void read_identification(Table t, Case& c) {
+  if (auto f = t.subtable("fixed", false)) {
+    for (auto&& [k, v] : f->raw()) {
+      const auto idx = plant::coefficient_from_name(k.str());
+      if (!idx) {
+        std::vector<std::string_view> names;
+        for (int i = 0; i < plant::kNumCoefficients; ++i) names.push_back(plant::coefficient_name(i));
+        f->check_unknown(names);
+      }
+      c.fixed[*idx] = f->number(k.str());
+    }
+    if (c.fixed[plant::K1] && *c.fixed[plant::K1] <= 0)
+      f->fail(f->raw().get("K1"), "K1", "must be positive (output units per g)");
+  }
+  t.check_unknown({"fixed"});
+}
+
+}  // namespace
+
+Case read_case(const std::string& path) {
+  toml::table root;
+  try {
+    root = toml::parse_file(path);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream s;
+    s << path;
+    if (e.source().begin.line > 0) s << ":" << e.source().begin.line;
+    s << ": " << e.description();
+    throw InputError(s.str());
+  }
+  Case c;
+  c.path = path;
+  c.content = to_json(root);
+  Table top(root, "", path);
+  if (auto g = top.opt_number("g_m_per_s2")) {
+    if (*g < 9.7 || *g > 9.9)
+      top.fail(root.get("g_m_per_s2"), "g_m_per_s2", "a site's gravity lies between 9.7 and 9.9 m/s^2");
+    c.g_m_per_s2 = *g;
+  }
+  if (auto t = top.subtable("instrument", false)) {
+    c.instrument = t->string("name", c.instrument);
+    c.output_unit = t->string("output_unit", c.output_unit);
+    t->check_unknown({"name", "output_unit"});
+  }
+  if (auto t = top.subtable("coefficients", false)) read_coefficients(*t, c);
+  if (auto t = top.subtable("orientation", false)) {
+    c.orientation_g = t->vec3("a_g");
+    t->check_unknown({"a_g"});
+  }
+  if (auto t = top.subtable("vibration", false)) read_vibration(*t, c);
+  if (auto t = top.subtable("range", false)) {
+    const double r = t->number("limit_g");
+    if (r <= 0) t->fail(t->raw().get("limit_g"), "limit_g", "must be positive");
+    c.range_limit_g = r;
+    t->check_unknown({"limit_g"});
+  }
+  if (auto t = top.subtable("dividing_head", false)) read_dividing_head(*t, c);
+  if (auto t = top.subtable("identification", false)) read_identification(*t, c);
+  if (auto t = top.subtable("run", false)) {
+    c.seed = static_cast<std::uint64_t>(t->integer("seed", false, 1, 0));
+    t->check_unknown({"seed"});
+  }
+  top.check_unknown({"g_m_per_s2", "instrument", "coefficients", "orientation", "vibration", "range",
+                     "dividing_head", "identification", "run"});
+  return c;
+}
+
+void require(const Case& c, bool present, const std::string& table, const std::string& command) {
+  if (!present) throw InputError(c.path + ": " + command + " needs a [" + table + "] table");
+}
+
+}  // namespace vrelab::app

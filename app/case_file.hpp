@@ -1,0 +1,54 @@
+#pragma once
+// app/case_file.hpp -- reading a case file (TOML) into the library's inputs.
+//
+// Takes: the path of a case file (keys in docs/case-files.md).
+// Gives: a Case whose tables are present only where the file has them; the parsed file as
+//        JSON (recorded in every result). Throws InputError naming the file, the line and
+//        the key for anything wrong: a syntax error, an unknown key (with a suggestion), a
+//        missing or non-finite number, a negative sigma, an empty position set.
+#include <cstdint>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <variant>
+
+#include <nlohmann/json.hpp>
+
+#include "plant/model1.hpp"
+#include "validation/dividing_head.hpp"
+#include "validation/identification.hpp"
+#include "vibration/profile.hpp"
+
+namespace vrelab::app {
+
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct DividingHead {
+  std::vector<validation::Position> positions;
+  validation::StaticTestErrors errors;
+  std::string description;  // e.g. "3 series x 8 positions"
+};
+
+struct Case {
+  std::string path;
+  nlohmann::json content;  // the file, as JSON
+  double g_m_per_s2 = 9.80665;
+  std::string instrument = "accelerometer";
+  std::string output_unit = "mA";
+  std::optional<plant::Coefficients> coefficients;
+  std::optional<Vec3> orientation_g;
+  std::optional<std::variant<vibration::SineVibration, vibration::RandomVibration>> vibration;
+  std::optional<double> range_limit_g;
+  std::optional<DividingHead> dividing_head;
+  validation::FixedSet fixed{};
+  std::uint64_t seed = 1;
+};
+
+Case read_case(const std::string& path);
+
+// Throws InputError "<file>: <what>" when the case lacks a table a command needs.
+void require(const Case& c, bool present, const std::string& table, const std::string& command);
+
+}  // namespace vrelab::app

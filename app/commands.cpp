@@ -1,0 +1,280 @@
+#include "app/commands.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include <fmt/format.h>
+#include <fmt/ostream.h>
+
+#include "app/case_file.hpp"
+#include "app/output.hpp"
+#include "rectification/eq3.hpp"
+#include "validation/static_test.hpp"
+#include "vrelab_version.hpp"
+
+namespace vrelab::app {
+namespace {
+
+using nlohmann::json;
+using plant::kNumCoefficients;
+constexpr double kArcsec = std::numbers::pi / (180.0 * 3600.0);
+
+std::string unit_of(int i, const Case& c) {
+  const std::string u(plant::coefficient_info()[i].unit);
+  return u == "out/g" ? c.output_unit + "/g" : u;
+}
+
+json coefficients_json(const plant::Coefficients& k, const validation::CoefFlags* available = nullptr) {
+  json j = json::object();
+  for (int i = 0; i < kNumCoefficients; ++i) {
+    const std::string name(plant::coefficient_name(i));
+    j[name] = (available && !(*available)[i]) ? json(nullptr) : json(k[i]);
+  }
+  return j;
+}
+
+json array_json(const validation::CoefArray& a, const validation::CoefFlags& available) {
+  plant::Coefficients k;
+  k.v = a;
+  return coefficients_json(k, &available);
+}
+
+json vec_json(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+
+std::string cell(double x) { return fmt::format(" {:>10.3e}", x); }
+std::string text_cell(const std::string& s) { return fmt::format(" {:>10}", s); }
+
+std::string header_line(const std::string& command, const Case& c, std::uint64_t seed) {
+  return fmt::format("vrelab {} ({}) {} {}  [seed {}]\n", kProgramVersion, kGitDescribe, command, c.path, seed);
+}
+
+}  // namespace
+
+void run_identify(const IdentifyOptions& o, std::ostream& out) {
+  Case c = read_case(o.case_path);
+  require(c, c.coefficients.has_value(), "coefficients", "identify");
+  require(c, c.dividing_head.has_value(), "dividing_head", "identify");
+  if (o.seed) c.seed = *o.seed;
+  if (o.monte_carlo == 1) throw InputError("--monte-carlo: needs at least 2 trials (or 0 for none)");
+  const DividingHead& head = *c.dividing_head;
+  const plant::Coefficients& truth = *c.coefficients;
+
+  // Identifiability first: a rank-deficient set is reported in words, not solved into noise.
+  const validation::Identifiability ident = validation::identifiability(head.positions, c.fixed);
+  if (!ident.full_rank()) {
+    std::string msg = fmt::format(
+        "{}: [dividing_head] with [identification] fixed: the {} free coefficients are not all "
+        "identifiable from this position set (rank {} of {}).",
+        c.path, ident.parameters, ident.rank, ident.parameters);
+    for (const auto& s : ident.confounded) msg += "\n  - " + s;
+    msg += "\n  Fix one coefficient of each group in [identification] fixed (the paper takes k1_asym "
+           "from another test and assumes k_PP = k_OO = 0), or add positions.";
+    throw InputError(msg);
+  }
+
+  validation::StaticTestSettings settings;
+  settings.fixed = c.fixed;
+  settings.seed = c.seed;
+  settings.monte_carlo_trials = o.monte_carlo;
+  const validation::StaticTestReport r = validation::run_static_test(truth, head.positions, head.errors, settings);
+
+  // ---- text report
+  const auto& e = head.errors;
+  out << header_line("identify", c, c.seed);
+  out << fmt::format("Static test on the virtual dividing head: {}, {} reading(s) each = {} readings\n",
+                     head.description, e.repeats, r.readings.size());
+  out << fmt::format(
+      "  errors: initial orientation [{:g}, {:g}, {:g}] arcsec, set angle sigma {:g} arcsec, reading "
+      "noise sigma {:g} ug\n",
+      e.initial_error_rad[0] / kArcsec, e.initial_error_rad[1] / kArcsec, e.initial_error_rad[2] / kArcsec,
+      e.angle_sigma_rad / kArcsec, e.noise_sigma_g * 1e6);
+  out << fmt::format("Identifiability (least squares): {} free coefficients, rank {}, condition number {:.3g}\n",
+                     r.identifiability.parameters, r.identifiability.rank, r.identifiability.condition_number);
+  std::string fixed_list;
+  for (int i = 0; i < kNumCoefficients; ++i)
+    if (c.fixed[i]) fixed_list += fmt::format("{}{} = {:g}", fixed_list.empty() ? "" : ", ", plant::coefficient_name(i), *c.fixed[i]);
+  if (!fixed_list.empty()) out << "  fixed at known values: " << fixed_list << "\n";
+  for (const auto& n : r.notes) out << "  note: " << n << "\n";
+  out << "\n";
+
+  std::string line = fmt::format("{:<10}{:<7}{:>11}", "", "", "");
+  for (const auto& m : r.methods) line += fmt::format("  {:<32}", m.name);
+  out << line << "\n";
+  line = fmt::format("{:<10}{:<7}{:>11}", "coef", "unit", "truth");
+  for (std::size_t m = 0; m < r.methods.size(); ++m) line += "  " + text_cell("estimate") + text_cell("error") + text_cell("sigma");
+  out << line << "\n";
+  for (int i = 0; i < kNumCoefficients; ++i) {
+    line = fmt::format("{:<10}{:<7}", plant::coefficient_name(i), unit_of(i, c)) + cell(truth[i]);
+    for (const auto& m : r.methods) {
+      line += "  ";
+      if (!m.estimate.available[i]) {
+        line += text_cell("n/a") + text_cell("") + text_cell("");
+      } else {
+        line += cell(m.estimate.value[i]) + cell(m.estimate.value[i] - truth[i]) +
+                (m.estimate.assumed[i] ? text_cell("(given)") : cell(m.first_order.sigma[i]));
+      }
+    }
+    out << line << "\n";
+  }
+  out << "error = estimate - truth; sigma: first-order standard uncertainty from set-angle errors and noise;\n"
+         "(given): held at a known or assumed value, not estimated.\n";
+
+  if (o.monte_carlo > 0) {
+    out << fmt::format("\nUncertainty: first-order propagation vs Monte Carlo ({} trials, seed {})\n", o.monte_carlo,
+                       c.seed + 1);
+    for (const auto& m : r.methods) {
+      out << fmt::format("  {}\n", m.name);
+      out << fmt::format("  {:<10}{:>11}{:>11}{:>8}{:>11}{:>11}\n", "coef", "sigma_1st", "sigma_MC", "ratio",
+                         "bias_1st", "bias_MC");
+      for (int i = 0; i < kNumCoefficients; ++i) {
+        if (!m.estimate.available[i] || m.estimate.assumed[i]) continue;
+        const double s1 = m.first_order.sigma[i], smc = m.monte_carlo->std[i];
+        out << fmt::format("  {:<10}{}{}{:>8.3f}{}{}\n", plant::coefficient_name(i), cell(s1), cell(smc),
+                           s1 > 0 ? smc / s1 : 0.0, cell(m.first_order.bias[i]), cell(m.monte_carlo->mean_error[i]));
+      }
+    }
+    out << "bias: effect of the initial orientation error (first-order) and the mean error over the trials (MC).\n";
+  }
+
+  if (o.json_path.empty()) return;
+  // ---- JSON
+  json j;
+  j["program"] = program_record();
+  j["command"] = "identify";
+  j["case"] = case_record(c);
+  j["seed"] = c.seed;
+  j["settings"] = {{"monte_carlo_trials", o.monte_carlo},
+                   {"monte_carlo_seed", o.monte_carlo > 0 ? json(c.seed + 1) : json(nullptr)},
+                   {"least_squares_weights", "1 / first-order variance of each reading"},
+                   {"rank_tolerance", 1e-10}};
+  json units = json::object();
+  for (int i = 0; i < kNumCoefficients; ++i) units[std::string(plant::coefficient_name(i))] = unit_of(i, c);
+  j["units"] = units;
+  j["truth"] = coefficients_json(truth);
+  j["estimates"] = {{"paper_printed", nullptr}, {"paper_corrected", nullptr}, {"least_squares", nullptr}};
+  j["errors"] = j["estimates"];
+  j["sigma"] = j["estimates"];
+  j["bias_first_order"] = j["estimates"];
+  j["given"] = j["estimates"];
+  for (const auto& m : r.methods) {
+    j["estimates"][m.name] = coefficients_json(m.estimate.value, &m.estimate.available);
+    validation::CoefArray err{}, sigma = m.first_order.sigma, bias = m.first_order.bias;
+    json given = json::array();
+    for (int i = 0; i < kNumCoefficients; ++i) {
+      err[i] = m.estimate.value[i] - truth[i];
+      if (m.estimate.assumed[i]) {
+        sigma[i] = bias[i] = 0.0;
+        given.push_back(std::string(plant::coefficient_name(i)));
+      }
+    }
+    j["errors"][m.name] = array_json(err, m.estimate.available);
+    j["sigma"][m.name] = array_json(sigma, m.estimate.available);
+    j["bias_first_order"][m.name] = array_json(bias, m.estimate.available);
+    j["given"][m.name] = given;
+    if (m.monte_carlo) {
+      j["monte_carlo"][m.name] = {{"trials", m.monte_carlo->n},
+                                  {"std", array_json(m.monte_carlo->std, m.estimate.available)},
+                                  {"mean_error", array_json(m.monte_carlo->mean_error, m.estimate.available)}};
+    }
+  }
+  const auto& id = r.identifiability;
+  json free = json::array(), identifiable = json::object();
+  for (int i = 0; i < kNumCoefficients; ++i)
+    if (id.free[i]) {
+      free.push_back(std::string(plant::coefficient_name(i)));
+      identifiable[std::string(plant::coefficient_name(i))] = static_cast<bool>(id.identifiable[i]);
+    }
+  json fixed = json::object();
+  for (int i = 0; i < kNumCoefficients; ++i)
+    if (c.fixed[i]) fixed[std::string(plant::coefficient_name(i))] = *c.fixed[i];
+  j["identifiability"] = {{"parameters", id.parameters},
+                          {"rank", id.rank},
+                          {"condition_number", id.condition_number},
+                          {"free", free},
+                          {"fixed", fixed},
+                          {"identifiable", identifiable},
+                          {"confounded", id.confounded}};
+  j["notes"] = r.notes;
+  json readings = json::array();
+  for (const auto& rd : r.readings) {
+    const auto& p = head.positions[static_cast<std::size_t>(rd.position)];
+    readings.push_back({{"position", rd.position},
+                        {"series", p.series},
+                        {"angle_deg", p.angle_rad * 180 / std::numbers::pi},
+                        {"a_nominal_g", vec_json(p.nominal_g)},
+                        {"output", rd.output}});
+  }
+  j["readings"] = readings;
+  j["readings_unit"] = c.output_unit;
+  write_atomic(o.json_path, j.dump(2) + "\n");
+}
+
+void run_predict(const PredictOptions& o, std::ostream& out) {
+  const Case c = read_case(o.case_path);
+  require(c, c.coefficients.has_value(), "coefficients", "predict");
+  require(c, c.orientation_g.has_value(), "orientation", "predict");
+  require(c, c.vibration.has_value(), "vibration", "predict");
+  const plant::Coefficients& k = *c.coefficients;
+  const Vec3 a = *c.orientation_g;
+
+  rectification::Eq3Terms terms;
+  std::optional<double> printed;
+  std::string description;
+  json vib;
+  if (const auto* s = std::get_if<vibration::SineVibration>(&*c.vibration)) {
+    terms = rectification::sine_rectification(k, a, *s, c.range_limit_g);
+    printed = rectification::sine_rectification_as_printed(k, a, *s);
+    const Vec3 ph = s->phase_rad * 180 / std::numbers::pi;
+    description = fmt::format("sine, peak [{:g}, {:g}, {:g}] g, phase [{:g}, {:g}, {:g}] deg", s->amplitude_g[0],
+                              s->amplitude_g[1], s->amplitude_g[2], ph[0], ph[1], ph[2]);
+    vib = {{"type", "sine"}, {"amplitude_g", vec_json(s->amplitude_g)}, {"phase_deg", vec_json(ph)}};
+  } else {
+    const auto& rv = std::get<vibration::RandomVibration>(*c.vibration);
+    terms = rectification::random_rectification(k, a, rv, c.range_limit_g);
+    description = fmt::format("Gaussian random, rms [{:g}, {:g}, {:g}] g", rv.rms_g[0], rv.rms_g[1], rv.rms_g[2]);
+    const Eigen::Matrix3d cov = rv.covariance_g2();
+    json cj = json::array();
+    for (int i = 0; i < 3; ++i) cj.push_back(vec_json(cov.row(i).transpose()));
+    vib = {{"type", "random"}, {"rms_g", vec_json(rv.rms_g)}, {"covariance_g2", cj}};
+  }
+
+  out << header_line("predict", c, c.seed);
+  out << fmt::format("Static acceleration a = [{:g}, {:g}, {:g}] g (|a| = {:.6g} g); vibration: {}\n", a[0], a[1], a[2],
+                     a.norm(), description);
+  if (c.range_limit_g) out << fmt::format("Range limit: +/-{:g} g (clipping term)\n", *c.range_limit_g);
+  out << "Vibration error from model (1), quasi-static (eq. (3) corrected):\n";
+  out << fmt::format("  {:<10}{:>14}{:>16}\n", "term", "error (ug)", "error (g)");
+  json tj = json::object();
+  for (int t = 0; t < rectification::kNumTerms; ++t) {
+    if (t == rectification::t_clipping && !c.range_limit_g) continue;
+    const double g = terms.g[t];
+    tj[std::string(rectification::term_name(t))] = g;
+    const bool omitted = t == rectification::t_k_PP || t == rectification::t_k_OO;
+    out << fmt::format("  {:<10}{:>14.6f}{:>16.6e}{}\n", rectification::term_name(t), g * 1e6, g,
+                       omitted ? "   (omitted by the printed eq. (3))" : "");
+  }
+  const double total = terms.total_g();
+  out << fmt::format("  {:<10}{:>14.6f}{:>16.6e}\n", "total", total * 1e6, total);
+  out << fmt::format("  of which the printed eq. (3) omits (k_PP, k_OO): {:.6f} ug\n", terms.omitted_by_paper_g() * 1e6);
+  if (printed)
+    out << fmt::format("Eq. (3) as printed in the paper gives {:.6f} ug (differs by {:.6f} ug)\n", *printed * 1e6,
+                       (*printed - total) * 1e6);
+
+  if (o.json_path.empty()) return;
+  json j;
+  j["program"] = program_record();
+  j["command"] = "predict";
+  j["case"] = case_record(c);
+  j["model"] = "eq3_corrected_quasi_static";
+  j["orientation_g"] = vec_json(a);
+  j["vibration"] = vib;
+  j["range_limit_g"] = c.range_limit_g ? json(*c.range_limit_g) : json(nullptr);
+  j["total_g"] = total;
+  j["terms"] = tj;
+  j["omitted_by_paper_g"] = terms.omitted_by_paper_g();
+  j["paper_printed_total_g"] = printed ? json(*printed) : json(nullptr);
+  j["units"] = {{"total_g", "g"}, {"terms", "g"}};
+  write_atomic(o.json_path, j.dump(2) + "\n");
+}
+
+}  // namespace vrelab::app

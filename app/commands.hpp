@@ -1,0 +1,26 @@
+#pragma once
+// app/commands.hpp -- the CLI's commands: parse the case, call the library, write results.
+// Each prints a human-readable summary on `out` and, when json_path is set, writes the JSON
+// result atomically. Bad input throws InputError (the CLI exits with code 2).
+#include <cstdint>
+#include <optional>
+#include <ostream>
+#include <string>
+
+namespace vrelab::app {
+
+struct IdentifyOptions {
+  std::string case_path;
+  std::string json_path;
+  int monte_carlo = 0;
+  std::optional<std::uint64_t> seed;
+};
+void run_identify(const IdentifyOptions& o, std::ostream& out);
+
+struct PredictOptions {
+  std::string case_path;
+  std::string json_path;
+};
+void run_predict(const PredictOptions& o, std::ostream& out);
+
+}  // namespace vrelab::app

@@ -1,0 +1,49 @@
+// vrelab: the command-line interface. A thin layer: options in, library calls, results out.
+// Exit codes: 0 success, 2 bad input (case file, options), 1 anything else.
+#include <iostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "app/case_file.hpp"
+#include "app/commands.hpp"
+#include "vrelab_version.hpp"
+
+int main(int argc, char** argv) {
+  using namespace vrelab::app;
+  CLI::App app{"vrelab: a virtual shaker laboratory for the vibration rectification error of accelerometers"};
+  app.set_version_flag("--version", std::string("vrelab ") + vrelab::kProgramVersion + " (" + vrelab::kGitDescribe + ")");
+  app.require_subcommand(1);
+
+  IdentifyOptions id;
+  auto* identify = app.add_subcommand(
+      "identify", "Virtual static test on a dividing head; identify the coefficients of model (1)");
+  identify->add_option("case", id.case_path, "Case file (TOML)")->required();
+  identify->add_option("--json", id.json_path, "Write the result as JSON to this file");
+  identify->add_option("--monte-carlo", id.monte_carlo, "Also run N simulated tests for Monte Carlo uncertainty")
+      ->check(CLI::NonNegativeNumber);
+  identify->add_option("--seed", id.seed, "Override the case's [run] seed");
+
+  PredictOptions pr;
+  auto* predict = app.add_subcommand("predict", "Vibration error implied by model (1): eq. (3), corrected");
+  predict->add_option("case", pr.case_path, "Case file (TOML)")->required();
+  predict->add_option("--json", pr.json_path, "Write the result as JSON to this file");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? 0 : 2;
+  }
+  try {
+    if (*identify) run_identify(id, std::cout);
+    if (*predict) run_predict(pr, std::cout);
+  } catch (const InputError& e) {
+    std::cerr << "vrelab: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "vrelab: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,37 @@
+#include "app/output.hpp"
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include <unistd.h>
+
+#include "vrelab_version.hpp"
+
+namespace vrelab::app {
+
+void write_atomic(const std::string& path, const std::string& text) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  if (target.has_parent_path()) fs::create_directories(target.parent_path());
+  const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    out << text;
+    out.flush();
+    if (!out) {
+      fs::remove(tmp);
+      throw std::runtime_error("writing " + tmp.string() + " failed");
+    }
+  }
+  fs::rename(tmp, target);
+}
+
+nlohmann::json program_record() {
+  return {{"name", "vrelab"}, {"version", kProgramVersion}, {"git", kGitDescribe}};
+}
+
+nlohmann::json case_record(const Case& c) { return {{"file", c.path}, {"content", c.content}}; }
+
+}  // namespace vrelab::app

@@ -1,0 +1,20 @@
+#pragma once
+// app/output.hpp -- writing results: atomically, with the record of how they were made.
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "app/case_file.hpp"
+
+namespace vrelab::app {
+
+// Writes `text` to `path` through a temporary file in the same folder and a rename, so a
+// reader never sees a partial file and a failed run leaves no file. Creates the folder.
+void write_atomic(const std::string& path, const std::string& text);
+
+// {"name", "version", "git"}: the program that made a result.
+nlohmann::json program_record();
+// {"file", "content"}: the case a result was made from.
+nlohmann::json case_record(const Case& c);
+
+}  // namespace vrelab::app
