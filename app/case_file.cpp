@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <numbers>
 #include <set>
 #include <sstream>
@@ -291,6 +292,7 @@ void read_identification(Table t, Case& c) {
 }  // namespace
 
 Case read_case(const std::string& path) {
+  if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": cannot open the case file (no such file)");
   toml::table root;
   try {
     root = toml::parse_file(path);

@@ -48,7 +48,9 @@ double output(const Coefficients& c, const Vec3& a) { return c[K1] * output_g(c,
 
 Vec3 output_gradient(const Coefficients& c, const Vec3& a) {
   const double x = a[IA], y = a[PA], z = a[OA];
-  const double sign_x = (x > 0) - (x < 0);
+  // At the kink of |a_IA| take the mean of the one-sided slopes; "at" includes the 1e-16 g
+  // left by cos(90 deg) in floating point.
+  const double sign_x = std::abs(x) <= 1e-12 ? 0.0 : (x > 0) - (x < 0);
   const double d_ia = 1.0 + 0.5 * c[k1_asym] * sign_x + 2 * c[k2] * x + 3 * c[k3] * x * x +
                       4 * c[k4] * x * x * x + c[k_IP] * y + c[k_IO] * z;
   const double d_pa = c[delta_OA] + c[k_IP] * x + c[k_PO] * z + 2 * c[k_PP] * y;

@@ -59,8 +59,8 @@ Basis basis(const Vec3& a_g);
 
 double output(const Coefficients& c, const Vec3& a_g);    // U, output units
 double output_g(const Coefficients& c, const Vec3& a_g);  // U / K1, g
-// dU/da in output units per g. At a_IA = 0 the asymmetry term contributes 0 (the mean of
-// its one-sided slopes).
+// dU/da in output units per g. At a_IA = 0 (|a_IA| <= 1e-12 g) the asymmetry term
+// contributes 0 (the mean of its one-sided slopes).
 Vec3 output_gradient(const Coefficients& c, const Vec3& a_g);
 
 }  // namespace vrelab::plant

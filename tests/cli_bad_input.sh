@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# The installed command line: exit code 2 and a message on stderr for bad input, exit 0
+# and a JSON file for good input. Usage: cli_bad_input.sh <vrelab binary> <cases dir>
+set -u
+bin=$1
+cases=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+pass=0
+
+expect() {  # expect <want rc> <stderr regex> <args...>
+  local want=$1 pattern=$2
+  shift 2
+  "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$?
+  if [ "$rc" -ne "$want" ] || ! grep -Eq -- "$pattern" "$tmp/err" "$tmp/out"; then
+    echo "FAIL: vrelab $* -> rc $rc (want $want), stderr: $(cat "$tmp/err")"
+    fail=$((fail + 1))
+  else
+    pass=$((pass + 1))
+  fi
+}
+
+sed 's/^k2 = .*/k2 = nan/' "$cases/ideal-static.toml" >"$tmp/nan.toml"
+expect 2 'k2: must be a finite number' identify "$tmp/nan.toml" --json "$tmp/o/nan.json"
+[ -e "$tmp/o/nan.json" ] && { echo "FAIL: partial output written"; fail=$((fail + 1)); }
+expect 2 'missing.toml: cannot open the case file' identify "$tmp/missing.toml"
+expect 2 'required' identify
+expect 2 '' bogus-command
+expect 0 'least_squares' identify "$cases/ideal-static.toml" --json "$tmp/o/id.json"
+[ -s "$tmp/o/id.json" ] || { echo "FAIL: no JSON written"; fail=$((fail + 1)); }
+expect 0 'total' predict "$cases/paper-predict.toml" --json "$tmp/o/p.json"
+expect 0 'vrelab 0' --version
+echo "$pass passed, $fail failed"
+[ "$fail" -eq 0 ]

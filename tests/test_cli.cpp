@@ -1,0 +1,171 @@
+// The commands as the CLI runs them, in-process: JSON schema and values on the shipped
+// cases, and bad input (a clear message naming the key and line, no partial output).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "app/case_file.hpp"
+#include "app/commands.hpp"
+
+using namespace vrelab::app;
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    path = fs::temp_directory_path() / ("vrelab-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                                        "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+// A copy of a shipped case with one regex replacement applied.
+fs::path edited_case(const TempDir& d, const std::string& name, const std::string& pattern, const std::string& with) {
+  const std::string text = read_file(fs::path(VRELAB_CASES_DIR) / name);
+  const std::string edited = std::regex_replace(text, std::regex(pattern), with);
+  EXPECT_NE(edited, text) << "pattern " << pattern << " did not match";
+  const fs::path out = d.path / ("edited-" + name);
+  std::ofstream(out) << edited;
+  return out;
+}
+
+json identify_json(const fs::path& case_path, const TempDir& d, int mc = 0) {
+  IdentifyOptions o;
+  o.case_path = case_path.string();
+  o.json_path = (d.path / "out" / "identify.json").string();
+  o.monte_carlo = mc;
+  std::ostringstream text;
+  run_identify(o, text);
+  return json::parse(read_file(o.json_path));
+}
+
+}  // namespace
+
+TEST(CliIdentify, IdealCaseRecoversTheTruthAndWritesTheDocumentedSchema) {
+  TempDir d;
+  const json j = identify_json(fs::path(VRELAB_CASES_DIR) / "ideal-static.toml", d);
+  for (const char* key : {"program", "case", "seed", "truth", "estimates", "errors", "sigma", "identifiability", "readings"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["identifiability"]["rank"], 10);
+  EXPECT_EQ(j["readings"].size(), 24u);
+  for (const char* m : {"paper_corrected", "least_squares"})
+    for (auto& [name, truth] : j["truth"].items()) {
+      const double t = truth.get<double>();
+      EXPECT_NEAR(j["estimates"][m][name].get<double>(), t, 1e-9 * std::abs(t) + 1e-15) << m << " " << name;
+    }
+  EXPECT_TRUE(j["estimates"]["paper_printed"]["delta_OA"].is_null());
+  EXPECT_NEAR(j["estimates"]["paper_printed"]["k3"].get<double>(), -j["truth"]["k3"].get<double>() / 3, 1e-9);
+  EXPECT_EQ(j["case"]["content"]["dividing_head"]["positions_per_series"], 8);
+}
+
+TEST(CliIdentify, OtherPositionSetsRunLeastSquaresOnlyAndSaySo) {
+  TempDir d;
+  const fs::path c = edited_case(d, "ideal-static.toml", "positions_per_series = 8", "positions_per_series = 24");
+  const json j = identify_json(c, d);
+  EXPECT_TRUE(j["estimates"]["paper_corrected"].is_null());
+  EXPECT_FALSE(j["estimates"]["least_squares"].is_null());
+  EXPECT_NE(j["notes"][0].get<std::string>().find("3 x 8"), std::string::npos);
+}
+
+TEST(CliPredict, WritesTotalAndTermsThatAddUp) {
+  TempDir d;
+  PredictOptions o;
+  o.case_path = std::string(VRELAB_CASES_DIR) + "/paper-predict.toml";
+  o.json_path = (d.path / "predict.json").string();
+  std::ostringstream text;
+  run_predict(o, text);
+  const json j = json::parse(read_file(o.json_path));
+  double sum = 0;
+  for (auto& [k, v] : j["terms"].items()) sum += v.get<double>();
+  EXPECT_NEAR(j["total_g"].get<double>(), sum, 1e-18);
+  // k2 w^2/2 by hand: 1.5e-5 * 9 / 2.
+  EXPECT_NEAR(j["terms"]["k2"].get<double>(), 1.5e-5 * 9 / 2, 1e-18);
+  EXPECT_NEAR(j["omitted_by_paper_g"].get<double>(), 4e-6 * 1 / 2, 1e-18);
+  EXPECT_TRUE(j.contains("paper_printed_total_g"));
+}
+
+namespace {
+
+// Runs identify on an edited case and expects InputError whose message matches `expect`,
+// and no output file.
+void expect_identify_rejects(const std::string& pattern, const std::string& with, const std::string& expect,
+                             const std::string& base = "ideal-static.toml") {
+  TempDir d;
+  const fs::path c = edited_case(d, base, pattern, with);
+  IdentifyOptions o;
+  o.case_path = c.string();
+  o.json_path = (d.path / "out" / "identify.json").string();
+  std::ostringstream text;
+  try {
+    run_identify(o, text);
+    ADD_FAILURE() << "accepted: " << pattern << " -> " << with;
+  } catch (const InputError& e) {
+    EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(expect))) << e.what();
+    EXPECT_NE(std::string(e.what()).find(c.string()), std::string::npos) << "names the file: " << e.what();
+  }
+  EXPECT_FALSE(fs::exists(o.json_path));
+}
+
+}  // namespace
+
+TEST(CliBadInput, TypoIsAnUnknownKeyWithLineAndSuggestion) {
+  expect_identify_rejects("angle_sigma_arcsec", "angle_sigma_arcsex",
+                          R"(:\d+: \[dividing_head\] angle_sigma_arcsex: unknown key \(did you mean 'angle_sigma_arcsec'\?\))");
+  expect_identify_rejects("\\[coefficients\\]", "[coeficients]", R"(coeficients: unknown key \(did you mean 'coefficients'\?\))");
+}
+
+TEST(CliBadInput, MissingCoefficientIsNamed) {
+  expect_identify_rejects("\nk4 = [^\n]*", "", R"(\[coefficients\] k4: missing)");
+}
+
+TEST(CliBadInput, NanIsRejected) {
+  expect_identify_rejects("\nk2 = [^\n#]*", "\nk2 = nan ", R"(:\d+: \[coefficients\] k2: must be a finite number)");
+}
+
+TEST(CliBadInput, NegativeSigmaIsRejected) {
+  expect_identify_rejects("noise_sigma_ug = 0.0", "noise_sigma_ug = -1.0",
+                          R"(:\d+: \[dividing_head\] noise_sigma_ug: must not be negative)");
+}
+
+TEST(CliBadInput, EmptyPositionSetIsRejected) {
+  expect_identify_rejects("positions_per_series = 8", "positions = []", R"(\[dividing_head\] positions: the position set is empty)");
+  expect_identify_rejects("positions_per_series = 8", "positions_per_series = 0",
+                          R"(positions_per_series: must be at least 1)");
+}
+
+TEST(CliBadInput, RankDeficientSetIsReportedInWords) {
+  expect_identify_rejects("fixed = \\{[^}]*\\}", "fixed = { }",
+                          R"(rank 11 of 13[\s\S]*k0 and a common shift of k2, k_PP, k_OO[\s\S]*k1_asym)");
+}
+
+TEST(CliBadInput, SyntaxErrorNamesTheLine) {
+  expect_identify_rejects("k3 = ", "k3 = = ", R"(:\d+: )");
+}
+
+TEST(CliBadInput, PredictRejectsNegativeAmplitude) {
+  TempDir d;
+  const fs::path c = edited_case(d, "paper-predict.toml", "amplitude_g = \\[3.0", "amplitude_g = [-3.0");
+  PredictOptions o;
+  o.case_path = c.string();
+  o.json_path = (d.path / "p.json").string();
+  std::ostringstream text;
+  EXPECT_THROW(run_predict(o, text), InputError);
+  EXPECT_FALSE(fs::exists(o.json_path));
+}
