@@ -25,6 +25,19 @@ expect() {  # expect <want rc> <stderr regex> <args...>
 sed 's/^k2 = .*/k2 = nan/' "$cases/ideal-static.toml" >"$tmp/nan.toml"
 expect 2 'k2: must be a finite number' identify "$tmp/nan.toml" --json "$tmp/o/nan.json"
 [ -e "$tmp/o/nan.json" ] && { echo "FAIL: partial output written"; fail=$((fail + 1)); }
+# Each kind of bad input: exit 2, the key named, no output file.
+bad() {  # bad <name> <sed expression> <stderr regex> [case]
+  local name=$1 expr=$2 pattern=$3 base=${4:-ideal-static.toml}
+  sed -E "$expr" "$cases/$base" >"$tmp/$name.toml"
+  expect 2 "$pattern" identify "$tmp/$name.toml" --json "$tmp/o/$name.json"
+  [ -e "$tmp/o/$name.json" ] && { echo "FAIL: $name: partial output written"; fail=$((fail + 1)); }
+  return 0
+}
+bad typo 's/^angle_sigma_arcsec/angle_sigma_arcsex/' "angle_sigma_arcsex: unknown key \(did you mean 'angle_sigma_arcsec'\?\)"
+bad nocoef '/^k4 = /d' '\[coefficients\] k4: missing'
+bad negative 's/^noise_sigma_ug = .*/noise_sigma_ug = -1.0/' 'noise_sigma_ug: must not be negative'
+bad empty 's/^positions_per_series = .*/positions = []/' 'the position set is empty'
+bad rank 's/^fixed = .*/fixed = { }/' 'rank 11 of 13'
 expect 2 'missing.toml: cannot open the case file' identify "$tmp/missing.toml"
 expect 2 'required' identify
 expect 2 '' bogus-command

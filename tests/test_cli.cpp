@@ -169,3 +169,22 @@ TEST(CliBadInput, PredictRejectsNegativeAmplitude) {
   EXPECT_THROW(run_predict(o, text), InputError);
   EXPECT_FALSE(fs::exists(o.json_path));
 }
+
+TEST(CliIdentify, SameSeedSameResultOtherSeedOtherResult) {
+  TempDir d;
+  const fs::path c = fs::path(VRELAB_CASES_DIR) / "paper-static.toml";
+  auto run = [&](std::optional<std::uint64_t> seed) {
+    IdentifyOptions o;
+    o.case_path = c.string();
+    o.json_path = (d.path / "r.json").string();
+    o.seed = seed;
+    std::ostringstream text;
+    run_identify(o, text);
+    return json::parse(read_file(o.json_path));
+  };
+  const json a = run(std::nullopt), b = run(std::nullopt), other = run(99);
+  EXPECT_EQ(a["estimates"], b["estimates"]);
+  EXPECT_EQ(a["readings"], b["readings"]);
+  EXPECT_NE(a["estimates"]["least_squares"], other["estimates"]["least_squares"]);
+  EXPECT_EQ(other["seed"], 99);
+}

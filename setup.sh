@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Sets vrelab up on a fresh Debian (12) machine and runs the main job:
+#   1. installs the Debian packages it builds with (apt-get, with sudo when not root);
+#   2. configures and builds into build/ (the program is build/vrelab);
+#   3. runs the main job on the shipped default case.
+# Options: --no-run (skip step 3). CMake options can be passed in VRELAB_CMAKE_ARGS.
+set -euo pipefail
+cd "$(dirname "$0")"
+
+packages=(build-essential cmake git pkg-config
+          libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev
+          libgtest-dev)
+
+run_main=1
+[ "${1:-}" = "--no-run" ] && run_main=0
+
+if ! dpkg -s "${packages[@]}" >/dev/null 2>&1; then
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  echo "== Installing Debian packages: ${packages[*]}"
+  $sudo apt-get update
+  $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y "${packages[@]}"
+fi
+
+echo "== Building into build/"
+# shellcheck disable=SC2086
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release ${VRELAB_CMAKE_ARGS:-}
+cmake --build build -j"$(nproc)"
+
+if [ "$run_main" -eq 1 ]; then
+  # The main job. Until the paper reproduction exists it is the paper's static test
+  # and identification; results in out/identify.json.
+  echo "== Main job: build/vrelab identify cases/paper-static.toml --json out/identify.json --monte-carlo 1000"
+  build/vrelab identify cases/paper-static.toml --json out/identify.json --monte-carlo 1000
+fi
