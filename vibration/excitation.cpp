@@ -1,0 +1,25 @@
+#include "vibration/excitation.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <sstream>
+
+namespace vrelab::vibration {
+
+SineExcitation::SineExcitation(const SineVibration& v) : v_(v) { validate(v_); }
+
+Vec3 SineExcitation::acceleration_g(double t) const {
+  const double wt = 2 * std::numbers::pi * v_.frequency_Hz * t;
+  Vec3 a;
+  for (int i = 0; i < 3; ++i) a[i] = v_.amplitude_g[i] * std::sin(wt + v_.phase_rad[i]);
+  return a;
+}
+
+std::string SineExcitation::describe() const {
+  std::ostringstream s;
+  s << "sine " << v_.frequency_Hz << " Hz, peak [" << v_.amplitude_g[0] << ", " << v_.amplitude_g[1] << ", "
+    << v_.amplitude_g[2] << "] g";
+  return s.str();
+}
+
+}  // namespace vrelab::vibration
