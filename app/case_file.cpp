@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <filesystem>
 #include <numbers>
 #include <set>
@@ -94,12 +96,14 @@ class Table {
     if (x && *x < 0) fail(t_.get(key), key, "must not be negative, got " + std::to_string(*x));
     return x.value_or(fallback);
   }
-  std::int64_t integer(std::string_view key, bool required, std::int64_t fallback, std::int64_t min) {
+  std::int64_t integer(std::string_view key, bool required, std::int64_t fallback, std::int64_t min,
+                       std::int64_t max = std::numeric_limits<std::int32_t>::max()) {
     const toml::node* n = get(key, required);
     if (!n) return fallback;
     if (!n->is_integer()) fail(n, key, std::string("expected an integer, got ") + type_name(*n));
     const std::int64_t v = n->as_integer()->get();
     if (v < min) fail(n, key, "must be at least " + std::to_string(min) + ", got " + std::to_string(v));
+    if (v > max) fail(n, key, "must be at most " + std::to_string(max) + ", got " + std::to_string(v));
     return v;
   }
   std::string string(std::string_view key, std::string fallback) {
@@ -198,10 +202,12 @@ void read_vibration(Table t, Case& c) {
       if (!rows || rows->size() != 3) t.fail(n, "correlation", "expected a 3 x 3 array of numbers");
       for (int i = 0; i < 3; ++i) v.correlation.row(i) = t.vec3_of(rows->get(static_cast<std::size_t>(i)), "correlation");
     }
+    for (int i = 0; i < 3; ++i)
+      if (v.rms_g[i] < 0) t.fail(t.raw().get("rms_g"), "rms_g", "rms values must not be negative");
     try {
       vibration::validate(v);
     } catch (const std::invalid_argument& e) {
-      t.fail(t.raw().get("rms_g"), "rms_g/correlation", e.what());
+      t.fail(t.raw().get("correlation"), "correlation", e.what());
     }
     t.check_unknown({"type", "rms_g", "correlation"});
     c.vibration = v;
@@ -217,7 +223,7 @@ void read_dividing_head(Table t, Case& c) {
     t.fail(nullptr, "positions_per_series",
            "give exactly one of positions_per_series, positions or orientations_g");
   if (t.has("positions_per_series")) {
-    const auto n = t.integer("positions_per_series", true, 8, 1);
+    const auto n = t.integer("positions_per_series", true, 8, 1, 3600);
     std::vector<int> series{1, 2, 3};
     if (const toml::node* s = t.get("series", false)) {
       series.clear();
@@ -233,7 +239,8 @@ void read_dividing_head(Table t, Case& c) {
     h.description = std::to_string(series.size()) + " series x " + std::to_string(n) + " positions";
   } else if (const toml::node* p = t.get("positions", false)) {
     const toml::array* a = p->as_array();
-    if (!a || a->empty()) t.fail(p, "positions", "the position set is empty");
+    if (!a) t.fail(p, "positions", "expected an array of tables {series = 1, angle_deg = 45.0}");
+    if (a->empty()) t.fail(p, "positions", "the position set is empty");
     for (auto&& x : *a) {
       const toml::table* e = x.as_table();
       if (!e) t.fail(&x, "positions", "each position is a table {series = 1, angle_deg = 45.0}");
@@ -253,7 +260,8 @@ void read_dividing_head(Table t, Case& c) {
   } else {
     const toml::node* o = t.get("orientations_g", true);
     const toml::array* a = o->as_array();
-    if (!a || a->empty()) t.fail(o, "orientations_g", "the position set is empty");
+    if (!a) t.fail(o, "orientations_g", "expected an array of [a_IA, a_PA, a_OA] vectors");
+    if (a->empty()) t.fail(o, "orientations_g", "the position set is empty");
     for (auto&& x : *a) {
       const Vec3 v = t.vec3_of(&x, "orientations_g");
       if (std::abs(v.norm() - 1) > 1e-6)
@@ -266,7 +274,7 @@ void read_dividing_head(Table t, Case& c) {
   h.errors.initial_error_rad = t.opt_vec3("initial_error_arcsec").value_or(Vec3::Zero()) * kArcsec;
   h.errors.angle_sigma_rad = t.non_negative("angle_sigma_arcsec", 0.0) * kArcsec;
   h.errors.noise_sigma_g = t.non_negative("noise_sigma_ug", 0.0) * 1e-6;
-  h.errors.repeats = static_cast<int>(t.integer("repeats", false, 1, 1));
+  h.errors.repeats = static_cast<int>(t.integer("repeats", false, 1, 1, 100000));
   t.check_unknown({"positions_per_series", "series", "positions", "orientations_g", "initial_error_arcsec",
                    "angle_sigma_arcsec", "noise_sigma_ug", "repeats"});
   c.dividing_head = std::move(h);

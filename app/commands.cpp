@@ -88,8 +88,10 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
       "noise sigma {:g} ug\n",
       e.initial_error_rad[0] / kArcsec, e.initial_error_rad[1] / kArcsec, e.initial_error_rad[2] / kArcsec,
       e.angle_sigma_rad / kArcsec, e.noise_sigma_g * 1e6);
-  out << fmt::format("Identifiability (least squares): {} free coefficients, rank {}, condition number {:.3g}\n",
-                     r.identifiability.parameters, r.identifiability.rank, r.identifiability.condition_number);
+  out << fmt::format(
+      "Identifiability (least squares): {} free coefficients, rank {}, condition number {:.3g} (position set), "
+      "{:.3g} (weighted)\n",
+      r.identifiability.parameters, r.identifiability.rank, ident.condition_number, r.identifiability.condition_number);
   std::string fixed_list;
   for (int i = 0; i < kNumCoefficients; ++i)
     if (c.fixed[i]) fixed_list += fmt::format("{}{} = {:g}", fixed_list.empty() ? "" : ", ", plant::coefficient_name(i), *c.fixed[i]);
@@ -189,7 +191,8 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
     if (c.fixed[i]) fixed[std::string(plant::coefficient_name(i))] = *c.fixed[i];
   j["identifiability"] = {{"parameters", id.parameters},
                           {"rank", id.rank},
-                          {"condition_number", id.condition_number},
+                          {"condition_number", ident.condition_number},
+                          {"condition_number_weighted", id.condition_number},
                           {"free", free},
                           {"fixed", fixed},
                           {"identifiable", identifiable},
@@ -227,7 +230,8 @@ void run_predict(const PredictOptions& o, std::ostream& out) {
     const Vec3 ph = s->phase_rad * 180 / std::numbers::pi;
     description = fmt::format("sine, peak [{:g}, {:g}, {:g}] g, phase [{:g}, {:g}, {:g}] deg", s->amplitude_g[0],
                               s->amplitude_g[1], s->amplitude_g[2], ph[0], ph[1], ph[2]);
-    vib = {{"type", "sine"}, {"amplitude_g", vec_json(s->amplitude_g)}, {"phase_deg", vec_json(ph)}};
+    vib = {{"type", "sine"}, {"amplitude_g", vec_json(s->amplitude_g)}, {"phase_deg", vec_json(ph)},
+           {"frequency_Hz", s->frequency_Hz > 0 ? json(s->frequency_Hz) : json(nullptr)}};
   } else {
     const auto& rv = std::get<vibration::RandomVibration>(*c.vibration);
     terms = rectification::random_rectification(k, a, rv, c.range_limit_g);

@@ -13,11 +13,13 @@ namespace vrelab::app {
 void write_atomic(const std::string& path, const std::string& text) {
   namespace fs = std::filesystem;
   const fs::path target(path);
-  if (target.has_parent_path()) fs::create_directories(target.parent_path());
+  std::error_code dir_error;
+  if (target.has_parent_path()) fs::create_directories(target.parent_path(), dir_error);
+  if (dir_error) throw InputError("cannot create the folder of " + target.string() + ": " + dir_error.message());
   const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
+    if (!out) throw InputError("cannot write " + tmp.string());
     out << text;
     out.flush();
     if (!out) {
@@ -25,7 +27,12 @@ void write_atomic(const std::string& path, const std::string& text) {
       throw std::runtime_error("writing " + tmp.string() + " failed");
     }
   }
-  fs::rename(tmp, target);
+  std::error_code ec;
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp);
+    throw InputError("cannot write " + target.string() + ": " + ec.message());
+  }
 }
 
 nlohmann::json program_record() {

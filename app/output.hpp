@@ -10,6 +10,7 @@ namespace vrelab::app {
 
 // Writes `text` to `path` through a temporary file in the same folder and a rename, so a
 // reader never sees a partial file and a failed run leaves no file. Creates the folder.
+// A path that cannot be written throws InputError (exit code 2).
 void write_atomic(const std::string& path, const std::string& text);
 
 // {"name", "version", "git"}: the program that made a result.

@@ -38,9 +38,14 @@ bad nocoef '/^k4 = /d' '\[coefficients\] k4: missing'
 bad negative 's/^noise_sigma_ug = .*/noise_sigma_ug = -1.0/' 'noise_sigma_ug: must not be negative'
 bad empty 's/^positions_per_series = .*/positions = []/' 'the position set is empty'
 bad rank 's/^fixed = .*/fixed = { }/' 'rank 11 of 13'
+bad bigint 's/^repeats = .*/repeats = 4294967297/' 'repeats: must be at most'
+bad notarray 's/^positions_per_series = .*/positions = "abc"/' 'positions: expected an array of tables'
+mkdir -p "$tmp/o/isdir.json"
+expect 2 'cannot write' identify "$cases/ideal-static.toml" --json "$tmp/o/isdir.json"
+ls "$tmp/o" | grep -q 'tmp' && { echo "FAIL: a temporary file was left behind"; fail=$((fail + 1)); }
 expect 2 'missing.toml: cannot open the case file' identify "$tmp/missing.toml"
 expect 2 'required' identify
-expect 2 '' bogus-command
+expect 2 'subcommand is required' bogus-command
 expect 0 'least_squares' identify "$cases/ideal-static.toml" --json "$tmp/o/id.json"
 [ -s "$tmp/o/id.json" ] || { echo "FAIL: no JSON written"; fail=$((fail + 1)); }
 expect 0 'total' predict "$cases/paper-predict.toml" --json "$tmp/o/p.json"

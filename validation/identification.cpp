@@ -90,6 +90,10 @@ std::string describe(const std::array<double, N>& v, const std::vector<Position>
     for (std::size_t n = 0; n < idx.size(); ++n)
       out << (n == 0 ? "" : n + 1 == idx.size() ? " and " : ", ") << label(idx[n]);
   }
+  if (idx.size() == 1) {
+    out << " affects no reading in this position set";
+    return out.str();
+  }
   out << " cannot be told apart: ";
   for (std::size_t n = 0; n < idx.size(); ++n) {
     const double f = v[idx[n]];
@@ -262,17 +266,19 @@ struct Table {
   double operator()(int s, int j) const { return t[s - 1][j - 1]; }
 };
 
-Estimate paper_common(const Table& U, double k1_tilde, double K, bool corrected) {
+Estimate paper_common(const Table& U, double k1_tilde, double K, bool corrected, double kpp = 0, double koo = 0) {
   constexpr double r2 = std::numbers::sqrt2;
   Estimate e;
   e.value[K1] = K;
   e.value[k1_asym] = k1_tilde;
+  // At these 12 positions a_PA^2 + a_OA^2 sums to 6 for each of k_PP and k_OO.
   e.value[k0] = (U(1, 3) + U(2, 3) + U(1, 7) + U(2, 7) + U(3, 1) + U(3, 2) + U(3, 3) + U(3, 4) + U(3, 5) +
-                 U(3, 6) + U(3, 7) + U(3, 8)) / (12 * K);
+                 U(3, 6) + U(3, 7) + U(3, 8)) / (12 * K) - (kpp + koo) / 2;
   const double sum45 = U(1, 2) + U(1, 4) + U(1, 6) + U(1, 8);
   if (corrected) {
-    e.value[k2] = (sum45 - (U(1, 1) + U(1, 5)) / 2) / K - 3 * e.value[k0] + (1 - 2 * r2) / 2 * k1_tilde;
-    e.value[k4] = (U(1, 1) + U(1, 5) - sum45) / K + 2 * e.value[k0] + (r2 - 1) * k1_tilde;
+    // a_PA^2 = 1/2 at the four 45 deg positions of series 1 and 0 at j = 1, 5.
+    e.value[k2] = (sum45 - (U(1, 1) + U(1, 5)) / 2) / K - 3 * e.value[k0] + (1 - 2 * r2) / 2 * k1_tilde - 2 * kpp;
+    e.value[k4] = (U(1, 1) + U(1, 5) - sum45) / K + 2 * e.value[k0] + (r2 - 1) * k1_tilde + 2 * kpp;
     const double d1 = (U(1, 5) - U(1, 1)) / 2;
     const double d2 = ((U(1, 4) + U(1, 6)) - (U(1, 2) + U(1, 8))) / 4;
     e.value[k3] = 2 * (d1 - r2 * d2) / K;
@@ -291,7 +297,8 @@ Estimate paper_common(const Table& U, double k1_tilde, double K, bool corrected)
   e.value[k_IO] = (U(2, 2) + U(2, 6) - (U(2, 4) + U(2, 8))) / (2 * K);
   e.value[k_PO] = (U(3, 2) + U(3, 6) - (U(3, 4) + U(3, 8))) / (2 * K);
   for (int i = 0; i < N; ++i) e.available[i] = true;
-  e.value[k_PP] = e.value[k_OO] = 0.0;  // the paper's silent assumption
+  e.value[k_PP] = kpp;  // the paper's silent assumption is 0
+  e.value[k_OO] = koo;
   e.assumed[k_PP] = e.assumed[k_OO] = e.assumed[k1_asym] = true;
   if (!corrected) e.available[delta_OA] = e.available[delta_PA] = false;  // not printed
   return e;
@@ -306,12 +313,12 @@ Estimate paper_printed(const PaperTable& t, double k1_tilde) {
   return paper_common(U, k1_tilde, k1, false);
 }
 
-Estimate paper_corrected(const PaperTable& t, double k1_tilde) {
+Estimate paper_corrected(const PaperTable& t, double k1_tilde, double kpp, double koo) {
   const Table U{t};
   constexpr double r2 = std::numbers::sqrt2;
   const double d1 = (U(1, 5) - U(1, 1)) / 2;
   const double d2 = ((U(1, 4) + U(1, 6)) - (U(1, 2) + U(1, 8))) / 4;
-  return paper_common(U, k1_tilde, 2 * r2 * d2 - d1, true);
+  return paper_common(U, k1_tilde, 2 * r2 * d2 - d1, true, kpp, koo);
 }
 
 }  // namespace vrelab::validation

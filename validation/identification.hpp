@@ -65,7 +65,8 @@ std::optional<PaperTable> paper_table(const std::vector<Position>& positions,
 
 // The paper's formulas as printed; k1_tilde is k1' taken from elsewhere (as the paper does).
 Estimate paper_printed(const PaperTable& u, double k1_tilde);
-// The corrected closed forms (exact for model (1) with k_PP = k_OO = 0).
-Estimate paper_corrected(const PaperTable& u, double k1_tilde);
+// The corrected closed forms, exact for model (1) with k_PP and k_OO at the given values
+// (the paper assumes both zero; only their common shift with k0 and k2 is invisible).
+Estimate paper_corrected(const PaperTable& u, double k1_tilde, double k_PP_known = 0.0, double k_OO_known = 0.0);
 
 }  // namespace vrelab::validation

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <random>
+#include <string>
 
 namespace vrelab::validation {
 
@@ -30,9 +31,17 @@ StaticTestReport run_static_test(const plant::Coefficients& truth, const std::ve
     estimators.emplace_back("paper_printed", [&positions, k1 = *k1_tilde](const std::vector<Reading>& r) {
       return paper_printed(*paper_table(positions, r), k1);
     });
-    estimators.emplace_back("paper_corrected", [&positions, k1 = *k1_tilde](const std::vector<Reading>& r) {
-      return paper_corrected(*paper_table(positions, r), k1);
+    const double kpp = settings.fixed[plant::k_PP].value_or(0.0), koo = settings.fixed[plant::k_OO].value_or(0.0);
+    estimators.emplace_back("paper_corrected", [&positions, k1 = *k1_tilde, kpp, koo](const std::vector<Reading>& r) {
+      return paper_corrected(*paper_table(positions, r), k1, kpp, koo);
     });
+    if (kpp != 0 || koo != 0)
+      report.notes.push_back("paper_printed assumes k_PP = k_OO = 0 (as printed); paper_corrected uses the fixed values");
+    for (int i : {plant::K1, plant::k0, plant::k2, plant::k3, plant::k4, plant::delta_OA, plant::delta_PA, plant::k_IP,
+                  plant::k_IO, plant::k_PO})
+      if (settings.fixed[i])
+        report.notes.push_back(std::string("the paper's formulas estimate ") + std::string(plant::coefficient_name(i)) +
+                               " and ignore its fixed value; least_squares holds it");
   }
   const FixedSet fixed = settings.fixed;
   estimators.emplace_back("least_squares", [&positions, weights, fixed](const std::vector<Reading>& r) {

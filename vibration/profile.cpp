@@ -15,8 +15,8 @@ void check_axes(const Vec3& v, const char* field, bool non_negative) {
     if (!std::isfinite(v[i]))
       throw std::invalid_argument(std::string(field) + "[" + axis[i] + "] is not a finite number");
     if (non_negative && v[i] < 0)
-      throw std::invalid_argument(std::string(field) + "[" + axis[i] + "] = " + std::to_string(v[i]) +
-                                  " is negative (use a phase of 180 deg for a reversed axis)");
+      throw std::invalid_argument(std::string(field) + "[" + axis[i] + "] = " + std::to_string(v[i]) + " is negative" +
+                                  (std::string(field) == "amplitude_g" ? " (use a phase of 180 deg for a reversed axis)" : ""));
   }
 }
 
