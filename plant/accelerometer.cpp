@@ -1,0 +1,318 @@
+#include "plant/accelerometer.hpp"
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+namespace vrelab::plant {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr int kIaTerms[] = {k0, k1_asym, k2, k3, k4};
+constexpr int kCrossTerms[] = {delta_OA, delta_PA, k_IP, k_IO, k_PO, k_PP, k_OO};
+
+bool is_ia_term(int c) { return c >= k0 && c <= k4; }
+
+double ia_basis(int c, double z) {
+  switch (c) {
+    case k0: return 1.0;
+    case k1_asym: return 0.5 * std::abs(z);
+    case k2: return z * z;
+    case k3: return z * z * z;
+    default: return z * z * z * z;
+  }
+}
+
+double ia_basis_slope(int c, double z) {
+  switch (c) {
+    case k0: return 0.0;
+    case k1_asym: return 0.5 * ((z > 0) - (z < 0));
+    case k2: return 2 * z;
+    case k3: return 3 * z * z;
+    default: return 4 * z * z * z;
+  }
+}
+
+}  // namespace
+
+std::string_view location_name(Location l) {
+  switch (l) {
+    case Location::input: return "input";
+    case Location::loop: return "loop";
+    default: return "output";
+  }
+}
+
+bool location_allowed(int c, Location l) {
+  if (c == K1) return false;
+  return is_ia_term(c) || l != Location::loop;
+}
+
+std::array<Location, kNumCoefficients> PlantConfig::default_locations() {
+  std::array<Location, kNumCoefficients> l{};
+  for (int c = 0; c < kNumCoefficients; ++c) l[c] = is_ia_term(c) ? Location::loop : Location::output;
+  return l;
+}
+
+bool Dynamics::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    if (error) *error = m;
+    return false;
+  };
+  auto positive = [](double x) { return std::isfinite(x) && x > 0; };
+  if (!positive(pendulum_frequency_Hz)) return fail("pendulum_frequency_Hz must be positive");
+  if (!positive(pendulum_damping_ratio)) return fail("pendulum_damping_ratio must be positive");
+  if (!positive(angle_gain_rad_per_s2_per_g)) return fail("angle_gain_rad_per_s2_per_g must be positive");
+  if (!positive(loop_bandwidth_Hz)) return fail("loop_bandwidth_Hz must be positive");
+  if (!(phase_margin_deg >= 10 && phase_margin_deg <= 85)) return fail("phase_margin_deg must lie in [10, 85]");
+  if (integrator && !(integrator_zero_ratio > 0 && integrator_zero_ratio <= 0.5))
+    return fail("integrator_zero_ratio must lie in (0, 0.5]");
+  if (!(antialias_Hz >= 0) || !std::isfinite(antialias_Hz)) return fail("antialias_Hz must not be negative");
+  return true;
+}
+
+Servo design_servo(const Dynamics& d) {
+  std::string why;
+  if (!d.IsValid(&why)) throw std::invalid_argument(why);
+  using C = std::complex<double>;
+  const double wc = 2 * kPi * d.loop_bandwidth_Hz, wp = 2 * kPi * d.pendulum_frequency_Hz;
+  const C jw(0, wc);
+  const C plant = d.angle_gain_rad_per_s2_per_g / (jw * jw + 2 * d.pendulum_damping_ratio * wp * jw + wp * wp);
+  Servo s{};
+  s.integrator_rad_per_s = d.integrator ? d.integrator_zero_ratio * wc : 0.0;
+  const C pi = 1.0 + s.integrator_rad_per_s / jw;
+  const double phase_deg = std::arg(plant * pi) * 180 / kPi;  // in (-360, 0]
+  double lead_deg = d.phase_margin_deg - 180 - (phase_deg > 0 ? phase_deg - 360 : phase_deg);
+  if (lead_deg > 75)
+    throw std::invalid_argument("phase_margin_deg: the phase lead needed at the crossover (" + std::to_string(lead_deg) +
+                                " deg) exceeds what one lead network gives (75 deg)");
+  double alpha = 1.0;
+  if (lead_deg > 0) {
+    const double sn = std::sin(lead_deg * kPi / 180);
+    alpha = (1 + sn) / (1 - sn);
+  }
+  s.lead_zero_rad_per_s = wc / std::sqrt(alpha);
+  s.lead_pole_rad_per_s = wc * std::sqrt(alpha);
+  const C lead = (1.0 + jw / s.lead_zero_rad_per_s) / (1.0 + jw / s.lead_pole_rad_per_s);
+  s.gain_g_per_rad = 1.0 / std::abs(plant * pi * lead);
+  return s;
+}
+
+Accelerometer::Accelerometer(PlantConfig config, const Vec3& a_static_g, Input input)
+    : config_(std::move(config)), a_static_(a_static_g), input_(std::move(input)), servo_(design_servo(config_.dynamics)) {
+  if (!(config_.coefficients[K1] > 0)) throw std::invalid_argument("K1 must be positive");
+  for (int c = 1; c < kNumCoefficients; ++c)
+    if (!location_allowed(c, config_.location[c]))
+      throw std::invalid_argument(std::string(coefficient_name(c)) + " cannot act at the " +
+                                  std::string(location_name(config_.location[c])));
+  for (int c : kIaTerms) {
+    if (config_.coefficients[c] == 0) continue;
+    has_in_ia_ |= config_.location[c] == Location::input;
+    has_loop_ |= config_.location[c] == Location::loop;
+    has_out_ia_ |= config_.location[c] == Location::output;
+  }
+  n_ = kCoreStates;
+  for (const auto& e : config_.effects) {
+    effect_offset_.push_back(n_);
+    n_ += e->num_states();
+  }
+}
+
+double Accelerometer::f_ia(Location l, double z) const {
+  double s = 0;
+  for (int c : kIaTerms)
+    if (config_.location[c] == l) s += config_.coefficients[c] * ia_basis(c, z);
+  return s;
+}
+
+double Accelerometer::f_ia_slope(Location l, double z) const {
+  double s = 0;
+  for (int c : kIaTerms)
+    if (config_.location[c] == l) s += config_.coefficients[c] * ia_basis_slope(c, z);
+  return s;
+}
+
+double Accelerometer::cross(Location l, const Vec3& a) const {
+  const Basis f = basis(a);
+  double s = 0;
+  for (int c : kCrossTerms)
+    if (config_.location[c] == l) s += config_.coefficients[c] * f[c];
+  return s;
+}
+
+double Accelerometer::solve_z(double i) const {
+  if (!has_in_ia_ && !has_loop_) return i;
+  // m_il(z) = z + F_input(z) + F_loop(z) = i: monotone, a small perturbation of z = i.
+  double z = i - f_ia(Location::input, i) - f_ia(Location::loop, i);
+  for (int it = 0; it < 30; ++it) {
+    const double g = z + f_ia(Location::input, z) + f_ia(Location::loop, z) - i;
+    const double dz = g / (1 + f_ia_slope(Location::input, z) + f_ia_slope(Location::loop, z));
+    z -= dz;
+    if (std::abs(dz) <= 1e-16 * (1 + std::abs(z))) break;
+  }
+  return z;
+}
+
+double Accelerometer::readout(double i, const Vec3& a) const {
+  double out = i + cross(Location::output, a);
+  if (has_out_ia_) out += f_ia(Location::output, solve_z(i));
+  return out;
+}
+
+void Accelerometer::rhs(double t, const double* x, double* dx) const {
+  const Vec3 a_case = input_ ? Vec3(a_static_ + input_(t)) : a_static_;
+  Vec3 a = a_case;
+  for (std::size_t e = 0; e < config_.effects.size(); ++e)
+    a = config_.effects[e]->input(a, x + effect_offset_[e], dx + effect_offset_[e]);
+  const double s1 = a[IA] + f_ia(Location::input, a[IA]) + cross(Location::input, a);
+
+  const double theta = x[kTheta], omega = x[kOmega];
+  double p = theta;
+  for (const auto& e : config_.effects) p = e->pickoff(p);
+  const double u = servo_.gain_g_per_rad * p;
+  const double k = servo_.lead_pole_rad_per_s / servo_.lead_zero_rad_per_s;
+  const double y = k * u + (1 - k) * x[kLead];
+  dx[kLead] = servo_.lead_pole_rad_per_s * (u - x[kLead]);
+  double i = y + servo_.integrator_rad_per_s * x[kIntegral];
+  dx[kIntegral] = servo_.integrator_rad_per_s > 0 ? y : 0.0;
+  for (const auto& e : config_.effects) i = e->current(i);
+
+  const double z = solve_z(i);
+  const double torque = has_in_ia_ ? z + f_ia(Location::input, z) : z;  // m_in(m_il^-1(i))
+  const Dynamics& d = config_.dynamics;
+  const double wp = 2 * kPi * d.pendulum_frequency_Hz;
+  double drive = s1 - torque;
+  for (const auto& e : config_.effects) drive += e->extra_input_g(theta, omega, s1, a);
+  const double alpha = -2 * d.pendulum_damping_ratio * wp * omega - wp * wp * theta + d.angle_gain_rad_per_s2_per_g * drive;
+  dx[kTheta] = omega;
+  dx[kOmega] = alpha;
+
+  double out = i + cross(Location::output, a);
+  if (has_out_ia_) out += f_ia(Location::output, z);
+  if (d.antialias_Hz > 0) {
+    const double wa = 2 * kPi * d.antialias_Hz;
+    dx[kAA1] = x[kAA2];
+    dx[kAA2] = wa * wa * (out - x[kAA1]) - std::numbers::sqrt2 * wa * x[kAA2];
+    out = x[kAA1];
+  } else {
+    dx[kAA1] = dx[kAA2] = 0.0;
+  }
+  dx[kQuadrature] = out - q_ref_;
+}
+
+double Accelerometer::output_g(double t, const double* x) const {
+  if (config_.dynamics.antialias_Hz > 0) return x[kAA1];
+  const Vec3 a_case = input_ ? Vec3(a_static_ + input_(t)) : a_static_;
+  Vec3 a = a_case;
+  std::vector<double> scratch(static_cast<std::size_t>(n_));
+  for (std::size_t e = 0; e < config_.effects.size(); ++e)
+    a = config_.effects[e]->input(a, x + effect_offset_[e], scratch.data() + effect_offset_[e]);
+  double p = x[kTheta];
+  for (const auto& e : config_.effects) p = e->pickoff(p);
+  const double k = servo_.lead_pole_rad_per_s / servo_.lead_zero_rad_per_s;
+  const double y = k * servo_.gain_g_per_rad * p + (1 - k) * x[kLead];
+  double i = y + servo_.integrator_rad_per_s * x[kIntegral];
+  for (const auto& e : config_.effects) i = e->current(i);
+  return readout(i, a);
+}
+
+std::vector<double> Accelerometer::state_scale() const {
+  const Dynamics& d = config_.dynamics;
+  const double wc = 2 * kPi * d.loop_bandwidth_Hz;
+  std::vector<double> s(static_cast<std::size_t>(n_), 1.0);
+  s[kTheta] = d.angle_gain_rad_per_s2_per_g / (wc * wc);
+  s[kOmega] = d.angle_gain_rad_per_s2_per_g / wc;
+  s[kLead] = 1.0;
+  s[kIntegral] = servo_.integrator_rad_per_s > 0 ? 1.0 / servo_.integrator_rad_per_s : 1.0;
+  s[kQuadrature] = 1.0 / wc;
+  s[kAA1] = 1.0;
+  s[kAA2] = d.antialias_Hz > 0 ? 2 * kPi * d.antialias_Hz : 1.0;
+  for (std::size_t e = 0; e < config_.effects.size(); ++e)
+    for (int k = 0; k < config_.effects[e]->num_states(); ++k)
+      s[static_cast<std::size_t>(effect_offset_[e] + k)] = config_.effects[e]->state_scale(k);
+  return s;
+}
+
+std::vector<double> Accelerometer::equilibrium() const {
+  // Guess: the exact rest state with the integrator (theta = 0, tau = s1), then Newton on
+  // every state but the quadrature (whose value is arbitrary).
+  std::vector<double> x(static_cast<std::size_t>(n_), 0.0);
+  for (std::size_t e = 0; e < config_.effects.size(); ++e) config_.effects[e]->rest_state(a_static_, x.data() + effect_offset_[e]);
+  const double i_rest = a_static_[IA] + f_ia(Location::input, a_static_[IA]) + f_ia(Location::loop, a_static_[IA]) +
+                        cross(Location::input, a_static_);
+  if (servo_.integrator_rad_per_s > 0) x[kIntegral] = i_rest / servo_.integrator_rad_per_s;
+  const std::vector<double> scale = state_scale();
+  std::vector<int> free;
+  for (int k = 0; k < n_; ++k)
+    if (k != kQuadrature && (k != kAA1 && k != kAA2 ? true : config_.dynamics.antialias_Hz > 0)) free.push_back(k);
+  if (config_.dynamics.antialias_Hz > 0) x[kAA1] = output_g(0, x.data());
+  const int m = static_cast<int>(free.size());
+  std::vector<double> f(static_cast<std::size_t>(n_)), fp(f), fm(f);
+  for (int iter = 0; iter < 20; ++iter) {
+    rhs(0, x.data(), f.data());
+    Eigen::VectorXd r(m);
+    for (int a = 0; a < m; ++a) r[a] = f[static_cast<std::size_t>(free[a])];
+    Eigen::MatrixXd j(m, m);
+    for (int b = 0; b < m; ++b) {
+      const std::size_t kb = static_cast<std::size_t>(free[b]);
+      const double h = 1e-7 * scale[kb];
+      const double keep = x[kb];
+      x[kb] = keep + h;
+      rhs(0, x.data(), fp.data());
+      x[kb] = keep - h;
+      rhs(0, x.data(), fm.data());
+      x[kb] = keep;
+      for (int a = 0; a < m; ++a) j(a, b) = (fp[static_cast<std::size_t>(free[a])] - fm[static_cast<std::size_t>(free[a])]) / (2 * h);
+    }
+    const Eigen::VectorXd step = j.fullPivLu().solve(r);
+    double worst = 0;
+    for (int b = 0; b < m; ++b) {
+      const std::size_t kb = static_cast<std::size_t>(free[b]);
+      x[kb] -= step[b];
+      worst = std::max(worst, std::abs(step[b]) / scale[kb]);
+    }
+    if (worst < 1e-15) break;
+  }
+  return x;
+}
+
+Accelerometer::Linear Accelerometer::linearise() const {
+  const std::vector<double> x0 = equilibrium();
+  const std::vector<double> scale = state_scale();
+  Linear lin;
+  lin.A.resize(n_, n_);
+  lin.B.resize(n_, 3);
+  lin.C.resize(n_);
+  std::vector<double> x = x0, fp(static_cast<std::size_t>(n_)), fm(fp);
+  for (int k = 0; k < n_; ++k) {
+    const std::size_t kk = static_cast<std::size_t>(k);
+    const double h = 1e-6 * scale[kk];
+    x[kk] = x0[kk] + h;
+    rhs(0, x.data(), fp.data());
+    const double op = output_g(0, x.data());
+    x[kk] = x0[kk] - h;
+    rhs(0, x.data(), fm.data());
+    const double om = output_g(0, x.data());
+    x[kk] = x0[kk];
+    for (int r = 0; r < n_; ++r) lin.A(r, k) = (fp[static_cast<std::size_t>(r)] - fm[static_cast<std::size_t>(r)]) / (2 * h);
+    lin.C[k] = (op - om) / (2 * h);
+  }
+  // Input columns: perturb the static input (the plant sees a_static + a(t)).
+  Accelerometer shifted = *this;
+  shifted.input_ = {};
+  for (int c = 0; c < 3; ++c) {
+    const double h = 1e-6;
+    shifted.a_static_ = a_static_;
+    shifted.a_static_[c] += h;
+    shifted.rhs(0, x0.data(), fp.data());
+    shifted.a_static_[c] -= 2 * h;
+    shifted.rhs(0, x0.data(), fm.data());
+    for (int r = 0; r < n_; ++r) lin.B(r, c) = (fp[static_cast<std::size_t>(r)] - fm[static_cast<std::size_t>(r)]) / (2 * h);
+  }
+  return lin;
+}
+
+}  // namespace vrelab::plant

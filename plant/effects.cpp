@@ -1,0 +1,56 @@
+#include "plant/effects.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace vrelab::plant {
+
+PickoffNonlinearity::PickoffNonlinearity(double p2) : p2_(p2) {
+  if (!std::isfinite(p2)) throw std::invalid_argument("pickoff p2_per_rad must be finite");
+}
+
+CurrentSaturation::CurrentSaturation(double limit_g) : limit_g_(limit_g) {
+  if (!(limit_g > 0) || !std::isfinite(limit_g)) throw std::invalid_argument("saturation limit_g must be positive");
+}
+
+double CurrentSaturation::current(double i) const { return std::clamp(i, -limit_g_, limit_g_); }
+
+double PendulumGeometry::extra_input_g(double theta, double, double s1, const Vec3& a) const {
+  return s1 * (std::cos(theta) - 1) - a[PA] * std::sin(theta);
+}
+
+MechanicalMode::MechanicalMode(double f, double z, const Vec3& mask)
+    : w_(2 * std::numbers::pi * f), z_(z), mask_(mask) {
+  if (!(f > 0) || !std::isfinite(f)) throw std::invalid_argument("mode frequency_Hz must be positive");
+  if (!(z > 0) || !std::isfinite(z)) throw std::invalid_argument("mode damping_ratio must be positive");
+}
+
+double MechanicalMode::state_scale(int k) const { return k % 2 == 0 ? 1 / (w_ * w_) : 1 / w_; }
+
+void MechanicalMode::rest_state(const Vec3& a, double* s) const {
+  for (int i = 0; i < 3; ++i) {
+    s[2 * i] = mask_[i] != 0 ? -a[i] / (w_ * w_) : 0.0;
+    s[2 * i + 1] = 0.0;
+  }
+}
+
+Vec3 MechanicalMode::input(const Vec3& a, const double* s, double* ds) const {
+  // Relative coordinate y (g s^2): y'' + 2 z w y' + w^2 y = -a_case; the pendulum's base
+  // then accelerates with a_case + y'' = -(2 z w y' + w^2 y).
+  Vec3 out = a;
+  for (int i = 0; i < 3; ++i) {
+    if (mask_[i] == 0) {
+      ds[2 * i] = ds[2 * i + 1] = 0.0;
+      continue;
+    }
+    const double y = s[2 * i], v = s[2 * i + 1];
+    ds[2 * i] = v;
+    ds[2 * i + 1] = -a[i] - 2 * z_ * w_ * v - w_ * w_ * y;
+    out[i] = -(2 * z_ * w_ * v + w_ * w_ * y);
+  }
+  return out;
+}
+
+}  // namespace vrelab::plant

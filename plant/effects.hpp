@@ -1,0 +1,90 @@
+#pragma once
+// plant/effects.hpp -- effects beyond model (1), each a switchable module on the plant.
+//
+// An Effect hooks into the signal path of the accelerometer (accelerometer.hpp) at fixed
+// places: the mechanical input (the acceleration the pendulum feels), the pickoff, the
+// torquer current, and the pendulum's torque balance; it may own states. Adding an effect is
+// a new class here and a line in the case reader. Each hook's default is the identity, so
+// an effect overrides only where it acts. None of the shipped effects changes the static
+// response inside the range: the static identification cannot see them.
+#include <memory>
+#include <string>
+
+#include "plant/model1.hpp"
+
+namespace vrelab::plant {
+
+class Effect {
+ public:
+  virtual ~Effect() = default;
+  virtual std::string name() const = 0;
+  virtual int num_states() const { return 0; }
+  // Typical magnitude of state k per g of input (sets finite-difference steps, tolerances).
+  virtual double state_scale(int /*k*/) const { return 1.0; }
+  // A guess of the states at rest under a static case acceleration (refined by Newton).
+  virtual void rest_state(const Vec3& /*a_static_g*/, double* /*s*/) const {}
+  // Mechanical path: the acceleration (g) the pendulum feels for a case acceleration a_g;
+  // writes the derivatives of the effect's own states.
+  virtual Vec3 input(const Vec3& a_g, const double* /*s*/, double* /*ds*/) const { return a_g; }
+  virtual double pickoff(double theta_rad) const { return theta_rad; }
+  virtual double current(double i_g) const { return i_g; }
+  // Extra unbalanced input on the pendulum, in g (the plant multiplies by b = P g / J):
+  // s1 is the input-axis drive, a_g the acceleration the pendulum feels.
+  virtual double extra_input_g(double /*theta_rad*/, double /*omega_rad_per_s*/, double /*s1_g*/,
+                               const Vec3& /*a_g*/) const {
+    return 0.0;
+  }
+};
+
+// Pendulum geometry: the input axis turns with the pendulum, so the drive is
+// a_IA cos(theta) - a_PA sin(theta) instead of a_IA. The a_PA sin(theta) part is the
+// vibropendulous coupling: under vibration along IA and PA it rectifies as
+// -<a_PA theta>, zero statically (theta = 0 at rest with the integrator).
+class PendulumGeometry final : public Effect {
+ public:
+  std::string name() const override { return "pendulum_geometry"; }
+  double extra_input_g(double theta, double, double s1, const Vec3& a) const override;
+};
+
+// Pickoff nonlinearity: the pickoff reads theta + p2 theta^2 (p2 in 1/rad). With the
+// integrator the loop nulls the reading, so theta settles at 0 statically; under vibration
+// <theta> = -p2 <theta^2> and the hinge stiffness turns it into an output shift.
+class PickoffNonlinearity final : public Effect {
+ public:
+  explicit PickoffNonlinearity(double p2_per_rad);
+  std::string name() const override { return "pickoff_nonlinearity"; }
+  double pickoff(double theta) const override { return theta + p2_ * theta * theta; }
+
+ private:
+  double p2_;
+};
+
+// Current saturation: the torquer current (in g of rebalance) clips at +-limit_g.
+class CurrentSaturation final : public Effect {
+ public:
+  explicit CurrentSaturation(double limit_g);
+  std::string name() const override { return "current_saturation"; }
+  double current(double i) const override;
+
+ private:
+  double limit_g_;
+};
+
+// A second mechanical mode (flexure or mount resonance) between the case and the pendulum
+// along the chosen axes: base-excited oscillator, transmissibility
+// (w^2 + 2 z w s) / (s^2 + 2 z w s + w^2), static gain 1.
+class MechanicalMode final : public Effect {
+ public:
+  MechanicalMode(double frequency_Hz, double damping_ratio, const Vec3& axes_mask);
+  std::string name() const override { return "mechanical_mode"; }
+  int num_states() const override { return 6; }  // relative displacement and velocity per axis
+  double state_scale(int k) const override;
+  void rest_state(const Vec3& a_static_g, double* s) const override;
+  Vec3 input(const Vec3& a_g, const double* s, double* ds) const override;
+
+ private:
+  double w_, z_;
+  Vec3 mask_;
+};
+
+}  // namespace vrelab::plant
