@@ -1,6 +1,9 @@
 #include "app/case_file.hpp"
 
 #include <algorithm>
+#include <functional>
+#include <map>
+#include <memory>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -275,8 +278,12 @@ void read_dividing_head(Table t, Case& c) {
   h.errors.angle_sigma_rad = t.non_negative("angle_sigma_arcsec", 0.0) * kArcsec;
   h.errors.noise_sigma_g = t.non_negative("noise_sigma_ug", 0.0) * 1e-6;
   h.errors.repeats = static_cast<int>(t.integer("repeats", false, 1, 1, 100000));
+  const std::string source = t.string("source", "model");
+  if (source != "model" && source != "ode")
+    t.fail(t.raw().get("source"), "source", "must be \"model\" (model (1)) or \"ode\" (the ODE plant), got \"" + source + "\"");
+  h.from_ode = source == "ode";
   t.check_unknown({"positions_per_series", "series", "positions", "orientations_g", "initial_error_arcsec",
-                   "angle_sigma_arcsec", "noise_sigma_ug", "repeats"});
+                   "angle_sigma_arcsec", "noise_sigma_ug", "repeats", "source"});
   c.dividing_head = std::move(h);
 }
 
@@ -295,6 +302,129 @@ void read_identification(Table t, Case& c) {
       f->fail(f->raw().get("K1"), "K1", "must be positive (output units per g)");
   }
   t.check_unknown({"fixed"});
+}
+
+bool boolean(Table& t, std::string_view key, bool fallback) {
+  const toml::node* n = t.get(key, false);
+  if (!n) return fallback;
+  if (!n->is_boolean()) t.fail(n, key, "expected true or false");
+  return n->as_boolean()->get();
+}
+
+// The effects beyond model (1): one entry per [plant.effects.<name>] table. Adding an
+// effect is a class in plant/effects.hpp and an entry here.
+using EffectReader = std::function<std::shared_ptr<const plant::Effect>(Table&)>;
+const std::map<std::string, EffectReader>& effect_readers() {
+  static const std::map<std::string, EffectReader> readers{
+      {"pickoff_nonlinearity",
+       [](Table& t) {
+         auto e = std::make_shared<plant::PickoffNonlinearity>(t.number("p2_per_rad"));
+         t.check_unknown({"p2_per_rad"});
+         return e;
+       }},
+      {"pendulum_geometry",
+       [](Table& t) {
+         t.check_unknown({});
+         return std::make_shared<plant::PendulumGeometry>();
+       }},
+      {"current_saturation",
+       [](Table& t) {
+         const double limit = t.number("limit_g");
+         if (!(limit > 0)) t.fail(t.raw().get("limit_g"), "limit_g", "must be positive");
+         t.check_unknown({"limit_g"});
+         return std::make_shared<plant::CurrentSaturation>(limit);
+       }},
+      {"mechanical_mode",
+       [](Table& t) {
+         const double f = t.number("frequency_Hz"), z = t.number("damping_ratio");
+         if (!(f > 0)) t.fail(t.raw().get("frequency_Hz"), "frequency_Hz", "must be positive");
+         if (!(z > 0)) t.fail(t.raw().get("damping_ratio"), "damping_ratio", "must be positive");
+         const Vec3 axes = t.opt_vec3("axes").value_or(Vec3(1, 0, 0));
+         t.check_unknown({"frequency_Hz", "damping_ratio", "axes"});
+         return std::make_shared<plant::MechanicalMode>(f, z, axes);
+       }},
+  };
+  return readers;
+}
+
+void read_plant(Table t, Case& c) {
+  c.has_plant_table = true;
+  const std::string type = t.string("type", "from_coefficients");
+  if (type != "from_coefficients")
+    t.fail(t.raw().get("type"), "type", "only \"from_coefficients\" is available, got \"" + type + "\"");
+  plant::Dynamics& d = c.plant.dynamics;
+  d.pendulum_frequency_Hz = t.opt_number("pendulum_frequency_Hz").value_or(d.pendulum_frequency_Hz);
+  d.pendulum_damping_ratio = t.opt_number("pendulum_damping_ratio").value_or(d.pendulum_damping_ratio);
+  d.angle_gain_rad_per_s2_per_g = t.opt_number("angle_gain_rad_per_s2_per_g").value_or(d.angle_gain_rad_per_s2_per_g);
+  d.loop_bandwidth_Hz = t.opt_number("loop_bandwidth_Hz").value_or(d.loop_bandwidth_Hz);
+  d.phase_margin_deg = t.opt_number("phase_margin_deg").value_or(d.phase_margin_deg);
+  d.integrator = boolean(t, "integrator", d.integrator);
+  d.integrator_zero_ratio = t.opt_number("integrator_zero_ratio").value_or(d.integrator_zero_ratio);
+  d.antialias_Hz = t.non_negative("antialias_Hz", d.antialias_Hz);
+  std::string why;
+  if (!d.IsValid(&why)) t.fail(nullptr, "dynamics", why);
+  try {
+    plant::design_servo(d);
+  } catch (const std::invalid_argument& e) {
+    t.fail(t.raw().get("phase_margin_deg"), "phase_margin_deg", e.what());
+  }
+  if (auto loc = t.subtable("location", false)) {
+    for (auto&& [k, v] : loc->raw()) {
+      const auto idx = plant::coefficient_from_name(k.str());
+      if (!idx || *idx == plant::K1) {
+        std::vector<std::string_view> names;
+        for (int i = 1; i < plant::kNumCoefficients; ++i) names.push_back(plant::coefficient_name(i));
+        loc->check_unknown(names);
+        loc->fail(&v, k.str(), "K1 has no place to act");
+      }
+      const std::string where = loc->string(k.str(), "");
+      const plant::Location l = where == "input" ? plant::Location::input
+                                : where == "loop" ? plant::Location::loop
+                                                  : plant::Location::output;
+      if ((where != "input" && where != "loop" && where != "output") || !plant::location_allowed(*idx, l))
+        loc->fail(&v, k.str(), std::string("must be ") + (*idx <= plant::k4 ? "\"input\", \"loop\" or \"output\""
+                                                                            : "\"input\" or \"output\" (it needs a_PA or a_OA)") +
+                                   ", got \"" + where + "\"");
+      c.plant.location[*idx] = l;
+    }
+  }
+  if (auto eff = t.subtable("effects", false)) {
+    std::vector<std::string_view> names;
+    for (const auto& [name, reader] : effect_readers()) names.push_back(name);
+    for (auto&& [k, v] : eff->raw()) {
+      const auto it = effect_readers().find(std::string(k.str()));
+      if (it == effect_readers().end()) eff->check_unknown(names);
+      auto sub = eff->subtable(k.str(), true);
+      try {
+        c.plant.effects.push_back(it->second(*sub));
+      } catch (const std::invalid_argument& e) {
+        eff->fail(&v, k.str(), e.what());
+      }
+    }
+  }
+  t.check_unknown({"type", "pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g",
+                   "loop_bandwidth_Hz", "phase_margin_deg", "integrator", "integrator_zero_ratio", "antialias_Hz",
+                   "location", "effects"});
+}
+
+void read_readout(Table t, Case& c) {
+  rectification::Readout& r = c.shake.readout;
+  r.sample_rate_Hz = t.number("sample_rate_Hz");
+  if (!(r.sample_rate_Hz > 0)) t.fail(t.raw().get("sample_rate_Hz"), "sample_rate_Hz", "must be positive");
+  r.noise_sigma_g = t.non_negative("noise_sigma_ug", 0.0) * 1e-6;
+  r.quantisation_lsb_g = t.non_negative("quantisation_lsb_ug", 0.0) * 1e-6;
+  t.check_unknown({"sample_rate_Hz", "noise_sigma_ug", "quantisation_lsb_ug"});
+}
+
+void read_shake(Table t, Case& c) {
+  rectification::ShakeSettings& s = c.shake;
+  s.relative_tolerance = t.opt_number("relative_tolerance").value_or(s.relative_tolerance);
+  s.settle_decay = t.opt_number("settle_decay").value_or(s.settle_decay);
+  s.blocks = static_cast<int>(t.integer("blocks", false, s.blocks, 2, 1000));
+  s.min_measure_s = t.non_negative("min_measure_s", s.min_measure_s);
+  std::string why;
+  if (!s.IsValid(&why)) t.fail(nullptr, "shake", why);
+  t.check_unknown({"relative_tolerance", "settle_decay", "blocks", "min_measure_s"});
 }
 
 }  // namespace
@@ -340,11 +470,19 @@ Case read_case(const std::string& path) {
   if (auto t = top.subtable("dividing_head", false)) read_dividing_head(*t, c);
   if (auto t = top.subtable("identification", false)) read_identification(*t, c);
   if (auto t = top.subtable("run", false)) {
-    c.seed = static_cast<std::uint64_t>(t->integer("seed", false, 1, 0));
+    c.seed = static_cast<std::uint64_t>(t->integer("seed", false, 1, 0, std::numeric_limits<std::int64_t>::max()));
     t->check_unknown({"seed"});
   }
+  if (auto t = top.subtable("plant", false)) {
+    if (!c.coefficients) t->fail(nullptr, "type", "a [plant] is built from [coefficients], which is missing");
+    read_plant(*t, c);
+  }
+  if (c.coefficients) c.plant.coefficients = *c.coefficients;
+  if (auto t = top.subtable("readout", false)) read_readout(*t, c);
+  if (auto t = top.subtable("shake", false)) read_shake(*t, c);
+  c.shake.readout.seed = c.seed;
   top.check_unknown({"g_m_per_s2", "instrument", "coefficients", "orientation", "vibration", "range",
-                     "dividing_head", "identification", "run"});
+                     "dividing_head", "identification", "run", "plant", "readout", "shake"});
   return c;
 }
 

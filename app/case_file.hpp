@@ -14,7 +14,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "plant/accelerometer.hpp"
 #include "plant/model1.hpp"
+#include "rectification/shake.hpp"
 #include "validation/dividing_head.hpp"
 #include "validation/identification.hpp"
 #include "vibration/profile.hpp"
@@ -29,6 +31,7 @@ struct DividingHead {
   std::vector<validation::Position> positions;
   validation::StaticTestErrors errors;
   std::string description;  // e.g. "3 series x 8 positions"
+  bool from_ode = false;    // source = "ode": readings from the ODE plant, else model (1)
 };
 
 struct Case {
@@ -44,6 +47,10 @@ struct Case {
   std::optional<DividingHead> dividing_head;
   validation::FixedSet fixed{};
   std::uint64_t seed = 1;
+  // The ODE plant: [plant] (defaults when absent: from the coefficients, default dynamics).
+  bool has_plant_table = false;
+  plant::PlantConfig plant;
+  rectification::ShakeSettings shake;  // [shake] and [readout]
 };
 
 Case read_case(const std::string& path);

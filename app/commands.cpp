@@ -1,10 +1,14 @@
 #include "app/commands.hpp"
 
+#include <chrono>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <numbers>
 
 #include <fmt/format.h>
 #include <fmt/ostream.h>
+#include <unistd.h>
 
 #include "app/case_file.hpp"
 #include "app/output.hpp"
@@ -73,6 +77,10 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
   }
 
   validation::StaticTestSettings settings;
+  if (head.from_ode) {
+    const plant::PlantConfig plant = c.plant;
+    settings.source = [plant](const Vec3& a) { return plant.coefficients[plant::K1] * plant::settled_output_g(plant, a); };
+  }
   settings.fixed = c.fixed;
   settings.seed = c.seed;
   settings.monte_carlo_trials = o.monte_carlo;
@@ -81,8 +89,9 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
   // ---- text report
   const auto& e = head.errors;
   out << header_line("identify", c, c.seed);
-  out << fmt::format("Static test on the virtual dividing head: {}, {} reading(s) each = {} readings\n",
-                     head.description, e.repeats, r.readings.size());
+  out << fmt::format("Static test on the virtual dividing head: {}, {} reading(s) each = {} readings, from {}\n",
+                     head.description, e.repeats, r.readings.size(),
+                     head.from_ode ? "the ODE plant (settled in each position)" : "model (1)");
   out << fmt::format(
       "  errors: initial orientation [{:g}, {:g}, {:g}] arcsec, set angle sigma {:g} arcsec, reading "
       "noise sigma {:g} ug\n",
@@ -209,6 +218,7 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
   }
   j["readings"] = readings;
   j["readings_unit"] = c.output_unit;
+  j["readings_source"] = head.from_ode ? "ode" : "model";
   write_atomic(o.json_path, j.dump(2) + "\n");
 }
 
@@ -278,6 +288,131 @@ void run_predict(const PredictOptions& o, std::ostream& out) {
   j["omitted_by_paper_g"] = terms.omitted_by_paper_g();
   j["paper_printed_total_g"] = printed ? json(*printed) : json(nullptr);
   j["units"] = {{"total_g", "g"}, {"terms", "g"}};
+  write_atomic(o.json_path, j.dump(2) + "\n");
+}
+
+namespace {
+
+json plant_json(const plant::PlantConfig& p) {
+  const plant::Dynamics& d = p.dynamics;
+  const plant::Servo sv = plant::design_servo(d);
+  json loc = json::object();
+  for (int i = 1; i < kNumCoefficients; ++i)
+    loc[std::string(plant::coefficient_name(i))] = std::string(plant::location_name(p.location[i]));
+  json effects = json::array();
+  for (const auto& e : p.effects) effects.push_back(e->name());
+  return {{"type", "from_coefficients"},
+          {"dynamics",
+           {{"pendulum_frequency_Hz", d.pendulum_frequency_Hz},
+            {"pendulum_damping_ratio", d.pendulum_damping_ratio},
+            {"angle_gain_rad_per_s2_per_g", d.angle_gain_rad_per_s2_per_g},
+            {"loop_bandwidth_Hz", d.loop_bandwidth_Hz},
+            {"phase_margin_deg", d.phase_margin_deg},
+            {"integrator", d.integrator},
+            {"integrator_zero_ratio", d.integrator_zero_ratio},
+            {"antialias_Hz", d.antialias_Hz}}},
+          {"servo",
+           {{"gain_g_per_rad", sv.gain_g_per_rad},
+            {"lead_zero_Hz", sv.lead_zero_rad_per_s / (2 * std::numbers::pi)},
+            {"lead_pole_Hz", sv.lead_pole_rad_per_s / (2 * std::numbers::pi)},
+            {"integrator_Hz", sv.integrator_rad_per_s / (2 * std::numbers::pi)}}},
+          {"location", loc},
+          {"effects", effects}};
+}
+
+}  // namespace
+
+void run_shake(const ShakeOptions& o, std::ostream& out) {
+  Case c = read_case(o.case_path);
+  require(c, c.coefficients.has_value(), "coefficients", "shake");
+  require(c, c.orientation_g.has_value(), "orientation", "shake");
+  require(c, c.vibration.has_value(), "vibration", "shake");
+  if (o.seed) c.seed = *o.seed, c.shake.readout.seed = *o.seed;
+  const auto* sine = std::get_if<vibration::SineVibration>(&*c.vibration);
+  if (!sine) throw InputError(c.path + ": [vibration] type: shake runs \"sine\" profiles in this version");
+  if (!(sine->frequency_Hz > 0))
+    throw InputError(c.path + ": [vibration] frequency_Hz: a shaker run needs a positive frequency");
+  const auto& ro = c.shake.readout;
+  if (ro.active() && sine->frequency_Hz >= ro.sample_rate_Hz / 2)
+    throw InputError(fmt::format("{}: [vibration] frequency_Hz = {:g} is at or above the Nyquist frequency {:g} Hz of "
+                                 "[readout] sample_rate_Hz = {:g}",
+                                 c.path, sine->frequency_Hz, ro.sample_rate_Hz / 2, ro.sample_rate_Hz));
+  const Vec3 a = *c.orientation_g;
+
+  // The sampled record, streamed to a temporary file and renamed at the end.
+  std::ofstream series;
+  std::string series_tmp;
+  rectification::SampleSink sink;
+  if (!o.series_path.empty()) {
+    const std::filesystem::path target(o.series_path);
+    if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
+    series_tmp = o.series_path + ".tmp." + std::to_string(::getpid());
+    series.open(series_tmp);
+    if (!series) throw InputError("cannot write " + series_tmp);
+    series << fmt::format("# vrelab {} ({}) shake {}  seed {}\n", kProgramVersion, kGitDescribe, c.path, c.seed);
+    series << fmt::format("# output in {}; K1 = {:g} {}/g; static a_g = [{:g}, {:g}, {:g}]; vibration on from t = 0\n",
+                          c.output_unit, (*c.coefficients)[plant::K1], c.output_unit, a[0], a[1], a[2]);
+    series << fmt::format("time_s,input_IA_g,input_PA_g,input_OA_g,output_{}\n", c.output_unit);
+    sink = [&series](double t, const Vec3& in, double u) {
+      series << fmt::format("{:.9e},{:.9e},{:.9e},{:.9e},{:.12e}\n", t, in[0], in[1], in[2], u);
+    };
+  }
+  const auto start = std::chrono::steady_clock::now();
+  const rectification::SineShakeResult r = rectification::shake_sine(c.plant, a, *sine, c.shake, sink);
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double predicted = rectification::sine_rectification(*c.coefficients, a, *sine, c.range_limit_g).total_g();
+
+  out << header_line("shake", c, c.seed);
+  out << fmt::format("Plant: from coefficients, pendulum {:g} Hz, loop crossover {:g} Hz, phase margin {:g} deg{}{}\n",
+                     c.plant.dynamics.pendulum_frequency_Hz, c.plant.dynamics.loop_bandwidth_Hz,
+                     c.plant.dynamics.phase_margin_deg, c.plant.dynamics.integrator ? ", PI" : ", no integrator",
+                     c.plant.effects.empty() ? "" : ", effects:");
+  for (const auto& e : c.plant.effects) out << "  " << e->name() << "\n";
+  out << fmt::format("Static a = [{:g}, {:g}, {:g}] g; sine {:g} Hz, peak [{:g}, {:g}, {:g}] g\n", a[0], a[1], a[2],
+                     sine->frequency_Hz, sine->amplitude_g[0], sine->amplitude_g[1], sine->amplitude_g[2]);
+  out << fmt::format("Measurement: {}; settled {:.4g} s ({:.3g} slowest time constants), {} periods measured{}\n",
+                     r.method, r.settle_s, r.settle_s / r.slowest_time_constant_s, r.periods,
+                     r.samples ? fmt::format(", {} samples at {:g} Hz", r.samples, r.sample_rate_Hz) : "");
+  out << fmt::format("  measured vibration error   {:>14.6f} ug  +/- {:.3g} ug (1 sigma)\n", r.measured_g * 1e6, r.sigma_g * 1e6);
+  out << fmt::format("  eq. (3) corrected, truth   {:>14.6f} ug\n", predicted * 1e6);
+  out << fmt::format("  measured - eq. (3)         {:>14.6f} ug ({:+.4g} %)\n", (r.measured_g - predicted) * 1e6,
+                     predicted != 0 ? 100 * (r.measured_g / predicted - 1) : 0.0);
+  out << fmt::format("  solver: {} steps, {} right-hand sides, {:.3g} s wall\n", r.steps, r.rhs_evaluations, wall_s);
+
+  if (series.is_open()) {
+    series.close();
+    if (!series) throw InputError("writing " + series_tmp + " failed");
+    std::filesystem::rename(series_tmp, o.series_path);
+  }
+  if (o.json_path.empty()) return;
+  json j;
+  j["program"] = program_record();
+  j["command"] = "shake";
+  j["case"] = case_record(c);
+  j["seed"] = c.seed;
+  j["measured_g"] = r.measured_g;
+  j["sigma_g"] = r.sigma_g;
+  j["predicted_eq3_g"] = predicted;
+  j["integral_slope_g"] = r.integral_slope_g;
+  j["baseline_g"] = r.baseline_g;
+  j["plant"] = plant_json(c.plant);
+  j["measurement"] = {{"method", r.method},
+                      {"settle_s", r.settle_s},
+                      {"slowest_time_constant_s", r.slowest_time_constant_s},
+                      {"periods", r.periods},
+                      {"samples", r.samples},
+                      {"sample_rate_Hz", r.sample_rate_Hz}};
+  j["settings"] = {{"solver", "CVODE BDF, dense direct linear solver"},
+                   {"relative_tolerance", c.shake.relative_tolerance},
+                   {"settle_decay", c.shake.settle_decay},
+                   {"blocks", c.shake.blocks},
+                   {"min_measure_s", c.shake.min_measure_s},
+                   {"readout",
+                    {{"sample_rate_Hz", ro.sample_rate_Hz},
+                     {"noise_sigma_g", ro.noise_sigma_g},
+                     {"quantisation_lsb_g", ro.quantisation_lsb_g}}}};
+  j["solver_stats"] = {{"steps", r.steps}, {"rhs_evaluations", r.rhs_evaluations}, {"wall_s", wall_s}};
+  j["units"] = {{"measured_g", "g"}, {"sigma_g", "g"}, {"predicted_eq3_g", "g"}};
   write_atomic(o.json_path, j.dump(2) + "\n");
 }
 

@@ -23,4 +23,12 @@ struct PredictOptions {
 };
 void run_predict(const PredictOptions& o, std::ostream& out);
 
+struct ShakeOptions {
+  std::string case_path;
+  std::string json_path;
+  std::string series_path;  // CSV of the sampled record
+  std::optional<std::uint64_t> seed;
+};
+void run_shake(const ShakeOptions& o, std::ostream& out);
+
 }  // namespace vrelab::app

@@ -7,6 +7,7 @@
 
 #include "app/case_file.hpp"
 #include "app/commands.hpp"
+#include "plant/ode_solver.hpp"
 #include "vrelab_version.hpp"
 
 int main(int argc, char** argv) {
@@ -29,6 +30,13 @@ int main(int argc, char** argv) {
   predict->add_option("case", pr.case_path, "Case file (TOML)")->required();
   predict->add_option("--json", pr.json_path, "Write the result as JSON to this file");
 
+  ShakeOptions sh;
+  auto* shake = app.add_subcommand("shake", "One run on the virtual shaker: measured vibration error vs eq. (3)");
+  shake->add_option("case", sh.case_path, "Case file (TOML)")->required();
+  shake->add_option("--json", sh.json_path, "Write the result as JSON to this file");
+  shake->add_option("--series", sh.series_path, "Write the sampled record as CSV to this file");
+  shake->add_option("--seed", sh.seed, "Override the case's [run] seed");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -38,7 +46,11 @@ int main(int argc, char** argv) {
   try {
     if (*identify) run_identify(id, std::cout);
     if (*predict) run_predict(pr, std::cout);
+    if (*shake) run_shake(sh, std::cout);
   } catch (const InputError& e) {
+    std::cerr << "vrelab: error: " << e.what() << "\n";
+    return 2;
+  } catch (const vrelab::plant::SolverError& e) {
     std::cerr << "vrelab: error: " << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {

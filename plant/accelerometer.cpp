@@ -1,11 +1,14 @@
 #include "plant/accelerometer.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <complex>
 #include <numbers>
 #include <stdexcept>
 
 #include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
 
 namespace vrelab::plant {
 namespace {
@@ -313,6 +316,33 @@ Accelerometer::Linear Accelerometer::linearise() const {
     for (int r = 0; r < n_; ++r) lin.B(r, c) = (fp[static_cast<std::size_t>(r)] - fm[static_cast<std::size_t>(r)]) / (2 * h);
   }
   return lin;
+}
+
+double Accelerometer::slowest_time_constant_s(const Linear& lin) const {
+  std::vector<int> keep;
+  for (int k = 0; k < n_; ++k)
+    if (k != kQuadrature && ((k != kAA1 && k != kAA2) || config_.dynamics.antialias_Hz > 0)) keep.push_back(k);
+  const Eigen::Index m = static_cast<Eigen::Index>(keep.size());
+  Eigen::MatrixXd a(m, m);
+  for (Eigen::Index i = 0; i < m; ++i)
+    for (Eigen::Index j = 0; j < m; ++j) a(i, j) = lin.A(keep[static_cast<std::size_t>(i)], keep[static_cast<std::size_t>(j)]);
+  const Eigen::VectorXcd eig = Eigen::EigenSolver<Eigen::MatrixXd>(a, false).eigenvalues();
+  double slowest = std::numeric_limits<double>::infinity();
+  for (Eigen::Index i = 0; i < eig.size(); ++i) slowest = std::min(slowest, -eig[i].real());
+  if (!(slowest > 0)) throw std::invalid_argument("the closed loop is not stable (a pole with Re >= 0)");
+  return 1 / slowest;
+}
+
+double settled_output_g(const PlantConfig& config, const Vec3& a_g, double rtol) {
+  const Accelerometer plant(config, a_g);
+  const double tau = plant.slowest_time_constant_s(plant.linearise());
+  SolverSettings s;
+  s.relative_tolerance = rtol;
+  const double amplitude = std::max(1.0, a_g.norm());
+  for (double scale : plant.state_scale()) s.absolute_tolerance.push_back(rtol * 1e-3 * amplitude * scale);
+  OdeSolver ode(plant, 0.0, std::vector<double>(static_cast<std::size_t>(plant.size()), 0.0), s);
+  const std::vector<double>& x = ode.advance(30 * tau);
+  return plant.output_g(30 * tau, x.data());
 }
 
 }  // namespace vrelab::plant

@@ -97,6 +97,9 @@ class Accelerometer final : public OdeSystem {
   Linear linearise() const;
   // Typical magnitude of each state per g of input (finite-difference steps, tolerances).
   std::vector<double> state_scale() const;
+  // Slowest closed-loop time constant of `lin` (the quadrature's zero pole excluded);
+  // throws std::invalid_argument if a pole has Re >= 0.
+  double slowest_time_constant_s(const Linear& lin) const;
 
   const PlantConfig& config() const { return config_; }
   const Servo& servo() const { return servo_; }
@@ -118,5 +121,10 @@ class Accelerometer final : public OdeSystem {
   double q_ref_ = 0.0;
   bool has_in_ia_ = false, has_loop_ = false, has_out_ia_ = false;
 };
+
+// The plant run statically: from rest with every state zero (the instrument switched on in
+// orientation a_g), integrated for 30 slowest time constants (transient e^-30 ~ 1e-13),
+// returns U/K1 in g. Solver failures throw SolverError.
+double settled_output_g(const PlantConfig& config, const Vec3& a_g, double relative_tolerance = 1e-12);
 
 }  // namespace vrelab::plant

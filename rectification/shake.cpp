@@ -4,10 +4,10 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
+#include <random>
 #include <stdexcept>
 
 #include <Eigen/Dense>
-#include <Eigen/Eigenvalues>
 
 namespace vrelab::rectification {
 namespace {
@@ -28,7 +28,7 @@ bool ShakeSettings::IsValid(std::string* error) const {
 }
 
 SineShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, const vibration::SineVibration& v,
-                           const ShakeSettings& s) {
+                           const ShakeSettings& s, const SampleSink& sink) {
   std::string why;
   if (!s.IsValid(&why)) throw std::invalid_argument(why);
   vibration::validate(v);
@@ -44,25 +44,13 @@ SineShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_stati
   const Accelerometer::Linear lin = rest.linearise();
   const int n = rest.size();
 
-  // Slowest closed-loop time constant (the quadrature state's zero eigenvalue excluded).
-  std::vector<int> keep;
-  for (int k = 0; k < n; ++k)
-    if (k != Accelerometer::kQuadrature && !((k == Accelerometer::kAA1 || k == Accelerometer::kAA2) && config.dynamics.antialias_Hz <= 0))
-      keep.push_back(k);
-  Eigen::MatrixXd a_red(keep.size(), keep.size());
-  for (std::size_t i = 0; i < keep.size(); ++i)
-    for (std::size_t j = 0; j < keep.size(); ++j) a_red(static_cast<Eigen::Index>(i), static_cast<Eigen::Index>(j)) = lin.A(keep[i], keep[j]);
-  const Eigen::VectorXcd eig = Eigen::EigenSolver<Eigen::MatrixXd>(a_red, false).eigenvalues();
-  double slowest = std::numeric_limits<double>::infinity();
-  for (Eigen::Index i = 0; i < eig.size(); ++i) slowest = std::min(slowest, -eig[i].real());
-  if (!(slowest > 0)) throw std::invalid_argument("the closed loop is not stable (a pole with Re >= 0)");
-  r.slowest_time_constant_s = 1 / slowest;
+  r.slowest_time_constant_s = rest.slowest_time_constant_s(lin);
 
   // Linear periodic steady state: x = x_eq + Im(X e^{jwt}), X = (jwI - A)^-1 B W.
   Eigen::Vector3cd wc;
   for (int i = 0; i < 3; ++i) wc[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
-  const Eigen::MatrixXcd m = std::complex<double>(0, w) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
-  const Eigen::VectorXcd phasor = m.fullPivLu().solve(lin.B.cast<std::complex<double>>() * wc);
+  const Eigen::MatrixXcd resolvent = std::complex<double>(0, w) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
+  const Eigen::VectorXcd phasor = resolvent.fullPivLu().solve(lin.B.cast<std::complex<double>>() * wc);
 
   Accelerometer shaken(config, a_static, [v, w](double t) {
     Vec3 a;
@@ -90,22 +78,85 @@ SineShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_stati
   r.periods = per_block * s.blocks;
 
   plant::OdeSolver ode(shaken, 0.0, x0, solver);
-  double q_prev = ode.advance(r.settle_s)[Accelerometer::kQuadrature];
-  const double q_start = q_prev;
   const double block_s = per_block * period;
-  std::vector<double> block_mean;
-  for (int b = 1; b <= s.blocks; ++b) {
-    const double q = ode.advance(r.settle_s + b * block_s)[Accelerometer::kQuadrature];
-    block_mean.push_back((q - q_prev) / block_s);
-    q_prev = q;
+  const double k1 = config.coefficients[plant::K1];
+  auto batch_sigma = [&](const std::vector<double>& means, double mean) {
+    double ss = 0;
+    for (double b : means) ss += (b - mean) * (b - mean);
+    return std::sqrt(ss / (static_cast<double>(means.size()) - 1) / static_cast<double>(means.size()));
+  };
+  const Readout& ro = s.readout;
+  if (!ro.active() && !sink) {
+    // Continuous integral: Q is a state of the ODE.
+    r.method = "continuous integral";
+    double q_prev = ode.advance(r.settle_s)[Accelerometer::kQuadrature];
+    const double q_start = q_prev;
+    std::vector<double> block_mean;
+    for (int b = 1; b <= s.blocks; ++b) {
+      const double q = ode.advance(r.settle_s + b * block_s)[Accelerometer::kQuadrature];
+      block_mean.push_back((q - q_prev) / block_s);
+      q_prev = q;
+    }
+    r.measured_g = (q_prev - q_start) / (r.periods * period);
+    r.integral_slope_g = r.measured_g;
+    // Floor: the quadrature's own tolerance over the measured span.
+    const double floor = s.relative_tolerance * std::abs(phasor[Accelerometer::kQuadrature]) / (r.periods * period);
+    r.sigma_g = std::max(batch_sigma(block_mean, r.measured_g), floor);
+  } else {
+    // Sampled record, synchronous with the vibration.
+    r.method = "sampled record";
+    const double wanted = ro.active() ? ro.sample_rate_Hz : 50 * v.frequency_Hz;
+    const long per_period = std::max<long>(2, static_cast<long>(std::ceil(wanted / v.frequency_Hz - 1e-9)));
+    r.sample_rate_Hz = per_period * v.frequency_Hz;
+    const double dt = 1 / r.sample_rate_Hz;
+    std::mt19937_64 rng(ro.seed);
+    std::normal_distribution<double> normal(0, 1);
+    auto acquire = [&](double out_g) {
+      double u = k1 * (out_g + (ro.noise_sigma_g > 0 ? ro.noise_sigma_g * normal(rng) : 0.0));
+      if (ro.quantisation_lsb_g > 0) u = k1 * ro.quantisation_lsb_g * std::round(u / (k1 * ro.quantisation_lsb_g));
+      return u;
+    };
+    const long settle_n = settle_periods * per_period, block_n = per_block * per_period;
+    const long total_n = settle_n + s.blocks * block_n;
+    std::vector<double> block_sum(static_cast<std::size_t>(s.blocks), 0.0);
+    // Running integral of (U/K1 - baseline) for the paper's slope: sums for least squares.
+    double integral = 0, st = 0, stt = 0, si = 0, sti = 0;
+    long n_fit = 0;
+    for (long k = 0; k < total_n; ++k) {
+      const double t = k * dt;
+      const std::vector<double>& x = ode.advance(t);
+      const double u = acquire(shaken.output_g(t, x.data()));
+      if (sink) {
+        Vec3 in;
+        for (int i = 0; i < 3; ++i) in[i] = v.amplitude_g[i] * std::sin(w * t + v.phase_rad[i]);
+        sink(t, in, u);
+      }
+      if (k < settle_n) continue;
+      const long m = k - settle_n;
+      block_sum[static_cast<std::size_t>(m / block_n)] += u / k1;
+      integral += (u / k1 - r.baseline_g) * dt;
+      const double tm = (m + 1) * dt;
+      st += tm, stt += tm * tm, si += integral, sti += tm * integral;
+      ++n_fit;
+    }
+    r.samples = total_n;
+    // The record at rest: the same readout on the equilibrium output.
+    std::vector<double> rest_sum(static_cast<std::size_t>(s.blocks), 0.0);
+    for (long m = 0; m < s.blocks * block_n; ++m) rest_sum[static_cast<std::size_t>(m / block_n)] += acquire(r.baseline_g) / k1;
+    std::vector<double> vib_mean, rest_mean;
+    double vib_total = 0, rest_total = 0;
+    for (int b = 0; b < s.blocks; ++b) {
+      vib_mean.push_back(block_sum[static_cast<std::size_t>(b)] / static_cast<double>(block_n));
+      rest_mean.push_back(rest_sum[static_cast<std::size_t>(b)] / static_cast<double>(block_n));
+      vib_total += vib_mean.back() / s.blocks;
+      rest_total += rest_mean.back() / s.blocks;
+    }
+    r.measured_g = vib_total - rest_total;
+    const double fn = static_cast<double>(n_fit);
+    r.integral_slope_g = (fn * sti - st * si) / (fn * stt - st * st) - (rest_total - r.baseline_g);
+    const double sv = batch_sigma(vib_mean, vib_total), sr = batch_sigma(rest_mean, rest_total);
+    r.sigma_g = std::sqrt(sv * sv + sr * sr);
   }
-  r.measured_g = (q_prev - q_start) / (r.periods * period);
-  double ss = 0;
-  for (double b : block_mean) ss += (b - r.measured_g) * (b - r.measured_g);
-  const double batch_sigma = std::sqrt(ss / (s.blocks - 1) / s.blocks);
-  // Floor: the quadrature's own tolerance over the measured span.
-  const double floor = s.relative_tolerance * std::abs(phasor[Accelerometer::kQuadrature]) / (r.periods * period);
-  r.sigma_g = std::max(batch_sigma, floor);
   r.steps = ode.steps();
   r.rhs_evaluations = ode.rhs_evaluations();
   return r;

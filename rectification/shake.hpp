@@ -17,13 +17,32 @@
 //    the mean over whole periods is (Q(t2) - Q(t1)) / (t2 - t1) to the solver's tolerance;
 //  - uncertainty: the measuring interval is cut into `blocks` equal runs of whole periods;
 //    sigma = standard deviation of the block means / sqrt(blocks), floored at the solver's
-//    tolerance times the output amplitude divided by the number of periods.
+//    tolerance times the output amplitude divided by the number of periods;
+//  - with a Readout: the output is sampled synchronously (the rate raised to the next whole
+//    number of samples per period), noise and quantisation added, and the error is the mean
+//    of the samples over whole periods minus the mean of a record of equal length at rest;
+//    sigma combines the batch-mean sigmas of both records.
+#include <cstdint>
+#include <functional>
+#include <string>
+
 #include "plant/accelerometer.hpp"
 #include "vibration/profile.hpp"
 
 namespace vrelab::rectification {
 
+// The data acquisition: sampling, noise, quantisation (input-equivalent, g). Off when
+// sample_rate_Hz = 0: the measurement then uses the continuous integral Q.
+struct Readout {
+  double sample_rate_Hz = 0.0;
+  double noise_sigma_g = 0.0;       // white, per sample
+  double quantisation_lsb_g = 0.0;  // ADC step; 0 = off
+  std::uint64_t seed = 1;
+  bool active() const { return sample_rate_Hz > 0; }
+};
+
 struct ShakeSettings {
+  Readout readout;
   double relative_tolerance = 1e-10;
   double settle_decay = 1e-7;  // fraction to which transients decay before measuring
   int blocks = 4;              // batch means for the uncertainty
@@ -34,6 +53,13 @@ struct ShakeSettings {
 struct SineShakeResult {
   double measured_g = 0;
   double sigma_g = 0;
+  // The paper's method: least-squares slope of the running integral of (U/K1 - baseline).
+  // Over L seconds it carries a bias up to 12 w_IA / (omega^2 L^2) from the oscillation, so
+  // measured_g (the whole-period mean) is the estimate; the slope is kept for comparison.
+  double integral_slope_g = 0;
+  std::string method;              // "continuous integral" or "sampled record"
+  double sample_rate_Hz = 0;       // sampled record: synchronous with the vibration
+  long samples = 0;
   double baseline_g = 0;           // U/K1 at rest
   double settle_s = 0;             // skipped before measuring
   double slowest_time_constant_s = 0;
@@ -41,7 +67,11 @@ struct SineShakeResult {
   long steps = 0, rhs_evaluations = 0;
 };
 
+// Called for every sample of the record (time s, dynamic input g, output in output units).
+using SampleSink = std::function<void(double t_s, const Vec3& input_g, double output)>;
+
 SineShakeResult shake_sine(const plant::PlantConfig& plant, const Vec3& a_static_g,
-                           const vibration::SineVibration& v, const ShakeSettings& s = {});
+                           const vibration::SineVibration& v, const ShakeSettings& s = {},
+                           const SampleSink& sink = {});
 
 }  // namespace vrelab::rectification

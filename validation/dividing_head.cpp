@@ -62,7 +62,11 @@ Vec3 realised_orientation(const Position& p, const Vec3& initial_error_rad, cons
   return rotation(initial_error_rad).transpose() * head;
 }
 
-std::vector<Reading> simulate_static_test(const plant::Coefficients& truth,
+OutputSource model1_source(const plant::Coefficients& truth) {
+  return [truth](const Vec3& a) { return plant::output(truth, a); };
+}
+
+std::vector<Reading> simulate_static_test(const OutputSource& source, double K1,
                                           const std::vector<Position>& positions,
                                           const StaticTestErrors& e, std::mt19937_64& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -78,8 +82,8 @@ std::vector<Reading> simulate_static_test(const plant::Coefficients& truth,
           for (int k = 0; k < 3; ++k) d_angle[k] = e.angle_sigma_rad * normal(rng);
       }
       const Vec3 a = realised_orientation(positions[i], e.initial_error_rad, d_angle);
-      double u = plant::output(truth, a);
-      if (e.noise_sigma_g > 0) u += truth[plant::K1] * e.noise_sigma_g * normal(rng);
+      double u = source(a);
+      if (e.noise_sigma_g > 0) u += K1 * e.noise_sigma_g * normal(rng);
       out.push_back({static_cast<int>(i), u});
     }
   }

@@ -23,6 +23,7 @@
 //  - reading noise: each reading (one visit's mean output) gets N(0, (K1 sigma_g)^2);
 //  - repeats: each position is visited `repeats` times, each visit with fresh errors.
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -62,10 +63,21 @@ struct Reading {
 // positions `d_angle` is a small rotation about the sensor axes).
 Vec3 realised_orientation(const Position& p, const Vec3& initial_error_rad, const Vec3& d_angle_rad);
 
-// One complete test: positions.size() * repeats readings, position-major.
-std::vector<Reading> simulate_static_test(const plant::Coefficients& truth,
+// What the instrument reads (output units, noise-free) in a realised orientation (g).
+using OutputSource = std::function<double(const Vec3& a_g)>;
+// Model (1) with the given coefficients as the source.
+OutputSource model1_source(const plant::Coefficients& truth);
+
+// One complete test: positions.size() * repeats readings, position-major. K1 scales the
+// reading noise (given in g).
+std::vector<Reading> simulate_static_test(const OutputSource& source, double K1,
                                           const std::vector<Position>& positions,
                                           const StaticTestErrors& errors, std::mt19937_64& rng);
+inline std::vector<Reading> simulate_static_test(const plant::Coefficients& truth,
+                                                 const std::vector<Position>& positions,
+                                                 const StaticTestErrors& errors, std::mt19937_64& rng) {
+  return simulate_static_test(model1_source(truth), truth[plant::K1], positions, errors, rng);
+}
 
 // First-order error budget of each reading of `readings`, for coefficients `c` (in a lab,
 // the estimated ones): the variance from noise and set-angle errors (output units^2) and

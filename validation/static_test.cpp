@@ -10,7 +10,8 @@ StaticTestReport run_static_test(const plant::Coefficients& truth, const std::ve
                                  const StaticTestErrors& errors, const StaticTestSettings& settings) {
   StaticTestReport report;
   std::mt19937_64 rng(settings.seed);
-  report.readings = simulate_static_test(truth, positions, errors, rng);
+  const OutputSource source = settings.source ? settings.source : model1_source(truth);
+  report.readings = simulate_static_test(source, truth[plant::K1], positions, errors, rng);
 
   // Weights: 1 / first-order variance of each reading at an unweighted first fit.
   const LeastSquaresResult first = least_squares(positions, report.readings, {}, settings.fixed);
@@ -59,7 +60,7 @@ StaticTestReport run_static_test(const plant::Coefficients& truth, const std::ve
     fns.push_back(fn);
   }
   if (settings.monte_carlo_trials > 0) {
-    const auto stats = monte_carlo(fns, truth, positions, errors, settings.monte_carlo_trials, settings.seed + 1);
+    const auto stats = monte_carlo(fns, truth, source, positions, errors, settings.monte_carlo_trials, settings.seed + 1);
     for (std::size_t i = 0; i < stats.size(); ++i) report.methods[i].monte_carlo = stats[i];
   }
   return report;

@@ -31,6 +31,7 @@ struct MethodResult {
 
 struct StaticTestSettings {
   FixedSet fixed{};
+  OutputSource source;  // empty: model (1) with the true coefficients
   std::uint64_t seed = 1;
   int monte_carlo_trials = 0;
 };

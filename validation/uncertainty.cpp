@@ -39,7 +39,7 @@ Propagation propagate_first_order(const Estimator& estimator, const std::vector<
 }
 
 std::vector<MonteCarloStats> monte_carlo(const std::vector<Estimator>& estimators,
-                                         const plant::Coefficients& truth,
+                                         const plant::Coefficients& truth, const OutputSource& source,
                                          const std::vector<Position>& positions,
                                          const StaticTestErrors& errors, int n, std::uint64_t seed) {
   if (n < 2) throw std::invalid_argument("Monte Carlo needs at least 2 trials");
@@ -47,7 +47,7 @@ std::vector<MonteCarloStats> monte_carlo(const std::vector<Estimator>& estimator
   std::vector<MonteCarloStats> stats(estimators.size());
   std::vector<CoefArray> m2(estimators.size(), CoefArray{});
   for (int t = 1; t <= n; ++t) {
-    const std::vector<Reading> readings = simulate_static_test(truth, positions, errors, rng);
+    const std::vector<Reading> readings = simulate_static_test(source, truth[plant::K1], positions, errors, rng);
     for (std::size_t e = 0; e < estimators.size(); ++e) {
       const Estimate est = estimators[e](readings);
       MonteCarloStats& s = stats[e];

@@ -37,7 +37,7 @@ struct MonteCarloStats {
 
 // Runs `n` simulated tests from `seed`; one MonteCarloStats per estimator.
 std::vector<MonteCarloStats> monte_carlo(const std::vector<Estimator>& estimators,
-                                         const plant::Coefficients& truth,
+                                         const plant::Coefficients& truth, const OutputSource& source,
                                          const std::vector<Position>& positions,
                                          const StaticTestErrors& errors, int n, std::uint64_t seed);
 

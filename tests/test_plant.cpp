@@ -1,0 +1,155 @@
+// The ODE plant: its static response is model (1); a linear plant does not rectify; at low
+// frequency each term of (1), wherever it acts, rectifies as the corrected eq. (3); the loop
+// has the designed crossover and phase margin; solver failures are reported, not crashed.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <random>
+
+#include <Eigen/Dense>
+
+#include "plant/accelerometer.hpp"
+#include "rectification/eq3.hpp"
+#include "rectification/shake.hpp"
+#include "support/random_coefficients.hpp"
+#include "validation/dividing_head.hpp"
+
+using namespace vrelab;
+using namespace vrelab::plant;
+constexpr double kPi = std::numbers::pi;
+
+namespace {
+
+Location random_location(std::mt19937_64& rng, int c) {
+  const int n = (c >= k0 && c <= k4) ? 3 : 2;
+  const int pick = std::uniform_int_distribution<int>(0, n - 1)(rng);
+  if (n == 2) return pick == 0 ? Location::input : Location::output;
+  return pick == 0 ? Location::input : pick == 1 ? Location::loop : Location::output;
+}
+
+}  // namespace
+
+TEST(PlantStatic, SettledOutputReproducesModel1InEveryPositionOfTheDividingHead) {
+  // Navigation-grade magnitudes (1e-6 .. 1e-3), IA terms at random places; cross terms at
+  // the output (at the input (1) holds only to second order, see accelerometer.hpp).
+  // Tolerance 1e-9 relative to |U/K1| (floor 1e-3 g): the ODE settles for 30 time constants
+  // (e^-30 ~ 1e-13) at a relative tolerance of 1e-12.
+  std::mt19937_64 rng(41);
+  const auto positions = validation::equally_spaced_positions(8);
+  for (int n = 0; n < 4; ++n) {
+    PlantConfig cfg;
+    cfg.coefficients = test::random_coefficients(rng, 1e-6, 1e-3);
+    for (int c = k0; c <= k4; ++c) cfg.location[c] = random_location(rng, c);
+    if (n == 3) {  // the effects beyond (1) do not change the static response
+      cfg.effects.push_back(std::make_shared<PickoffNonlinearity>(50.0));
+      cfg.effects.push_back(std::make_shared<PendulumGeometry>());
+      cfg.effects.push_back(std::make_shared<MechanicalMode>(2000.0, 0.05, Vec3(1, 1, 1)));
+      cfg.effects.push_back(std::make_shared<CurrentSaturation>(30.0));
+    }
+    for (const auto& p : positions) {
+      const double model = output_g(cfg.coefficients, p.nominal_g);
+      EXPECT_NEAR(settled_output_g(cfg, p.nominal_g), model, 1e-9 * std::max(std::abs(model), 1e-3))
+          << "draw " << n << " a = " << p.nominal_g.transpose();
+    }
+  }
+}
+
+TEST(PlantStatic, CrossTermsAtTheInputHoldToSecondOrder) {
+  PlantConfig cfg;
+  cfg.coefficients[K1] = 1;
+  cfg.coefficients[k2] = 1e-4;
+  cfg.coefficients[delta_OA] = 1e-3;
+  cfg.location[delta_OA] = Location::input;
+  const Vec3 a(0.6, 0.8, 0);
+  // The torquer's k2 acts on a_IA + delta_OA a_PA: the excess is k2 (2 a_IA delta a_PA + delta^2 a_PA^2).
+  const double excess = 1e-4 * (2 * 0.6 * 1e-3 * 0.8 + 1e-6 * 0.64);
+  EXPECT_NEAR(settled_output_g(cfg, a) - output_g(cfg.coefficients, a), excess, 1e-12);
+}
+
+TEST(PlantDynamics, LinearPlantDoesNotRectifyA20gSineAt1kHz) {
+  PlantConfig cfg;
+  cfg.coefficients[K1] = 1.25;
+  vibration::SineVibration v;
+  v.amplitude_g = Vec3(20, 0, 0);
+  v.frequency_Hz = 1000;
+  const auto r = rectification::shake_sine(cfg, Vec3(0.5, std::sqrt(0.75), 0), v);
+  EXPECT_LT(std::abs(r.measured_g), 1e-9);  // the issue's numerical floor
+}
+
+TEST(PlantDynamics, EachTermAtEachPlaceRectifiesAsEq3AtOnePercentOfTheBandwidth) {
+  // 5 Hz = 1 % of the 500 Hz crossover. Loop and output terms see |H(jw)|^2 of the closed
+  // loop, 1 - O(1e-3) here; input terms see the vibration unfiltered. Bound 0.5 % (issue).
+  const Vec3 a(0.5, std::sqrt(0.75), 0);  // a_IA = 0.5 g: k3 acts, and |a_IA| < |w_IA| for k1'
+  for (int c = k1_asym; c <= k_OO; ++c) {
+    if (c == delta_OA || c == delta_PA) continue;  // linear: no rectification
+    for (Location l : {Location::input, Location::loop, Location::output}) {
+      if (!location_allowed(c, l)) continue;
+      PlantConfig cfg;
+      cfg.coefficients[K1] = 1.25;
+      cfg.coefficients[c] = c == k1_asym ? 1e-3 : 2e-4;
+      cfg.location[c] = l;
+      vibration::SineVibration v;
+      v.frequency_Hz = 5;
+      v.amplitude_g = c <= k4 ? Vec3(3, 0, 0) : Vec3(2, 1.5, 1);
+      v.phase_rad = Vec3(0, 0.4, -0.7);
+      const double expected = rectification::sine_rectification(cfg.coefficients, a, v).total_g();
+      const auto r = rectification::shake_sine(cfg, a, v);
+      EXPECT_NEAR(r.measured_g / expected, 1.0, 5e-3) << coefficient_name(c) << " at " << location_name(l);
+    }
+  }
+}
+
+TEST(PlantDynamics, LoopHasTheDesignedCrossoverAndPhaseMargin) {
+  // Independent of design_servo's arithmetic: the closed-loop response from the ODE's
+  // finite-difference linearisation. With |L| = 1 and arg L = -180 + PM at the crossover,
+  // T = L / (1 + L) has |T| = 1 / (2 sin(PM / 2)) there; and T -> 1 at low frequency.
+  for (double pm : {40.0, 50.0, 60.0}) {
+    PlantConfig cfg;
+    cfg.coefficients[K1] = 1;
+    cfg.dynamics.phase_margin_deg = pm;
+    const Accelerometer plant(cfg, Vec3(0, 0, 1));
+    const auto lin = plant.linearise();
+    auto response = [&](double f) {
+      const std::complex<double> jw(0, 2 * kPi * f);
+      const Eigen::MatrixXcd m = jw * Eigen::MatrixXcd::Identity(plant.size(), plant.size()) - lin.A.cast<std::complex<double>>();
+      const Eigen::VectorXcd x = m.fullPivLu().solve(lin.B.col(IA).cast<std::complex<double>>());
+      return (lin.C.cast<std::complex<double>>() * x)(0);
+    };
+    EXPECT_NEAR(std::abs(response(cfg.dynamics.loop_bandwidth_Hz)), 1 / (2 * std::sin(pm * kPi / 360)), 1e-6) << pm;
+    EXPECT_NEAR(std::abs(response(0.01)), 1.0, 1e-6);
+  }
+}
+
+TEST(PlantSolver, FailureNamesTheCallAndTheSimulatedTime) {
+  PlantConfig cfg;
+  cfg.coefficients[K1] = 1;
+  const Accelerometer plant(cfg, Vec3(1, 0, 0), [](double t) { return Vec3(std::sin(6000 * t), 0, 0); });
+  SolverSettings s;
+  s.max_steps = 20;
+  for (double x : plant.state_scale()) s.absolute_tolerance.push_back(1e-12 * x);
+  OdeSolver ode(plant, 0.0, std::vector<double>(static_cast<std::size_t>(plant.size()), 0.0), s);
+  try {
+    ode.advance(1.0);
+    ADD_FAILURE() << "no failure";
+  } catch (const SolverError& e) {
+    EXPECT_EQ(e.call, "CVode");
+    EXPECT_GT(e.t_s, 0.0);
+    EXPECT_LT(e.t_s, 1.0);
+    EXPECT_NE(std::string(e.what()).find("simulated time"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PlantSolver, AnExceptionInTheRightHandSideIsCarriedAcross) {
+  PlantConfig cfg;
+  cfg.coefficients[K1] = 1;
+  const Accelerometer plant(cfg, Vec3(1, 0, 0), [](double t) -> Vec3 {
+    if (t > 0.01) throw std::runtime_error("input failed");
+    return Vec3::Zero();
+  });
+  SolverSettings s;
+  for (double x : plant.state_scale()) s.absolute_tolerance.push_back(1e-12 * x);
+  OdeSolver ode(plant, 0.0, plant.equilibrium(), s);
+  EXPECT_THROW(ode.advance(1.0), std::runtime_error);
+}
