@@ -13,6 +13,7 @@
 #include "app/case_file.hpp"
 #include "app/output.hpp"
 #include "rectification/eq3.hpp"
+#include "rectification/series.hpp"
 #include "validation/static_test.hpp"
 #include "vrelab_version.hpp"
 
@@ -350,7 +351,8 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
     series.open(series_tmp);
     if (!series) throw InputError("cannot write " + series_tmp);
     series << fmt::format("# vrelab {} ({}) shake {}  seed {}\n", kProgramVersion, kGitDescribe, c.path, c.seed);
-    series << fmt::format("# output in {}; K1 = {:g} {}/g; static a_g = [{:g}, {:g}, {:g}]; vibration on from t = 0\n",
+    series << fmt::format("# output in {}; K1 = {:g} {}/g; static a_g = [{:g}, {:g}, {:g}]; at rest for t < 0, "
+                          "vibration on from t = 0\n",
                           c.output_unit, (*c.coefficients)[plant::K1], c.output_unit, a[0], a[1], a[2]);
     series << fmt::format("time_s,input_IA_g,input_PA_g,input_OA_g,output_{}\n", c.output_unit);
     sink = [&series](double t, const Vec3& in, double u) {
@@ -413,6 +415,107 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
                      {"quantisation_lsb_g", ro.quantisation_lsb_g}}}};
   j["solver_stats"] = {{"steps", r.steps}, {"rhs_evaluations", r.rhs_evaluations}, {"wall_s", wall_s}};
   j["units"] = {{"measured_g", "g"}, {"sigma_g", "g"}, {"predicted_eq3_g", "g"}};
+  write_atomic(o.json_path, j.dump(2) + "\n");
+}
+
+void run_measure(const MeasureOptions& o, std::ostream& out) {
+  const std::string& path = o.series_path;
+  if (o.on_s.size() != 2 || o.baseline_s.size() != 2) throw InputError("--on and --baseline each take FROM,TO in seconds");
+  rectification::SeriesWindows w;
+  w.on_from_s = o.on_s[0], w.on_to_s = o.on_s[1];
+  w.baseline_from_s = o.baseline_s[0], w.baseline_to_s = o.baseline_s[1];
+  w.frequency_Hz = o.frequency_Hz, w.K1 = o.K1, w.blocks = o.blocks;
+  try {
+    w.validate();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string("measure: ") + e.what());
+  }
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open the series (no such file?)");
+  rectification::SeriesMeasurer m(w);
+  std::string line;
+  long line_no = 0;
+  int column = -1;
+  std::string column_name;
+  std::vector<std::string> header;
+  auto split = [](const std::string& l) {
+    std::vector<std::string> f;
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t comma = l.find(',', start);
+      f.push_back(l.substr(start, comma == std::string::npos ? std::string::npos : comma - start));
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    return f;
+  };
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '#') continue;
+    const std::vector<std::string> f = split(line);
+    if (header.empty()) {
+      header = f;
+      if (header.size() < 2) throw InputError(fmt::format("{}:{}: the header needs a time column and an output column", path, line_no));
+      if (o.column.empty()) {
+        column = static_cast<int>(header.size()) - 1;
+      } else {
+        for (std::size_t i = 0; i < header.size(); ++i)
+          if (header[i] == o.column) column = static_cast<int>(i);
+        if (column < 1) throw InputError(fmt::format("{}:{}: no column named '{}'", path, line_no, o.column));
+      }
+      column_name = header[static_cast<std::size_t>(column)];
+      continue;
+    }
+    if (f.size() != header.size())
+      throw InputError(fmt::format("{}:{}: {} fields, the header has {}", path, line_no, f.size(), header.size()));
+    double t = 0, u = 0;
+    try {
+      std::size_t used_t = 0, used_u = 0;
+      t = std::stod(f[0], &used_t);
+      u = std::stod(f[static_cast<std::size_t>(column)], &used_u);
+      if (used_t != f[0].size() || used_u != f[static_cast<std::size_t>(column)].size()) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+      throw InputError(fmt::format("{}:{}: not a number in '{}'", path, line_no, line));
+    }
+    try {
+      m.add(t, u);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}:{}: {} (t = {}, {} = {})", path, line_no, e.what(), f[0], column_name,
+                                   f[static_cast<std::size_t>(column)]));
+    }
+  }
+  if (header.empty()) throw InputError(path + ": no header line and no samples");
+  rectification::SeriesResult r;
+  try {
+    r = m.finish();
+  } catch (const std::invalid_argument& e) {
+    throw InputError(path + ": " + e.what());
+  }
+  out << fmt::format("vrelab {} ({}) measure {}\n", kProgramVersion, kGitDescribe, path);
+  out << fmt::format("Output column '{}', K1 = {:g} per g; sample rate {:.6g} Hz\n", column_name, o.K1, r.sample_rate_Hz);
+  out << fmt::format("Baseline [{:g}, {:g}) s: {} samples, mean {:.9f} g\n", w.baseline_from_s, w.baseline_to_s,
+                     r.samples_baseline, r.baseline_g);
+  out << fmt::format("Vibration [{:g}, {:g}) s{}: {} samples\n", w.on_from_s, r.on_to_used_s,
+                     o.frequency_Hz > 0 ? fmt::format(" (whole periods of {:g} Hz)", o.frequency_Hz) : "", r.samples_on);
+  out << fmt::format("  vibration error          {:>14.6f} ug  +/- {:.3g} ug (1 sigma, batch means of {} blocks)\n",
+                     r.measured_g * 1e6, r.sigma_g * 1e6, o.blocks);
+  out << fmt::format("  running-integral slope   {:>14.6f} ug\n", r.integral_slope_g * 1e6);
+  if (o.json_path.empty()) return;
+  json j;
+  j["program"] = program_record();
+  j["command"] = "measure";
+  j["series"] = {{"file", path}, {"column", column_name}, {"K1", o.K1}};
+  j["windows"] = {{"baseline_s", {w.baseline_from_s, w.baseline_to_s}},
+                  {"on_s", {w.on_from_s, r.on_to_used_s}},
+                  {"frequency_Hz", o.frequency_Hz > 0 ? json(o.frequency_Hz) : json(nullptr)},
+                  {"blocks", o.blocks}};
+  j["measured_g"] = r.measured_g;
+  j["sigma_g"] = r.sigma_g;
+  j["integral_slope_g"] = r.integral_slope_g;
+  j["baseline_g"] = r.baseline_g;
+  j["samples"] = {{"on", r.samples_on}, {"baseline", r.samples_baseline}};
+  j["sample_rate_Hz"] = r.sample_rate_Hz;
   write_atomic(o.json_path, j.dump(2) + "\n");
 }
 

@@ -6,6 +6,7 @@
 #include <optional>
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace vrelab::app {
 
@@ -30,5 +31,16 @@ struct ShakeOptions {
   std::optional<std::uint64_t> seed;
 };
 void run_shake(const ShakeOptions& o, std::ostream& out);
+
+struct MeasureOptions {
+  std::string series_path;  // CSV: time in the first column; '#' lines are comments
+  std::string json_path;
+  std::vector<double> on_s, baseline_s;  // [from, to] each
+  double frequency_Hz = 0;
+  double K1 = 1;
+  std::string column;  // output column name; default the last column
+  int blocks = 4;
+};
+void run_measure(const MeasureOptions& o, std::ostream& out);
 
 }  // namespace vrelab::app

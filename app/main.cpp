@@ -37,6 +37,21 @@ int main(int argc, char** argv) {
   shake->add_option("--series", sh.series_path, "Write the sampled record as CSV to this file");
   shake->add_option("--seed", sh.seed, "Override the case's [run] seed");
 
+  MeasureOptions me;
+  auto* measure = app.add_subcommand("measure", "Vibration error from a recorded output series (CSV)");
+  measure->add_option("series", me.series_path, "CSV: time_s first, then output column(s); '#' lines are comments")
+      ->required();
+  measure->add_option("--on", me.on_s, "Vibration interval FROM,TO in s")->delimiter(',')->expected(2)->required();
+  measure->add_option("--baseline", me.baseline_s, "Baseline (at rest) interval FROM,TO in s")
+      ->delimiter(',')
+      ->expected(2)
+      ->required();
+  measure->add_option("--frequency", me.frequency_Hz, "Sine frequency in Hz: measure over whole periods");
+  measure->add_option("--K1", me.K1, "Scale factor, output units per g (default 1: output in g)");
+  measure->add_option("--column", me.column, "Output column name (default: the last column)");
+  measure->add_option("--blocks", me.blocks, "Blocks for the batch-means uncertainty (default 4)");
+  measure->add_option("--json", me.json_path, "Write the result as JSON to this file");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -47,6 +62,7 @@ int main(int argc, char** argv) {
     if (*identify) run_identify(id, std::cout);
     if (*predict) run_predict(pr, std::cout);
     if (*shake) run_shake(sh, std::cout);
+    if (*measure) run_measure(me, std::cout);
   } catch (const InputError& e) {
     std::cerr << "vrelab: error: " << e.what() << "\n";
     return 2;

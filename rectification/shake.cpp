@@ -117,6 +117,15 @@ SineShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_stati
       return u;
     };
     const long settle_n = settle_periods * per_period, block_n = per_block * per_period;
+    // The record at rest comes first (t < 0), as a lab records the baseline before switching
+    // the shaker on; the same readout on the equilibrium output.
+    std::vector<double> rest_sum(static_cast<std::size_t>(s.blocks), 0.0);
+    const long rest_n = s.blocks * block_n;
+    for (long m = 0; m < rest_n; ++m) {
+      const double u = acquire(r.baseline_g);
+      rest_sum[static_cast<std::size_t>(m / block_n)] += u / k1;
+      if (sink) sink(static_cast<double>(m - rest_n) * dt, Vec3::Zero(), u);
+    }
     const long total_n = settle_n + s.blocks * block_n;
     std::vector<double> block_sum(static_cast<std::size_t>(s.blocks), 0.0);
     // Running integral of (U/K1 - baseline) for the paper's slope: sums for least squares.
@@ -139,10 +148,7 @@ SineShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_stati
       st += tm, stt += tm * tm, si += integral, sti += tm * integral;
       ++n_fit;
     }
-    r.samples = total_n;
-    // The record at rest: the same readout on the equilibrium output.
-    std::vector<double> rest_sum(static_cast<std::size_t>(s.blocks), 0.0);
-    for (long m = 0; m < s.blocks * block_n; ++m) rest_sum[static_cast<std::size_t>(m / block_n)] += acquire(r.baseline_g) / k1;
+    r.samples = total_n + rest_n;
     std::vector<double> vib_mean, rest_mean;
     double vib_total = 0, rest_total = 0;
     for (int b = 0; b < s.blocks; ++b) {

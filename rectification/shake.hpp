@@ -20,8 +20,9 @@
 //    tolerance times the output amplitude divided by the number of periods;
 //  - with a Readout: the output is sampled synchronously (the rate raised to the next whole
 //    number of samples per period), noise and quantisation added, and the error is the mean
-//    of the samples over whole periods minus the mean of a record of equal length at rest;
-//    sigma combines the batch-mean sigmas of both records.
+//    of the samples over whole periods minus the mean of a record of equal length at rest
+//    (recorded first, at t < 0; the vibration starts at t = 0); sigma combines the
+//    batch-mean sigmas of both records.
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -67,7 +68,8 @@ struct SineShakeResult {
   long steps = 0, rhs_evaluations = 0;
 };
 
-// Called for every sample of the record (time s, dynamic input g, output in output units).
+// Called for every sample of the record (time s, dynamic input g, output in output units):
+// first the record at rest (t < 0), then the vibration (t >= 0).
 using SampleSink = std::function<void(double t_s, const Vec3& input_g, double output)>;
 
 SineShakeResult shake_sine(const plant::PlantConfig& plant, const Vec3& a_static_g,

@@ -188,3 +188,56 @@ TEST(CliIdentify, SameSeedSameResultOtherSeedOtherResult) {
   EXPECT_NE(a["estimates"]["least_squares"], other["estimates"]["least_squares"]);
   EXPECT_EQ(other["seed"], 99);
 }
+
+TEST(CliMeasure, ReproducesShakeFromItsOwnRecordAndRejectsBadSeries) {
+  TempDir d;
+  // A noisy sampled run; its record (rest for t < 0, vibration from 0) measured again.
+  const fs::path c = edited_case(d, "shake-sine-lab.toml", "min_measure_s = 2.0", "min_measure_s = 0.5");
+  ShakeOptions so;
+  so.case_path = c.string();
+  so.json_path = (d.path / "shake.json").string();
+  so.series_path = (d.path / "ts.csv").string();
+  std::ostringstream text;
+  run_shake(so, text);
+  const json shake = json::parse(read_file(so.json_path));
+  const double settle = shake["measurement"]["settle_s"].get<double>();
+  const double measured_span = shake["measurement"]["periods"].get<double>() / 80.0;
+  MeasureOptions mo;
+  mo.series_path = so.series_path;
+  mo.json_path = (d.path / "measure.json").string();
+  mo.on_s = {settle, settle + measured_span};
+  mo.baseline_s = {-measured_span, 0.0};
+  mo.frequency_Hz = 80;
+  mo.K1 = 1.25;
+  run_measure(mo, text);
+  const json m = json::parse(read_file(mo.json_path));
+  // Same samples, same windows, same arithmetic up to summation order: 1e-12 g.
+  EXPECT_NEAR(m["measured_g"].get<double>(), shake["measured_g"].get<double>(), 1e-12);
+  EXPECT_NEAR(m["sigma_g"].get<double>(), shake["sigma_g"].get<double>(), 1e-12);
+
+  // Bad series: a NaN sample, time going backwards, a record shorter than the interval.
+  auto rejects = [&](const std::string& body, const std::string& expect) {
+    const fs::path p = d.path / "bad.csv";
+    std::ofstream(p) << "time_s,output\n" << body;
+    MeasureOptions b = mo;
+    b.series_path = p.string();
+    b.json_path = (d.path / "bad.json").string();
+    b.frequency_Hz = 0;
+    b.on_s = {1.0, 2.0};
+    b.baseline_s = {0.0, 1.0};
+    try {
+      run_measure(b, text);
+      ADD_FAILURE() << "accepted: " << expect;
+    } catch (const InputError& e) {
+      EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(expect))) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(b.json_path));
+  };
+  std::string short_record;  // 0 .. 1.5 s: ends inside the vibration interval [1, 2)
+  for (int k = 0; k < 300; ++k) short_record += std::to_string(k * 0.005) + ",1.0\n";
+  rejects("0.0,1.0\n0.1,nan\n", R"(bad\.csv:3: sample is not a finite number)");
+  rejects("0.0,1.0\n0.2,1.0\n0.1,1.0\n", R"(bad\.csv:4: time does not increase)");
+  rejects("0.0,1.0\n0.1,abc\n", R"(bad\.csv:3: not a number)");
+  rejects(short_record, R"(too few samples.*shorter than the interval)");
+  rejects("0.0,1.0\n0.1", R"(bad\.csv:3: 1 fields, the header has 2)");  // a truncated last line
+}
