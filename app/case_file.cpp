@@ -427,6 +427,69 @@ void read_shake(Table t, Case& c) {
   t.check_unknown({"relative_tolerance", "settle_decay", "blocks", "min_measure_s"});
 }
 
+std::vector<Vec3> vec3_list(Table& t, std::string_view key, bool unit) {
+  std::vector<Vec3> out;
+  const toml::node* n = t.get(key, false);
+  if (!n) return out;
+  const toml::array* a = n->as_array();
+  if (!a || a->empty()) t.fail(n, key, "expected a non-empty array of [IA, PA, OA] vectors");
+  for (auto&& x : *a) {
+    Vec3 v = t.vec3_of(&x, key);
+    if (unit) {
+      if (!(v.norm() > 0)) t.fail(&x, key, "a direction must not be zero");
+      v.normalize();
+    }
+    out.push_back(v);
+  }
+  return out;
+}
+
+std::vector<double> number_list(Table& t, std::string_view key) {
+  std::vector<double> out;
+  const toml::node* n = t.get(key, false);
+  if (!n) return out;
+  const toml::array* a = n->as_array();
+  if (!a || a->empty()) t.fail(n, key, "expected a non-empty array of numbers");
+  for (auto&& x : *a) out.push_back(t.number_of(&x, key));
+  return out;
+}
+
+void read_sweep(Table t, Case& c) {
+  rectification::SweepGrid g;
+  g.frequencies_Hz = number_list(t, "frequencies_Hz");
+  if (g.frequencies_Hz.empty()) {
+    const double f1 = t.number("frequency_from_Hz"), f2 = t.number("frequency_to_Hz");
+    const auto n = t.integer("frequency_points", true, 0, 1, 100000);
+    const std::string spacing = t.string("frequency_spacing", "log");
+    if (spacing != "log" && spacing != "linear")
+      t.fail(t.raw().get("frequency_spacing"), "frequency_spacing", "must be \"log\" or \"linear\"");
+    if (!(f1 > 0) || !(f2 > f1)) t.fail(t.raw().get("frequency_to_Hz"), "frequency_to_Hz", "need 0 < from < to");
+    g.frequencies_Hz = rectification::spaced(f1, f2, static_cast<int>(n), spacing == "log");
+  }
+  for (double f : g.frequencies_Hz)
+    if (!(f > 0)) t.fail(t.raw().get("frequencies_Hz"), "frequencies_Hz", "frequencies must be positive");
+  g.amplitudes_g = number_list(t, "amplitudes_g");
+  if (g.amplitudes_g.empty()) t.fail(nullptr, "amplitudes_g", "missing (required)");
+  for (double a : g.amplitudes_g)
+    if (!(a >= 0)) t.fail(t.raw().get("amplitudes_g"), "amplitudes_g", "amplitudes must not be negative");
+  g.directions = vec3_list(t, "directions", true);
+  if (g.directions.empty()) t.fail(nullptr, "directions", "missing (required)");
+  g.orientations_g = vec3_list(t, "orientations_g", false);
+  if (g.orientations_g.empty()) {
+    if (!c.orientation_g) t.fail(nullptr, "orientations_g", "missing, and the case has no [orientation] a_g");
+    g.orientations_g.push_back(*c.orientation_g);
+  }
+  c.sweep_threads = static_cast<int>(t.integer("threads", false, 0, 0, 1024));
+  if (c.shake.readout.active())
+    for (double f : g.frequencies_Hz)
+      if (f >= c.shake.readout.sample_rate_Hz / 2)
+        t.fail(t.raw().get(t.has("frequencies_Hz") ? "frequencies_Hz" : "frequency_to_Hz"), "frequencies_Hz",
+               "frequency " + std::to_string(f) + " Hz is at or above the Nyquist frequency of [readout] sample_rate_Hz");
+  t.check_unknown({"frequencies_Hz", "frequency_from_Hz", "frequency_to_Hz", "frequency_points", "frequency_spacing",
+                   "amplitudes_g", "directions", "orientations_g", "threads"});
+  c.sweep = g;
+}
+
 }  // namespace
 
 Case read_case(const std::string& path) {
@@ -481,8 +544,9 @@ Case read_case(const std::string& path) {
   if (auto t = top.subtable("readout", false)) read_readout(*t, c);
   if (auto t = top.subtable("shake", false)) read_shake(*t, c);
   c.shake.readout.seed = c.seed;
+  if (auto t = top.subtable("sweep", false)) read_sweep(*t, c);
   top.check_unknown({"g_m_per_s2", "instrument", "coefficients", "orientation", "vibration", "range",
-                     "dividing_head", "identification", "run", "plant", "readout", "shake"});
+                     "dividing_head", "identification", "run", "plant", "readout", "shake", "sweep"});
   return c;
 }
 

@@ -17,6 +17,7 @@
 #include "plant/accelerometer.hpp"
 #include "plant/model1.hpp"
 #include "rectification/shake.hpp"
+#include "rectification/sweep.hpp"
 #include "validation/dividing_head.hpp"
 #include "validation/identification.hpp"
 #include "vibration/profile.hpp"
@@ -51,6 +52,8 @@ struct Case {
   bool has_plant_table = false;
   plant::PlantConfig plant;
   rectification::ShakeSettings shake;  // [shake] and [readout]
+  std::optional<rectification::SweepGrid> sweep;  // [sweep]
+  int sweep_threads = 0;                          // 0: all cores
 };
 
 Case read_case(const std::string& path);

@@ -1,6 +1,12 @@
 #include "app/commands.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <iostream>
+#include <iterator>
+#include <map>
+#include <sstream>
+#include <thread>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -517,6 +523,117 @@ void run_measure(const MeasureOptions& o, std::ostream& out) {
   j["samples"] = {{"on", r.samples_on}, {"baseline", r.samples_baseline}};
   j["sample_rate_Hz"] = r.sample_rate_Hz;
   write_atomic(o.json_path, j.dump(2) + "\n");
+}
+
+namespace {
+
+std::uint64_t fnv1a(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char ch : s) h = (h ^ ch) * 1099511628211ull;
+  return h;
+}
+
+constexpr const char* kSweepColumns =
+    "index,frequency_Hz,amplitude_g,direction_IA,direction_PA,direction_OA,a_IA_g,a_PA_g,a_OA_g,measured_g,sigma_g,"
+    "predicted_eq3_g,settle_s,steps,wall_s";
+
+std::string sweep_line(const rectification::SweepRow& r) {
+  const auto& c = r.condition;
+  return fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.12e},{:.4e},{:.12e},{:.6g},{},{:.4g}\n",
+                     c.index, c.frequency_Hz, c.amplitude_g, c.direction[0], c.direction[1], c.direction[2],
+                     c.orientation_g[0], c.orientation_g[1], c.orientation_g[2], r.measured_g, r.sigma_g,
+                     r.predicted_eq3_g, r.settle_s, r.steps, r.wall_s);
+}
+
+}  // namespace
+
+int run_sweep(const SweepOptions& o, std::ostream& out) {
+  namespace fs = std::filesystem;
+  const Case c = read_case(o.case_path);
+  require(c, c.coefficients.has_value(), "coefficients", "sweep");
+  require(c, c.sweep.has_value(), "sweep", "sweep");
+  const rectification::SweepGrid& grid = *c.sweep;
+  // The fingerprint ties a results file to the case and the program: a resumed sweep must
+  // not mix rows of different settings.
+  const std::string fingerprint = fmt::format("{:016x}", fnv1a(c.content.dump() + kProgramVersion));
+  const std::string header = fmt::format("# vrelab {} ({}) sweep {}\n# fingerprint {} conditions {} seed {}\n{}\n",
+                                         kProgramVersion, kGitDescribe, c.path, fingerprint, grid.size(), c.seed,
+                                         kSweepColumns);
+  std::map<std::size_t, std::string> rows;  // index -> line
+  const fs::path path(o.out_path);
+  if (path.has_parent_path()) fs::create_directories(path.parent_path());
+  if (fs::exists(path) && !o.restart) {
+    std::ifstream in(path);
+    std::string line, text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (text.find("# fingerprint " + fingerprint) == std::string::npos)
+      throw InputError(o.out_path + ": exists with rows of another case or program version; use --restart to discard it");
+    // A run interrupted mid-write leaves an unterminated last line: drop it.
+    if (!text.empty() && text.back() != '\n') text.erase(text.rfind('\n') + 1);
+    std::istringstream lines(text);
+    while (std::getline(lines, line)) {
+      if (line.empty() || line[0] == '#' || line.rfind("index,", 0) == 0) continue;
+      if (std::count(line.begin(), line.end(), ',') != 14) continue;
+      rows[std::stoul(line.substr(0, line.find(',')))] = line + "\n";
+    }
+  }
+  // Rewrite the kept rows (dropping any partial line), then append as conditions finish.
+  {
+    std::string text = header;
+    for (const auto& [i, l] : rows) text += l;
+    write_atomic(o.out_path, text);
+  }
+  std::vector<std::size_t> skip;
+  for (const auto& [i, l] : rows) skip.push_back(i);
+  const int threads = o.threads >= 0 ? o.threads : c.sweep_threads;
+  const int used = threads > 0 ? threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+
+  out << header_line("sweep", c, c.seed);
+  out << fmt::format("Grid: {} frequencies x {} amplitudes x {} directions x {} orientations = {} conditions; "
+                     "{} already in {}; {} thread(s)\n",
+                     grid.frequencies_Hz.size(), grid.amplitudes_g.size(), grid.directions.size(),
+                     grid.orientations_g.size(), grid.size(), rows.size(), o.out_path, used);
+  out.flush();
+  std::ofstream append(o.out_path, std::ios::app);
+  std::vector<std::string> failures;
+  const bool tty = ::isatty(2);
+  std::size_t last_decile = 0;
+  const auto start = std::chrono::steady_clock::now();
+  rectification::run_sweep(
+      c.plant, c.shake, grid, skip, used,
+      [&](const rectification::SweepRow& r) {
+        if (!r.ok) {
+          failures.push_back(fmt::format("condition {} ({:g} Hz, {:g} g): {}", r.condition.index, r.condition.frequency_Hz,
+                                         r.condition.amplitude_g, r.error));
+          return;
+        }
+        const std::string l = sweep_line(r);
+        append << l << std::flush;  // one row per write: an interruption loses at most this row
+        rows[r.condition.index] = l;
+      },
+      [&](const rectification::SweepProgress& p) {
+        if (!o.progress) return;
+        const double eta = p.done ? p.elapsed_s / static_cast<double>(p.done) * static_cast<double>(p.total - p.done) : 0;
+        if (tty) {
+          const int width = 30, fill = static_cast<int>(width * p.done / std::max<std::size_t>(1, p.total));
+          std::cerr << fmt::format("\r[{}{}] {}/{} conditions, {:.1f} s, ETA {:.0f} s ", std::string(fill, '#'),
+                                   std::string(width - fill, '.'), p.done, p.total, p.elapsed_s, eta)
+                    << std::flush;
+        } else if (p.total && p.done * 10 / p.total > last_decile) {
+          last_decile = p.done * 10 / p.total;
+          std::cerr << fmt::format("sweep: {}/{} conditions, {:.1f} s\n", p.done, p.total, p.elapsed_s);
+        }
+      });
+  if (o.progress && tty) std::cerr << "\n";
+  append.close();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // Final file: every row, sorted by condition.
+  std::string text = header;
+  for (const auto& [i, l] : rows) text += l;
+  write_atomic(o.out_path, text);
+  out << fmt::format("Done: {} conditions in {:.3g} s wall ({} written, {} failed) -> {}\n", grid.size() - skip.size(),
+                     wall, rows.size(), failures.size(), o.out_path);
+  for (const auto& f : failures) out << "  failed: " << f << "\n";
+  return static_cast<int>(failures.size());
 }
 
 }  // namespace vrelab::app

@@ -43,4 +43,14 @@ struct MeasureOptions {
 };
 void run_measure(const MeasureOptions& o, std::ostream& out);
 
+struct SweepOptions {
+  std::string case_path;
+  std::string out_path;  // CSV, appended as conditions finish; resumed if it exists
+  bool restart = false;  // discard an existing file
+  int threads = -1;      // -1: the case's [sweep] threads (0: all cores)
+  bool progress = true;
+};
+// Returns the number of conditions that failed (their rows are not written).
+int run_sweep(const SweepOptions& o, std::ostream& out);
+
 }  // namespace vrelab::app

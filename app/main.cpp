@@ -52,6 +52,15 @@ int main(int argc, char** argv) {
   measure->add_option("--blocks", me.blocks, "Blocks for the batch-means uncertainty (default 4)");
   measure->add_option("--json", me.json_path, "Write the result as JSON to this file");
 
+  SweepOptions sw;
+  auto* sweep = app.add_subcommand("sweep", "A grid of shaker runs on all cores; resumable");
+  sweep->add_option("case", sw.case_path, "Case file (TOML) with a [sweep] table")->required();
+  sweep->add_option("--out", sw.out_path, "Results CSV (resumed if it exists)")->required();
+  sweep->add_flag("--restart", sw.restart, "Discard an existing results file");
+  sweep->add_option("--threads", sw.threads, "Threads (default: the case's, 0 = all cores)");
+  bool no_progress = false;
+  sweep->add_flag("--no-progress", no_progress, "No progress bar");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -63,6 +72,10 @@ int main(int argc, char** argv) {
     if (*predict) run_predict(pr, std::cout);
     if (*shake) run_shake(sh, std::cout);
     if (*measure) run_measure(me, std::cout);
+    if (*sweep) {
+      sw.progress = !no_progress;
+      if (run_sweep(sw, std::cout) > 0) return 2;
+    }
   } catch (const InputError& e) {
     std::cerr << "vrelab: error: " << e.what() << "\n";
     return 2;
