@@ -23,14 +23,34 @@ class Excitation {
   virtual std::string describe() const = 0;
 };
 
+// A tone: A_i sin(theta(t) + phase_i) on axis i, one carrier phase theta(t) for all axes
+// (a fixed sine, theta = 2 pi f t, or a sweep). The imperfection decorators that need the
+// carrier (exact transverse phase shift, harmonics, rocking) take a ToneExcitation.
+struct CarrierState {
+  double phase_rad = 0.0;      // theta(t)
+  double frequency_Hz = 0.0;   // theta'(t) / (2 pi)
+  double rate_Hz_per_s = 0.0;  // theta''(t) / (2 pi)
+};
+
+class ToneExcitation : public Excitation {
+ public:
+  virtual CarrierState carrier(double t_s) const = 0;
+  virtual Vec3 amplitude_g() const = 0;  // A_i, peak, >= 0
+  virtual Vec3 phase_rad() const = 0;    // phase_i
+  Vec3 acceleration_g(double t_s) const override;  // A_i sin(theta(t) + phase_i)
+};
+
 // The sine of profile.hpp as an Excitation: w_i sin(2 pi f t + phase_i) on each axis.
-class SineExcitation final : public Excitation {
+class SineExcitation final : public ToneExcitation {
  public:
   explicit SineExcitation(const SineVibration& v);
   Vec3 acceleration_g(double t_s) const override;
   double max_frequency_Hz() const override { return v_.frequency_Hz; }
   std::string describe() const override;
   const SineVibration& sine() const { return v_; }
+  CarrierState carrier(double t_s) const override;
+  Vec3 amplitude_g() const override { return v_.amplitude_g; }
+  Vec3 phase_rad() const override { return v_.phase_rad; }
 
  private:
   SineVibration v_;

@@ -1,0 +1,83 @@
+#pragma once
+// vibration/random.hpp -- Gaussian random vibration synthesised from PSD tables, and the
+// Welch estimator that checks it.
+//
+// Takes: a RandomProfile (one PSD table per sensor axis [IA, PA, OA], or none for an axis
+//        at rest, and how the axes are coupled), a duration (s), a sample rate (Hz) and a
+//        64-bit seed.
+// Gives: samples in g, per axis, at that rate (synthesize_random); one-sided PSD estimates
+//        in g^2/Hz of any sampled signal (welch_psd).
+//
+// Synthesis (random-phase multisine, one inverse real FFT per axis): N samples at fs, bin k
+// at f_k = k fs / N. The signal is x[n] = sum_k A_k cos(2 pi k n / N + phi_k) with cosine
+// amplitude A_k = sqrt(2 G(f_k) fs / N), so that the mean square over the N samples is
+// exactly sum_k G(f_k) fs/N (Parseval), the Riemann sum of the integral of G. The FFTW c2r
+// transform is unnormalised, x[n] = sum over all N bins of X_k e^{+2 pi i k n / N}, hence
+// X_k = (A_k / 2) e^{i phi_k} = sqrt(G(f_k) fs / (2 N)) e^{i phi_k} for 0 < k < N/2
+// (the "sqrt(PSD N fs / 2)" of a 1/N-normalised inverse, divided by N). DC and Nyquist
+// bins are 0. Phases: phi_k = 2 pi u, u = (top 53 bits of an std::mt19937_64 draw) / 2^53,
+// drawn in order of k, axis by axis (IA, PA, OA), from an engine seeded by
+// std::seed_seq{seed lo, seed hi, block lo, block hi} -- bit-identical on every platform.
+// The result is exactly periodic with period N / fs (a wrap-around is seamless).
+//
+// Coupling: `independent` draws separate phases per axis (zero coherence between axes);
+// `common` uses the same phases on every axis (coherence 1 and zero relative phase at every
+// frequency; with proportional tables, G_i = d_i^2 G, the motion is along one fixed direction).
+//
+// Memory: 8 bytes per sample per axis for the result (fs = 20 kHz: 9.6 MB per minute per
+// axis), plus 16 (N/2 + 1) bytes of FFT buffer per axis while transforming. For long runs
+// use RandomExcitation (vibration/sampled.hpp), which synthesises in blocks.
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "vibration/psd.hpp"
+
+namespace vrelab::vibration {
+
+enum class AxisCoupling { independent, common };
+
+struct RandomProfile {
+  std::array<std::optional<PsdTable>, 3> psd;  // per axis [IA, PA, OA]; empty: axis at rest
+  AxisCoupling coupling = AxisCoupling::common;
+};
+
+// Throws std::invalid_argument if no axis has a table, or a table is invalid (the message
+// names the axis, then the table's field and row).
+void validate(const RandomProfile& p);
+// Highest table frequency over the axes, Hz.
+double max_frequency_Hz(const RandomProfile& p);
+std::string describe(const RandomProfile& p);
+
+struct SampledSignal {
+  double sample_rate_Hz = 0.0;
+  std::array<std::vector<double>, 3> samples_g;  // per axis, all of one length
+  std::size_t size() const { return samples_g[0].size(); }
+};
+
+// One period of N = round(duration_s * sample_rate_Hz) samples (N >= 16). Throws
+// std::invalid_argument naming duration_s or sample_rate_Hz when invalid, and naming
+// sample_rate_Hz when it is not above twice the profile's top frequency.
+SampledSignal synthesize_random(const RandomProfile& p, double duration_s, double sample_rate_Hz, std::uint64_t seed);
+
+// The same periodic block of `length` samples that RandomExcitation draws as its block
+// `block_index` (synthesize_random is block 0 of length N).
+SampledSignal random_phase_block(const RandomProfile& p, std::size_t length, double sample_rate_Hz, std::uint64_t seed,
+                                 std::int64_t block_index);
+
+struct PsdEstimate {
+  std::vector<double> frequency_Hz;   // k fs / L, k = 0 .. L/2
+  std::vector<double> psd_g2_per_Hz;  // one-sided
+  std::size_t segments = 0;           // number of averaged segments
+};
+
+// Welch: segments of `segment_length` samples (even, >= 8), 50 % overlap, periodic Hann
+// window w[n] = 0.5 - 0.5 cos(2 pi n / L), no detrending, one-sided density scaling
+// P_k = c |sum_n w[n] x[n] e^{-2 pi i k n / L}|^2 / (fs sum_n w[n]^2), c = 2 for
+// 0 < k < L/2 and 1 at DC and Nyquist, averaged over the segments.
+PsdEstimate welch_psd(std::span<const double> x_g, double sample_rate_Hz, std::size_t segment_length);
+
+}  // namespace vrelab::vibration
