@@ -20,7 +20,11 @@
 #include "rectification/sweep.hpp"
 #include "validation/dividing_head.hpp"
 #include "validation/identification.hpp"
+#include "vibration/decorators.hpp"
+#include "vibration/demand.hpp"
 #include "vibration/profile.hpp"
+#include "vibration/random.hpp"
+#include "vibration/sweep.hpp"
 
 namespace vrelab::app {
 
@@ -35,6 +39,25 @@ struct DividingHead {
   bool from_ode = false;    // source = "ode": readings from the ODE plant, else model (1)
 };
 
+// The [vibration] table. type: sine | random | sine_on_random | swept_sine.
+struct VibrationSpec {
+  std::string type;
+  vibration::SineVibration sine;                       // sine, sine_on_random
+  std::optional<vibration::RandomVibration> gaussian;  // random, sine_on_random (from rms_g or the PSD)
+  std::optional<vibration::RandomProfile> psd;         // PSD tables: needed to shake random profiles
+  std::optional<vibration::SweptSine> swept;
+  double duration_s = 10.0;  // measuring time of a non-periodic run
+};
+
+// The [shaker] table: limits and imperfections, each off unless given.
+struct ShakerSpec {
+  vibration::ShakerLimits limits;
+  std::optional<vibration::TransverseSpec> transverse;
+  std::vector<vibration::Harmonic> harmonics;
+  std::optional<vibration::RockingSpec> rocking;
+  bool imperfect() const { return transverse || !harmonics.empty() || rocking; }
+};
+
 struct Case {
   std::string path;
   nlohmann::json content;  // the file, as JSON
@@ -43,7 +66,8 @@ struct Case {
   std::string output_unit = "mA";
   std::optional<plant::Coefficients> coefficients;
   std::optional<Vec3> orientation_g;
-  std::optional<std::variant<vibration::SineVibration, vibration::RandomVibration>> vibration;
+  std::optional<VibrationSpec> vibration;
+  ShakerSpec shaker;
   std::optional<double> range_limit_g;
   std::optional<DividingHead> dividing_head;
   validation::FixedSet fixed{};

@@ -20,6 +20,7 @@
 #include "app/output.hpp"
 #include "rectification/eq3.hpp"
 #include "rectification/series.hpp"
+#include "vibration/sampled.hpp"
 #include "validation/static_test.hpp"
 #include "vrelab_version.hpp"
 
@@ -229,6 +230,39 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
   write_atomic(o.json_path, j.dump(2) + "\n");
 }
 
+namespace {
+
+// Eq. (3) corrected for the case's vibration (quasi-static; frequency-independent).
+rectification::Eq3Terms predict_terms(const Case& c) {
+  const VibrationSpec& v = *c.vibration;
+  const plant::Coefficients& k = *c.coefficients;
+  const Vec3& a = *c.orientation_g;
+  if (v.type == "random") return rectification::random_rectification(k, a, *v.gaussian, c.range_limit_g);
+  if (v.type == "sine_on_random")
+    return rectification::sine_on_random_rectification(k, a, v.sine, *v.gaussian, c.range_limit_g);
+  return rectification::sine_rectification(k, a, v.sine, c.range_limit_g);  // sine, swept sine
+}
+
+json vibration_json(const VibrationSpec& v) {
+  json j = {{"type", v.type}};
+  if (v.type != "random") {
+    j["amplitude_g"] = vec_json(v.sine.amplitude_g);
+    j["phase_deg"] = vec_json(v.sine.phase_rad * 180 / std::numbers::pi);
+    j["frequency_Hz"] = v.sine.frequency_Hz > 0 ? json(v.sine.frequency_Hz) : json(nullptr);
+  }
+  if (v.gaussian) {
+    j["rms_g"] = vec_json(v.gaussian->rms_g);
+    const Eigen::Matrix3d cov = v.gaussian->covariance_g2();
+    json cj = json::array();
+    for (int i = 0; i < 3; ++i) cj.push_back(vec_json(cov.row(i).transpose()));
+    j["covariance_g2"] = cj;
+  }
+  if (v.psd || v.swept) j["duration_s"] = v.duration_s;
+  return j;
+}
+
+}  // namespace
+
 void run_predict(const PredictOptions& o, std::ostream& out) {
   const Case c = read_case(o.case_path);
   require(c, c.coefficients.has_value(), "coefficients", "predict");
@@ -237,27 +271,20 @@ void run_predict(const PredictOptions& o, std::ostream& out) {
   const plant::Coefficients& k = *c.coefficients;
   const Vec3 a = *c.orientation_g;
 
-  rectification::Eq3Terms terms;
+  const VibrationSpec& vs = *c.vibration;
+  const rectification::Eq3Terms terms = predict_terms(c);
   std::optional<double> printed;
-  std::string description;
-  json vib;
-  if (const auto* s = std::get_if<vibration::SineVibration>(&*c.vibration)) {
-    terms = rectification::sine_rectification(k, a, *s, c.range_limit_g);
-    printed = rectification::sine_rectification_as_printed(k, a, *s);
-    const Vec3 ph = s->phase_rad * 180 / std::numbers::pi;
-    description = fmt::format("sine, peak [{:g}, {:g}, {:g}] g, phase [{:g}, {:g}, {:g}] deg", s->amplitude_g[0],
-                              s->amplitude_g[1], s->amplitude_g[2], ph[0], ph[1], ph[2]);
-    vib = {{"type", "sine"}, {"amplitude_g", vec_json(s->amplitude_g)}, {"phase_deg", vec_json(ph)},
-           {"frequency_Hz", s->frequency_Hz > 0 ? json(s->frequency_Hz) : json(nullptr)}};
-  } else {
-    const auto& rv = std::get<vibration::RandomVibration>(*c.vibration);
-    terms = rectification::random_rectification(k, a, rv, c.range_limit_g);
-    description = fmt::format("Gaussian random, rms [{:g}, {:g}, {:g}] g", rv.rms_g[0], rv.rms_g[1], rv.rms_g[2]);
-    const Eigen::Matrix3d cov = rv.covariance_g2();
-    json cj = json::array();
-    for (int i = 0; i < 3; ++i) cj.push_back(vec_json(cov.row(i).transpose()));
-    vib = {{"type", "random"}, {"rms_g", vec_json(rv.rms_g)}, {"covariance_g2", cj}};
+  json vib = vibration_json(vs);
+  std::string description = vs.type;
+  if (vs.type == "sine" || vs.type == "swept_sine") {
+    printed = rectification::sine_rectification_as_printed(k, a, vs.sine);
+    const Vec3 ph = vs.sine.phase_rad * 180 / std::numbers::pi;
+    description += fmt::format(", peak [{:g}, {:g}, {:g}] g, phase [{:g}, {:g}, {:g}] deg", vs.sine.amplitude_g[0],
+                               vs.sine.amplitude_g[1], vs.sine.amplitude_g[2], ph[0], ph[1], ph[2]);
   }
+  if (vs.gaussian)
+    description += fmt::format("{}Gaussian rms [{:g}, {:g}, {:g}] g", vs.type == "sine_on_random" ? " + " : ", ",
+                               vs.gaussian->rms_g[0], vs.gaussian->rms_g[1], vs.gaussian->rms_g[2]);
 
   out << header_line("predict", c, c.seed);
   out << fmt::format("Static acceleration a = [{:g}, {:g}, {:g}] g (|a| = {:.6g} g); vibration: {}\n", a[0], a[1], a[2],
@@ -335,16 +362,68 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
   require(c, c.orientation_g.has_value(), "orientation", "shake");
   require(c, c.vibration.has_value(), "vibration", "shake");
   if (o.seed) c.seed = *o.seed, c.shake.readout.seed = *o.seed;
-  const auto* sine = std::get_if<vibration::SineVibration>(&*c.vibration);
-  if (!sine) throw InputError(c.path + ": [vibration] type: shake runs \"sine\" profiles in this version");
-  if (!(sine->frequency_Hz > 0))
-    throw InputError(c.path + ": [vibration] frequency_Hz: a shaker run needs a positive frequency");
+  const VibrationSpec& vs = *c.vibration;
   const auto& ro = c.shake.readout;
-  if (ro.active() && sine->frequency_Hz >= ro.sample_rate_Hz / 2)
-    throw InputError(fmt::format("{}: [vibration] frequency_Hz = {:g} is at or above the Nyquist frequency {:g} Hz of "
+  const Vec3 a_static = *c.orientation_g;
+  // The table's motion, the shaker's demand and its limits.
+  std::shared_ptr<const vibration::Excitation> motion;
+  vibration::ShakerDemand demand;
+  double top_Hz = 0;
+  const bool periodic = vs.type == "sine";
+  try {
+    if (vs.type == "random" && !vs.psd)
+      throw InputError(c.path + ": [vibration] a shaken random profile needs PSD tables psd_IA / psd_PA / psd_OA");
+    if ((vs.type == "random" || vs.type == "sine_on_random") && !vs.psd)
+      throw InputError(c.path + ": [vibration] sine_on_random needs PSD tables psd_IA / psd_PA / psd_OA to be shaken");
+    if (periodic && !(vs.sine.frequency_Hz > 0))
+      throw InputError(c.path + ": [vibration] frequency_Hz: a shaker run needs a positive frequency");
+    std::shared_ptr<const vibration::ToneExcitation> tone;
+    if (vs.type == "sine" || vs.type == "sine_on_random") tone = std::make_shared<vibration::SineExcitation>(vs.sine);
+    if (vs.swept) tone = std::make_shared<vibration::SweptSineExcitation>(*vs.swept);
+    std::shared_ptr<const vibration::Excitation> m = tone;
+    if (tone && !c.shaker.harmonics.empty()) m = std::make_shared<vibration::HarmonicDistortion>(tone, c.shaker.harmonics);
+    if (tone && c.shaker.transverse) {
+      if (c.shaker.harmonics.empty())
+        m = std::make_shared<vibration::TransverseMotion>(tone, *c.shaker.transverse);
+      else
+        m = std::make_shared<vibration::TransverseMotion>(m, *c.shaker.transverse, vs.sine.frequency_Hz);
+    }
+    if (tone && c.shaker.rocking) {
+      vibration::RockingSpec r = *c.shaker.rocking;
+      r.static_gravity_g = a_static;
+      r.g_m_per_s2 = c.g_m_per_s2;
+      m = std::make_shared<vibration::Rocking>(m, tone, r);
+    }
+    if (!tone && c.shaker.imperfect())
+      throw InputError(c.path + ": [shaker] transverse motion, harmonics and rocking apply to sine and swept-sine runs");
+    if (vs.psd) {
+      top_Hz = vibration::max_frequency_Hz(*vs.psd);
+      auto random = std::make_shared<vibration::RandomExcitation>(*vs.psd, 8 * top_Hz, c.seed);
+      m = m ? std::shared_ptr<const vibration::Excitation>(std::make_shared<vibration::SumExcitation>(
+                  std::vector<std::shared_ptr<const vibration::Excitation>>{m, random}))
+            : random;
+      demand = vibration::shaker_demand(*vs.psd, c.g_m_per_s2);
+    }
+    if (vs.swept) demand = vibration::shaker_demand(*vs.swept, c.g_m_per_s2);
+    if (vs.type == "sine" || vs.type == "sine_on_random") {
+      const auto d = vibration::shaker_demand(vs.sine, c.shaker.harmonics, c.g_m_per_s2);
+      demand = vs.type == "sine" ? d : vibration::combine(d, demand);
+    }
+    top_Hz = std::max(top_Hz, m->max_frequency_Hz());
+    motion = m;
+  } catch (const std::invalid_argument& e) {
+    throw InputError(c.path + ": [vibration]/[shaker]: " + e.what());
+  }
+  try {
+    vibration::check_feasible(demand, c.shaker.limits);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(c.path + ": [shaker] the profile is beyond the shaker: " + e.what());
+  }
+  if (ro.active() && top_Hz >= ro.sample_rate_Hz / 2)
+    throw InputError(fmt::format("{}: [vibration] content up to {:g} Hz is at or above the Nyquist frequency {:g} Hz of "
                                  "[readout] sample_rate_Hz = {:g}",
-                                 c.path, sine->frequency_Hz, ro.sample_rate_Hz / 2, ro.sample_rate_Hz));
-  const Vec3 a = *c.orientation_g;
+                                 c.path, top_Hz, ro.sample_rate_Hz / 2, ro.sample_rate_Hz));
+  const Vec3& a = a_static;
 
   // The sampled record, streamed to a temporary file and renamed at the end.
   std::ofstream series;
@@ -366,9 +445,11 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
     };
   }
   const auto start = std::chrono::steady_clock::now();
-  const rectification::SineShakeResult r = rectification::shake_sine(c.plant, a, *sine, c.shake, sink);
+  const rectification::ShakeResult r =
+      periodic ? rectification::shake_sine(c.plant, a, vs.sine, c.shake, sink, c.shaker.imperfect() ? motion.get() : nullptr)
+               : rectification::shake_excitation(c.plant, a, *motion, vs.duration_s, c.shake, sink);
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  const double predicted = rectification::sine_rectification(*c.coefficients, a, *sine, c.range_limit_g).total_g();
+  const double predicted = predict_terms(c).total_g();
 
   out << header_line("shake", c, c.seed);
   out << fmt::format("Plant: from coefficients, pendulum {:g} Hz, loop crossover {:g} Hz, phase margin {:g} deg{}{}\n",
@@ -376,8 +457,8 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
                      c.plant.dynamics.phase_margin_deg, c.plant.dynamics.integrator ? ", PI" : ", no integrator",
                      c.plant.effects.empty() ? "" : ", effects:");
   for (const auto& e : c.plant.effects) out << "  " << e->name() << "\n";
-  out << fmt::format("Static a = [{:g}, {:g}, {:g}] g; sine {:g} Hz, peak [{:g}, {:g}, {:g}] g\n", a[0], a[1], a[2],
-                     sine->frequency_Hz, sine->amplitude_g[0], sine->amplitude_g[1], sine->amplitude_g[2]);
+  out << fmt::format("Static a = [{:g}, {:g}, {:g}] g; vibration: {}\n", a[0], a[1], a[2], motion->describe());
+  out << "Shaker demand: " << demand.report() << "\n";
   out << fmt::format("Measurement: {}; settled {:.4g} s ({:.3g} slowest time constants), {} periods measured{}\n",
                      r.method, r.settle_s, r.settle_s / r.slowest_time_constant_s, r.periods,
                      r.samples ? fmt::format(", {} samples at {:g} Hz", r.samples, r.sample_rate_Hz) : "");
@@ -404,6 +485,13 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
   j["integral_slope_g"] = r.integral_slope_g;
   j["baseline_g"] = r.baseline_g;
   j["plant"] = plant_json(c.plant);
+  j["vibration"] = vibration_json(vs);
+  j["vibration"]["description"] = motion->describe();
+  j["shaker_demand"] = {{"acceleration_rms_g", vec_json(demand.acceleration_rms_g)},
+                        {"acceleration_peak_g", vec_json(demand.acceleration_peak_g)},
+                        {"velocity_peak_m_per_s", vec_json(demand.velocity_peak_m_per_s)},
+                        {"displacement_peak_m", vec_json(demand.displacement_peak_m)},
+                        {"stroke_peak_to_peak_m", demand.table_stroke_peak_to_peak_m()}};
   j["measurement"] = {{"method", r.method},
                       {"settle_s", r.settle_s},
                       {"slowest_time_constant_s", r.slowest_time_constant_s},

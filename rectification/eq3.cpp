@@ -110,6 +110,21 @@ Eq3Terms random_rectification(const plant::Coefficients& c, const Vec3& a,
   return t;
 }
 
+Eq3Terms sine_on_random_rectification(const plant::Coefficients& c, const Vec3& a,
+                                      const vibration::SineVibration& sine, const vibration::RandomVibration& random,
+                                      std::optional<double> range_g) {
+  Eq3Terms t = sine_rectification(c, a, sine, range_g);
+  constexpr int n = 64;
+  for (int k = 0; k < n; ++k) {
+    const double theta = 2 * kPi * k / n;
+    Vec3 shifted = a;
+    for (int i = 0; i < 3; ++i) shifted[i] += sine.amplitude_g[i] * std::sin(theta + sine.phase_rad[i]);
+    const Eq3Terms g = random_rectification(c, shifted, random, range_g);
+    for (int j = 0; j < kNumTerms; ++j) t.g[j] += g.g[j] / n;
+  }
+  return t;
+}
+
 double sine_rectification_as_printed(const plant::Coefficients& c, const Vec3& a_g,
                                      const vibration::SineVibration& v) {
   const double a = a_g[IA];

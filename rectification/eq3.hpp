@@ -42,6 +42,14 @@ Eq3Terms random_rectification(const plant::Coefficients& c, const Vec3& a_g,
                               const vibration::RandomVibration& v,
                               std::optional<double> range_limit_g = std::nullopt);
 
+// Sine on Gaussian random (independent): E[f(a + S + G)] - f(a) =
+// <random_rectification at a + S(theta)>_theta + sine_rectification at a, the average over
+// the sine's phase by a 64-point trapezoid rule (exact for the polynomial terms; the
+// Gaussian-smoothed |.| and clipping converge spectrally).
+Eq3Terms sine_on_random_rectification(const plant::Coefficients& c, const Vec3& a_g,
+                                      const vibration::SineVibration& sine, const vibration::RandomVibration& random,
+                                      std::optional<double> range_limit_g = std::nullopt);
+
 // Eq. (3) literally as printed in the paper (in-phase amplitudes, asin without the factor
 // a, no k_PP/k_OO), for showing what the printed form returns. g.
 double sine_rectification_as_printed(const plant::Coefficients& c, const Vec3& a_g,

@@ -28,6 +28,7 @@
 #include <string>
 
 #include "plant/accelerometer.hpp"
+#include "vibration/excitation.hpp"
 #include "vibration/profile.hpp"
 
 namespace vrelab::rectification {
@@ -51,7 +52,7 @@ struct ShakeSettings {
   bool IsValid(std::string* error) const;
 };
 
-struct SineShakeResult {
+struct ShakeResult {
   double measured_g = 0;
   double sigma_g = 0;
   // The paper's method: least-squares slope of the running integral of (U/K1 - baseline).
@@ -68,12 +69,28 @@ struct SineShakeResult {
   long steps = 0, rhs_evaluations = 0;
 };
 
+using SineShakeResult = ShakeResult;
+
 // Called for every sample of the record (time s, dynamic input g, output in output units):
 // first the record at rest (t < 0), then the vibration (t >= 0).
 using SampleSink = std::function<void(double t_s, const Vec3& input_g, double output)>;
 
-SineShakeResult shake_sine(const plant::PlantConfig& plant, const Vec3& a_static_g,
-                           const vibration::SineVibration& v, const ShakeSettings& s = {},
-                           const SampleSink& sink = {});
+// `input`, when given, replaces the pure sine as the table's motion (shaker imperfections
+// on the commanded sine v: it must repeat with v's period); v still sets the periods, the
+// phasor start and the prediction.
+ShakeResult shake_sine(const plant::PlantConfig& plant, const Vec3& a_static_g, const vibration::SineVibration& v,
+                       const ShakeSettings& s = {}, const SampleSink& sink = {},
+                       const vibration::Excitation* input = nullptr);
+
+// Any excitation (random, sine-on-random, swept sine): the plant starts at rest in its
+// equilibrium, settles for ln(1/settle_decay) slowest time constants with the vibration on,
+// then the error is measured over `measure_s` seconds cut into `blocks` equal blocks. The
+// plant's own linearisation runs beside it on the same input, and the error is the mean of
+// the output minus that linear output: a finite record of random motion has a non-zero
+// mean and the loop delays it across the window edges, and neither is rectification (a
+// lab does the same, less exactly, with its reference accelerometer and long records).
+ShakeResult shake_excitation(const plant::PlantConfig& plant, const Vec3& a_static_g,
+                             const vibration::Excitation& input, double measure_s, const ShakeSettings& s = {},
+                             const SampleSink& sink = {});
 
 }  // namespace vrelab::rectification

@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "vibration/profile.hpp"
 #include "vibration/psd.hpp"
 
 namespace vrelab::vibration {
@@ -51,6 +52,11 @@ void validate(const RandomProfile& p);
 // Highest table frequency over the axes, Hz.
 double max_frequency_Hz(const RandomProfile& p);
 std::string describe(const RandomProfile& p);
+
+// The Gaussian description of a profile for the analytic prediction: rms per axis (the
+// spec's) and the correlation, 0 between independent axes and, for common phases,
+// rho_ij = integral sqrt(G_i G_j) df / (sigma_i sigma_j) (1 for proportional tables).
+RandomVibration gaussian_equivalent(const RandomProfile& p);
 
 struct SampledSignal {
   double sample_rate_Hz = 0.0;
