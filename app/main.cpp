@@ -1,6 +1,8 @@
 // vrelab: the command-line interface. A thin layer: options in, library calls, results out.
-// Exit codes: 0 success, 2 bad input (case file, options), 1 anything else.
+// Exit codes: 0 success, 2 bad input (case file, options, parameters the physics rejects,
+// solver failures), 1 anything else.
 #include <iostream>
+#include <stdexcept>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -80,6 +82,11 @@ int main(int argc, char** argv) {
     std::cerr << "vrelab: error: " << e.what() << "\n";
     return 2;
   } catch (const vrelab::plant::SolverError& e) {
+    std::cerr << "vrelab: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    // The library rejects parameters it cannot work with (e.g. an unstable loop design):
+    // input that passed the case reader's checks but not the physics.
     std::cerr << "vrelab: error: " << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {

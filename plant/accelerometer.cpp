@@ -90,7 +90,7 @@ Servo design_servo(const Dynamics& d) {
   const double phase_deg = std::arg(plant * pi) * 180 / kPi;  // in (-360, 0]
   double lead_deg = d.phase_margin_deg - 180 - (phase_deg > 0 ? phase_deg - 360 : phase_deg);
   if (lead_deg > 75)
-    throw std::invalid_argument("phase_margin_deg: the phase lead needed at the crossover (" + std::to_string(lead_deg) +
+    throw std::invalid_argument("the phase lead needed at the crossover (" + std::to_string(lead_deg) +
                                 " deg) exceeds what one lead network gives (75 deg)");
   double alpha = 1.0;
   if (lead_deg > 0) {

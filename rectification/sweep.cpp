@@ -55,6 +55,13 @@ void run_sweep(const plant::PlantConfig& plant, const ShakeSettings& settings, c
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < grid.size(); ++i)
     if (!std::binary_search(skip.begin(), skip.end(), i)) todo.push_back(i);
+  // Longest first, so that no long condition is left for the end (cost ~ simulated time x
+  // steps per second: settling ~0.05 s plus 4 periods, at ~max(f, 50 Hz) steps' worth).
+  auto cost = [&](std::size_t i) {
+    const double f = sweep_condition(grid, i).frequency_Hz;
+    return (0.05 + 5 / f) * std::max(f, 50.0);
+  };
+  std::stable_sort(todo.begin(), todo.end(), [&](std::size_t a, std::size_t b) { return cost(a) > cost(b); });
   std::atomic<std::size_t> next{0};
   std::mutex lock;
   SweepProgress progress;

@@ -50,5 +50,11 @@ expect 0 'least_squares' identify "$cases/ideal-static.toml" --json "$tmp/o/id.j
 [ -s "$tmp/o/id.json" ] || { echo "FAIL: no JSON written"; fail=$((fail + 1)); }
 expect 0 'total' predict "$cases/paper-predict.toml" --json "$tmp/o/p.json"
 expect 0 'vrelab 0' --version
+# A solver failure is reported with the call and the simulated time, exit 2.
+sed 's/^\[run\]/[shake]\nrelative_tolerance = 1e-30\n\n[run]/' "$cases/shake-sine.toml" >"$tmp/solver.toml"
+expect 2 'relative_tolerance|solver failure in .* at simulated time' shake "$tmp/solver.toml" --json "$tmp/o/solver.json"
+sed 's/^\[plant\]/[plant]\nphase_margin_deg = 85.0/' "$cases/shake-sine.toml" >"$tmp/design.toml"
+expect 2 'phase_margin_deg' shake "$tmp/design.toml"
+expect 0 'measured vibration error' shake "$cases/shake-sine.toml" --json "$tmp/o/shake.json"
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

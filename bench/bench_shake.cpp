@@ -1,0 +1,80 @@
+// Speed of the virtual shaker (issue: "Speed"), with Google Benchmark:
+//  - SineConditionLogSweep: one sine condition measured to the default tolerance (the
+//    measured error converges to ~1e-9 g or better), over a 100-point log sweep
+//    1 Hz - 5 kHz, default plant, k2 = 15 ug/g^2, 5 g along IA; counters: median and
+//    maximum milliseconds per condition;
+//  - RandomGevs20kHz: GEVS 20-2000 Hz along IA with the output sampled at 20 kHz, the
+//    shipped random-case tolerance (1e-4); counter: simulated seconds per wall second.
+// Run: build/vrelab_bench   (Release build; one core)
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "rectification/shake.hpp"
+#include "vibration/sampled.hpp"
+
+using namespace vrelab;
+
+namespace {
+
+plant::PlantConfig default_plant() {
+  plant::PlantConfig cfg;
+  cfg.coefficients[plant::K1] = 1.25;
+  cfg.coefficients[plant::k0] = 1.5e-3;
+  cfg.coefficients[plant::k2] = 1.5e-5;
+  return cfg;
+}
+
+void SineConditionLogSweep(benchmark::State& state) {
+  const plant::PlantConfig cfg = default_plant();
+  const Vec3 a(0.5, std::sqrt(0.75), 0);
+  std::vector<double> ms;
+  for (auto _ : state) {
+    ms.clear();
+    for (int i = 0; i < 100; ++i) {
+      vibration::SineVibration v;
+      v.amplitude_g = Vec3(5, 0, 0);
+      v.frequency_Hz = std::pow(10.0, std::log10(5000.0) * i / 99.0);
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto r = rectification::shake_sine(cfg, a, v);
+      benchmark::DoNotOptimize(r.measured_g);
+      ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+  }
+  std::sort(ms.begin(), ms.end());
+  state.counters["median_ms_per_condition"] = ms[ms.size() / 2];
+  state.counters["max_ms_per_condition"] = ms.back();
+}
+BENCHMARK(SineConditionLogSweep)->Iterations(3)->Unit(benchmark::kMillisecond);
+
+void RandomGevs20kHz(benchmark::State& state) {
+  const plant::PlantConfig cfg = default_plant();
+  vibration::RandomProfile p;
+  vibration::PsdTable t;
+  t.rows = {vibration::PsdRow::level(20, 0.026), vibration::PsdRow::level(50, 0.16),
+            vibration::PsdRow::level(800, 0.16), vibration::PsdRow::level(2000, 0.026)};
+  p.psd[IA] = t;
+  const vibration::RandomExcitation ex(p, 16000, 1);
+  rectification::ShakeSettings s;
+  s.relative_tolerance = 1e-4;
+  s.readout.sample_rate_Hz = 20000;
+  s.blocks = 16;
+  const double measure_s = 4.0;
+  double simulated = 0, wall = 0;
+  for (auto _ : state) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto r = rectification::shake_excitation(cfg, Vec3(0.5, std::sqrt(0.75), 0), ex, measure_s, s);
+    benchmark::DoNotOptimize(r.measured_g);
+    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    simulated += measure_s + r.settle_s;
+  }
+  state.counters["simulated_s_per_wall_s"] = simulated / wall;
+}
+BENCHMARK(RandomGevs20kHz)->Iterations(3)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
