@@ -14,6 +14,8 @@
 
 #include <toml++/toml.h>
 
+#include "plant/physical.hpp"
+
 namespace vrelab::app {
 namespace {
 
@@ -505,11 +507,70 @@ const std::map<std::string, EffectReader>& effect_readers() {
   return readers;
 }
 
+void read_effects(Table& t, Case& c) {
+  if (auto eff = t.subtable("effects", false)) {
+    std::vector<std::string_view> names;
+    for (const auto& [name, reader] : effect_readers()) names.push_back(name);
+    for (auto&& [k, v] : eff->raw()) {
+      const auto it = effect_readers().find(std::string(k.str()));
+      if (it == effect_readers().end()) eff->check_unknown(names);
+      auto sub = eff->subtable(k.str(), true);
+      try {
+        c.plant.effects.push_back(it->second(*sub));
+      } catch (const std::invalid_argument& e) {
+        eff->fail(&v, k.str(), e.what());
+      }
+    }
+  }
+}
+
+// type = "physical": SI parameters (plant/physical.hpp); the model (1) coefficients follow.
+void read_physical_plant(Table& t, Case& c) {
+  if (c.coefficients)
+    t.fail(t.raw().get("type"), "type",
+           "a physical plant implies its coefficients: remove the [coefficients] table (or use \"from_coefficients\")");
+  plant::PhysicalParameters p;
+  struct Key {
+    const char* name;
+    double* value;
+  };
+  const Key keys[] = {{"inertia_kg_m2", &p.inertia_kg_m2},
+                      {"damping_N_m_s_per_rad", &p.damping_N_m_s_per_rad},
+                      {"hinge_stiffness_N_m_per_rad", &p.hinge_stiffness_N_m_per_rad},
+                      {"pendulosity_kg_m", &p.pendulosity_kg_m},
+                      {"pickoff_V_per_rad", &p.pickoff_V_per_rad},
+                      {"servo_gain_A_per_V", &p.servo_gain_A_per_V},
+                      {"lead_zero_Hz", &p.lead_zero_Hz},
+                      {"lead_pole_Hz", &p.lead_pole_Hz},
+                      {"integrator_Hz", &p.integrator_Hz},
+                      {"torquer_N_m_per_A", &p.torquer_N_m_per_A},
+                      {"torquer_n2_per_A", &p.torquer_n2_per_A},
+                      {"torquer_n3_per_A2", &p.torquer_n3_per_A2},
+                      {"bias_torque_N_m", &p.bias_torque_N_m},
+                      {"load_ohm", &p.load_ohm},
+                      {"antialias_Hz", &p.antialias_Hz}};
+  std::vector<std::string_view> allowed{"type", "effects"};
+  for (const Key& k : keys) {
+    *k.value = t.opt_number(k.name).value_or(*k.value);
+    allowed.push_back(k.name);
+  }
+  std::string why;
+  if (!p.IsValid(&why)) t.fail(nullptr, why.substr(0, why.find(' ')), why);
+  c.plant = plant::plant_from_physical(p, c.g_m_per_s2);
+  read_effects(t, c);
+  t.check_unknown(allowed);
+  c.coefficients = plant::implied_coefficients(p, c.g_m_per_s2);
+  c.physical = p;
+  if (!c.output_unit_given) c.output_unit = "V";  // the load resistor's voltage
+}
+
 void read_plant(Table t, Case& c) {
   c.has_plant_table = true;
   const std::string type = t.string("type", "from_coefficients");
+  if (type == "physical") return read_physical_plant(t, c);
   if (type != "from_coefficients")
-    t.fail(t.raw().get("type"), "type", "only \"from_coefficients\" is available, got \"" + type + "\"");
+    t.fail(t.raw().get("type"), "type", "must be \"from_coefficients\" or \"physical\", got \"" + type + "\"");
+  if (!c.coefficients) t.fail(t.raw().get("type"), "type", "a [plant] is built from [coefficients], which is missing");
   plant::Dynamics& d = c.plant.dynamics;
   d.pendulum_frequency_Hz = t.opt_number("pendulum_frequency_Hz").value_or(d.pendulum_frequency_Hz);
   d.pendulum_damping_ratio = t.opt_number("pendulum_damping_ratio").value_or(d.pendulum_damping_ratio);
@@ -546,20 +607,8 @@ void read_plant(Table t, Case& c) {
       c.plant.location[*idx] = l;
     }
   }
-  if (auto eff = t.subtable("effects", false)) {
-    std::vector<std::string_view> names;
-    for (const auto& [name, reader] : effect_readers()) names.push_back(name);
-    for (auto&& [k, v] : eff->raw()) {
-      const auto it = effect_readers().find(std::string(k.str()));
-      if (it == effect_readers().end()) eff->check_unknown(names);
-      auto sub = eff->subtable(k.str(), true);
-      try {
-        c.plant.effects.push_back(it->second(*sub));
-      } catch (const std::invalid_argument& e) {
-        eff->fail(&v, k.str(), e.what());
-      }
-    }
-  }
+  read_effects(t, c);
+  c.plant.coefficients = *c.coefficients;
   t.check_unknown({"type", "pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g",
                    "loop_bandwidth_Hz", "phase_margin_deg", "integrator", "integrator_zero_ratio", "antialias_Hz",
                    "location", "effects"});
@@ -673,6 +722,7 @@ Case read_case(const std::string& path) {
   }
   if (auto t = top.subtable("instrument", false)) {
     c.instrument = t->string("name", c.instrument);
+    c.output_unit_given = t->has("output_unit");
     c.output_unit = t->string("output_unit", c.output_unit);
     t->check_unknown({"name", "output_unit"});
   }
@@ -694,11 +744,8 @@ Case read_case(const std::string& path) {
     c.seed = static_cast<std::uint64_t>(t->integer("seed", false, 1, 0, std::numeric_limits<std::int64_t>::max()));
     t->check_unknown({"seed"});
   }
-  if (auto t = top.subtable("plant", false)) {
-    if (!c.coefficients) t->fail(nullptr, "type", "a [plant] is built from [coefficients], which is missing");
-    read_plant(*t, c);
-  }
-  if (c.coefficients) c.plant.coefficients = *c.coefficients;
+  if (auto t = top.subtable("plant", false)) read_plant(*t, c);
+  else if (c.coefficients) c.plant.coefficients = *c.coefficients;
   if (auto t = top.subtable("readout", false)) read_readout(*t, c);
   if (auto t = top.subtable("shake", false)) read_shake(*t, c);
   c.shake.readout.seed = c.seed;

@@ -16,6 +16,7 @@
 
 #include "plant/accelerometer.hpp"
 #include "plant/model1.hpp"
+#include "plant/physical.hpp"
 #include "rectification/shake.hpp"
 #include "rectification/sweep.hpp"
 #include "validation/dividing_head.hpp"
@@ -64,6 +65,7 @@ struct Case {
   double g_m_per_s2 = 9.80665;
   std::string instrument = "accelerometer";
   std::string output_unit = "mA";
+  bool output_unit_given = false;
   std::optional<plant::Coefficients> coefficients;
   std::optional<Vec3> orientation_g;
   std::optional<VibrationSpec> vibration;
@@ -75,6 +77,7 @@ struct Case {
   // The ODE plant: [plant] (defaults when absent: from the coefficients, default dynamics).
   bool has_plant_table = false;
   plant::PlantConfig plant;
+  std::optional<plant::PhysicalParameters> physical;  // [plant] type = "physical"
   rectification::ShakeSettings shake;  // [shake] and [readout]
   std::optional<rectification::SweepGrid> sweep;  // [sweep]
   int sweep_threads = 0;                          // 0: all cores

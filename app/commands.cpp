@@ -327,15 +327,18 @@ void run_predict(const PredictOptions& o, std::ostream& out) {
 
 namespace {
 
-json plant_json(const plant::PlantConfig& p) {
+json plant_json(const plant::PlantConfig& p, bool physical) {
   const plant::Dynamics& d = p.dynamics;
-  const plant::Servo sv = plant::design_servo(d);
+  const plant::Servo sv = p.servo ? *p.servo : plant::design_servo(d);
   json loc = json::object();
   for (int i = 1; i < kNumCoefficients; ++i)
     loc[std::string(plant::coefficient_name(i))] = std::string(plant::location_name(p.location[i]));
   json effects = json::array();
   for (const auto& e : p.effects) effects.push_back(e->name());
-  return {{"type", "from_coefficients"},
+  return {{"type", physical ? "physical" : "from_coefficients"},
+          {"coefficients", coefficients_json(p.coefficients)},
+          {"torquer_c2_per_g", p.torquer_c2_per_g},
+          {"torquer_c3_per_g2", p.torquer_c3_per_g2},
           {"dynamics",
            {{"pendulum_frequency_Hz", d.pendulum_frequency_Hz},
             {"pendulum_damping_ratio", d.pendulum_damping_ratio},
@@ -452,10 +455,15 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
   const double predicted = predict_terms(c).total_g();
 
   out << header_line("shake", c, c.seed);
-  out << fmt::format("Plant: from coefficients, pendulum {:g} Hz, loop crossover {:g} Hz, phase margin {:g} deg{}{}\n",
-                     c.plant.dynamics.pendulum_frequency_Hz, c.plant.dynamics.loop_bandwidth_Hz,
-                     c.plant.dynamics.phase_margin_deg, c.plant.dynamics.integrator ? ", PI" : ", no integrator",
-                     c.plant.effects.empty() ? "" : ", effects:");
+  if (c.physical)
+    out << fmt::format("Plant: physical parameters, pendulum {:.4g} Hz, servo given{}{}\n",
+                       c.plant.dynamics.pendulum_frequency_Hz, c.plant.dynamics.integrator ? " (PI)" : " (no integrator)",
+                       c.plant.effects.empty() ? "" : ", effects:");
+  else
+    out << fmt::format("Plant: from coefficients, pendulum {:g} Hz, loop crossover {:g} Hz, phase margin {:g} deg{}{}\n",
+                       c.plant.dynamics.pendulum_frequency_Hz, c.plant.dynamics.loop_bandwidth_Hz,
+                       c.plant.dynamics.phase_margin_deg, c.plant.dynamics.integrator ? ", PI" : ", no integrator",
+                       c.plant.effects.empty() ? "" : ", effects:");
   for (const auto& e : c.plant.effects) out << "  " << e->name() << "\n";
   out << fmt::format("Static a = [{:g}, {:g}, {:g}] g; vibration: {}\n", a[0], a[1], a[2], motion->describe());
   out << "Shaker demand: " << demand.report() << "\n";
@@ -484,7 +492,7 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
   j["predicted_eq3_g"] = predicted;
   j["integral_slope_g"] = r.integral_slope_g;
   j["baseline_g"] = r.baseline_g;
-  j["plant"] = plant_json(c.plant);
+  j["plant"] = plant_json(c.plant, c.physical.has_value());
   j["vibration"] = vibration_json(vs);
   j["vibration"]["description"] = motion->describe();
   j["shaker_demand"] = {{"acceleration_rms_g", vec_json(demand.acceleration_rms_g)},

@@ -105,7 +105,13 @@ Servo design_servo(const Dynamics& d) {
 }
 
 Accelerometer::Accelerometer(PlantConfig config, const Vec3& a_static_g, Input input)
-    : config_(std::move(config)), a_static_(a_static_g), input_(std::move(input)), servo_(design_servo(config_.dynamics)) {
+    : config_(std::move(config)),
+      a_static_(a_static_g),
+      input_(std::move(input)),
+      servo_(config_.servo ? *config_.servo : design_servo(config_.dynamics)) {
+  if (!(servo_.gain_g_per_rad > 0) || !(servo_.lead_zero_rad_per_s > 0) || !(servo_.lead_pole_rad_per_s > 0) ||
+      !(servo_.integrator_rad_per_s >= 0))
+    throw std::invalid_argument("the servo needs a positive gain, lead zero and lead pole");
   if (!(config_.coefficients[K1] > 0)) throw std::invalid_argument("K1 must be positive");
   for (int c = 1; c < kNumCoefficients; ++c)
     if (!location_allowed(c, config_.location[c]))
@@ -184,7 +190,8 @@ void Accelerometer::rhs(double t, const double* x, double* dx) const {
   for (const auto& e : config_.effects) i = e->current(i);
 
   const double z = solve_z(i);
-  const double torque = has_in_ia_ ? z + f_ia(Location::input, z) : z;  // m_in(m_il^-1(i))
+  double torque = has_in_ia_ ? z + f_ia(Location::input, z) : z;  // m_in(m_il^-1(i))
+  torque += i * i * (config_.torquer_c2_per_g + config_.torquer_c3_per_g2 * i);
   const Dynamics& d = config_.dynamics;
   const double wp = 2 * kPi * d.pendulum_frequency_Hz;
   double drive = s1 - torque;

@@ -24,6 +24,7 @@
 #include <array>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,11 @@ struct PlantConfig {
   std::array<Location, kNumCoefficients> location = default_locations();
   Dynamics dynamics;
   std::vector<std::shared_ptr<const Effect>> effects;
+  // A servo given explicitly (physical parameters) instead of designed from `dynamics`.
+  std::optional<Servo> servo;
+  // A torquer polynomial in g of rebalance, tau(i) += c2 i^2 + c3 i^3 (physical plants;
+  // the plant's static curve is then its inverse, not a finite model (1)).
+  double torquer_c2_per_g = 0.0, torquer_c3_per_g2 = 0.0;
   static std::array<Location, kNumCoefficients> default_locations();
 };
 

@@ -56,5 +56,10 @@ expect 2 'relative_tolerance|solver failure in .* at simulated time' shake "$tmp
 sed 's/^\[plant\]/[plant]\nphase_margin_deg = 85.0/' "$cases/shake-sine.toml" >"$tmp/design.toml"
 expect 2 'phase_margin_deg' shake "$tmp/design.toml"
 expect 0 'measured vibration error' shake "$cases/shake-sine.toml" --json "$tmp/o/shake.json"
+# A PSD table whose frequencies do not increase: the row is named.
+sed 's/^psd_IA = .*/psd_IA = [[20.0, 0.026], [800.0, 0.16], [50.0, 0.16], [2000.0, 0.026]]/' "$cases/shake-random-gevs.toml" >"$tmp/psd.toml"
+expect 2 'psd_IA: .*row 3' shake "$tmp/psd.toml" --json "$tmp/o/psd.json"
+[ -e "$tmp/o/psd.json" ] && { echo "FAIL: psd: partial output written"; fail=$((fail + 1)); }
+expect 0 'measured vibration error' shake "$cases/shake-physical.toml"
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

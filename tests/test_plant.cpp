@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include "plant/accelerometer.hpp"
+#include "plant/physical.hpp"
 #include "rectification/eq3.hpp"
 #include "rectification/shake.hpp"
 #include "support/random_coefficients.hpp"
@@ -152,4 +153,74 @@ TEST(PlantSolver, AnExceptionInTheRightHandSideIsCarriedAcross) {
   for (double x : plant.state_scale()) s.absolute_tolerance.push_back(1e-12 * x);
   OdeSolver ode(plant, 0.0, plant.equilibrium(), s);
   EXPECT_THROW(ode.advance(1.0), std::runtime_error);
+}
+
+TEST(PlantPhysical, StaticOutputIsTheInverseOfTheTorquerCurve) {
+  // The physical torquer tau(i) = i + c2 i^2 + c3 i^3 (in g) with a bias torque: at rest the
+  // output is tau^-1(a_IA + k0), found here by bisection (independent of the plant's code),
+  // and to third order it is model (1) with k2 = -c2, k3 = 2 c2^2 - c3, k4 = 5 c2 c3 - 5 c2^3.
+  PhysicalParameters p;
+  p.torquer_n2_per_A = 2.0;    // c2 = 2.5e-3 /g: large, to see the orders
+  p.torquer_n3_per_A2 = 800.0;  // c3 = 1.25e-3 /g^2
+  p.bias_torque_N_m = 5e-8;
+  const double g = 9.81;
+  const PlantConfig cfg = plant_from_physical(p, g);
+  const double c2 = cfg.torquer_c2_per_g, c3 = cfg.torquer_c3_per_g2, k0_in = cfg.coefficients[k0];
+  EXPECT_NEAR(c2, 2.0 * 5e-6 * g / 0.0392, 1e-15);
+  for (double a_ia : {-1.0, -0.6, 0.0, 0.3, 1.0}) {
+    const Vec3 a(a_ia, std::sqrt(1 - a_ia * a_ia), 0);
+    double lo = -3, hi = 3;
+    for (int it = 0; it < 200; ++it) {
+      const double m = 0.5 * (lo + hi);
+      (m + c2 * m * m + c3 * m * m * m < a_ia + k0_in ? lo : hi) = m;
+    }
+    const double exact = 0.5 * (lo + hi);
+    EXPECT_NEAR(settled_output_g(cfg, a), exact, 1e-9 * std::max(std::abs(exact), 1e-3)) << a_ia;
+    // Series inversion to fourth order against the exact inverse.
+    const Coefficients k = implied_coefficients(p, g);
+    Coefficients no_bias = k;
+    no_bias[k0] = 0;
+    if (p.bias_torque_N_m == 0 || a_ia == 0) continue;
+    const double s = a_ia;  // without the bias, tau^-1(a) vs model (1)
+    double lo2 = -3, hi2 = 3;
+    for (int it = 0; it < 200; ++it) {
+      const double m = 0.5 * (lo2 + hi2);
+      (m + c2 * m * m + c3 * m * m * m < s ? lo2 : hi2) = m;
+    }
+    // The remainder is led by the fifth-order term of the series reversion,
+    // (14 c2^4 - 21 c2^2 c3 + 3 c3^2) s^5 (~4.7e-6 at |s| = 1 here): bound it by 1.2 times that.
+    const double c5 = 14 * c2 * c2 * c2 * c2 - 21 * c2 * c2 * c3 + 3 * c3 * c3;
+    EXPECT_NEAR(output_g(no_bias, Vec3(s, 0, 0)), 0.5 * (lo2 + hi2), 1.2 * std::abs(c5 * std::pow(s, 5)) + 1e-12);
+  }
+}
+
+TEST(PlantPhysical, MatchesTheFromCoefficientsPlantWithTheSameServoNearTheCrossover) {
+  // Physical parameters chosen to reproduce the default designed servo exactly; a torquer
+  // c2 then rectifies as a loop-located k2 = -c2 does, compared at 300 Hz where the loop
+  // shapes the result. The torquers differ by 2 c2^2 i^3 (+ O(c2^3)), which rectifies like
+  // k3 = 2 c2^2: relative to the k2 term, 6 c2 a_IA = 4.4e-5 here; allowed: twice that.
+  PlantConfig ref;
+  ref.coefficients[K1] = 1.25;
+  const Servo sv = design_servo(ref.dynamics);
+  PhysicalParameters p;
+  const double g = 9.81, amps_per_g = p.pendulosity_kg_m * g / p.torquer_N_m_per_A;
+  p.servo_gain_A_per_V = sv.gain_g_per_rad * amps_per_g / p.pickoff_V_per_rad;
+  p.lead_zero_Hz = sv.lead_zero_rad_per_s / (2 * kPi);
+  p.lead_pole_Hz = sv.lead_pole_rad_per_s / (2 * kPi);
+  p.integrator_Hz = sv.integrator_rad_per_s / (2 * kPi);
+  const double wp = 2 * kPi * ref.dynamics.pendulum_frequency_Hz;
+  p.inertia_kg_m2 = p.pendulosity_kg_m * g / ref.dynamics.angle_gain_rad_per_s2_per_g;
+  p.hinge_stiffness_N_m_per_rad = p.inertia_kg_m2 * wp * wp;
+  p.damping_N_m_s_per_rad = 2 * ref.dynamics.pendulum_damping_ratio * std::sqrt(p.hinge_stiffness_N_m_per_rad * p.inertia_kg_m2);
+  p.torquer_n2_per_A = 1.2e-2;
+  const PlantConfig phys = plant_from_physical(p, g);
+  ref.coefficients[k2] = -phys.torquer_c2_per_g;
+  vibration::SineVibration v;
+  v.amplitude_g = Vec3(5, 0, 0);
+  v.frequency_Hz = 300;
+  const Vec3 a(0.5, std::sqrt(0.75), 0);
+  const double e_phys = rectification::shake_sine(phys, a, v).measured_g;
+  const double e_ref = rectification::shake_sine(ref, a, v).measured_g;
+  EXPECT_NEAR(e_phys / e_ref, 1.0, 2 * 6 * phys.torquer_c2_per_g * 0.5) << e_phys << " vs " << e_ref;
+  EXPECT_GT(std::abs(e_phys / (ref.coefficients[k2] * 25 / 2) - 1), 0.1);  // the loop matters at 300 Hz
 }
