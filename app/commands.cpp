@@ -652,9 +652,14 @@ int run_sweep(const SweepOptions& o, std::ostream& out) {
   // The fingerprint ties a results file to the case and the program: a resumed sweep must
   // not mix rows of different settings.
   const std::string fingerprint = fmt::format("{:016x}", fnv1a(c.content.dump() + kProgramVersion));
-  const std::string header = fmt::format("# vrelab {} ({}) sweep {}\n# fingerprint {} conditions {} seed {}\n{}\n",
-                                         kProgramVersion, kGitDescribe, c.path, fingerprint, grid.size(), c.seed,
-                                         kSweepColumns);
+  const auto& ro = c.shake.readout;
+  const std::string header = fmt::format(
+      "# vrelab {} ({}) sweep {}\n# fingerprint {} conditions {} seed {}\n"
+      "# settings: CVODE BDF, relative_tolerance {:g}, settle_decay {:g}, blocks {}, min_measure_s {:g}, "
+      "readout sample_rate_Hz {:g} noise_sigma_g {:g} quantisation_lsb_g {:g}; units: g, Hz, s\n{}\n",
+      kProgramVersion, kGitDescribe, c.path, fingerprint, grid.size(), c.seed, c.shake.relative_tolerance,
+      c.shake.settle_decay, c.shake.blocks, c.shake.min_measure_s, ro.sample_rate_Hz, ro.noise_sigma_g,
+      ro.quantisation_lsb_g, kSweepColumns);
   std::map<std::size_t, std::string> rows;  // index -> line
   const fs::path path(o.out_path);
   if (path.has_parent_path()) fs::create_directories(path.parent_path());

@@ -284,12 +284,19 @@ TEST(CliSweep, ResumesAfterAnInterruptionWithIdenticalRowsAndRefusesAnotherCase)
   std::ostringstream text;
   EXPECT_EQ(run_sweep(o, text), 0);
   const std::string full = read_file(o.out_path);
-  // Interrupt: keep the header and the first 5 rows, the 6th cut mid-line.
+  // Interrupt: keep the header lines and the first 5 rows, the 6th cut mid-line.
   std::istringstream lines(full);
   std::string line, cut;
-  for (int k = 0; k < 3 + 5 && std::getline(lines, line); ++k) cut += line + "\n";
-  std::getline(lines, line);
-  cut += line.substr(0, line.size() / 2);
+  int data_rows = 0;
+  while (std::getline(lines, line)) {
+    const bool header = line.empty() || line[0] == '#' || line.rfind("index,", 0) == 0;
+    if (!header && data_rows == 5) {
+      cut += line.substr(0, line.size() / 2);
+      break;
+    }
+    cut += line + "\n";
+    if (!header) ++data_rows;
+  }
   std::ofstream(o.out_path) << cut;
   std::ostringstream resumed;
   EXPECT_EQ(run_sweep(o, resumed), 0);
