@@ -270,6 +270,7 @@ void read_random_part(Table& t, VibrationSpec& v, bool psd_required) {
 
 void read_vibration(Table t, Case& c) {
   VibrationSpec v;
+  v.line = t.line(&t.raw());
   v.type = t.string("type", "");
   if (v.type == "sine") {
     v.sine = read_sine_part(t, false);
@@ -590,11 +591,11 @@ void read_plant(Table t, Case& c) {
   if (auto loc = t.subtable("location", false)) {
     for (auto&& [k, v] : loc->raw()) {
       const auto idx = plant::coefficient_from_name(k.str());
-      if (!idx || *idx == plant::K1) {
+      if (idx && *idx == plant::K1) loc->fail(&v, k.str(), "K1 has no place to act (it is the scale factor)");
+      if (!idx) {
         std::vector<std::string_view> names;
         for (int i = 1; i < plant::kNumCoefficients; ++i) names.push_back(plant::coefficient_name(i));
         loc->check_unknown(names);
-        loc->fail(&v, k.str(), "K1 has no place to act");
       }
       const std::string where = loc->string(k.str(), "");
       const plant::Location l = where == "input" ? plant::Location::input
@@ -630,7 +631,7 @@ void read_shake(Table t, Case& c) {
   s.blocks = static_cast<int>(t.integer("blocks", false, s.blocks, 2, 1000));
   s.min_measure_s = t.non_negative("min_measure_s", s.min_measure_s);
   std::string why;
-  if (!s.IsValid(&why)) t.fail(nullptr, "shake", why);
+  if (!s.IsValid(&why)) t.fail(t.raw().get(why.substr(0, why.find(' '))), why.substr(0, why.find(' ')), why);
   t.check_unknown({"relative_tolerance", "settle_decay", "blocks", "min_measure_s"});
 }
 

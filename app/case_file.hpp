@@ -48,6 +48,7 @@ struct VibrationSpec {
   std::optional<vibration::RandomProfile> psd;         // PSD tables: needed to shake random profiles
   std::optional<vibration::SweptSine> swept;
   double duration_s = 10.0;  // measuring time of a non-periodic run
+  int line = 0;              // of the [vibration] table, for messages
 };
 
 // The [shaker] table: limits and imperfections, each off unless given.

@@ -19,6 +19,7 @@
 #include "app/case_file.hpp"
 #include "app/output.hpp"
 #include "rectification/eq3.hpp"
+#include "rectification/frequency.hpp"
 #include "rectification/series.hpp"
 #include "vibration/sampled.hpp"
 #include "validation/static_test.hpp"
@@ -232,6 +233,8 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
 
 namespace {
 
+json plant_json(const plant::PlantConfig& p, bool physical);
+
 // Eq. (3) corrected for the case's vibration (quasi-static; frequency-independent).
 rectification::Eq3Terms predict_terms(const Case& c) {
   const VibrationSpec& v = *c.vibration;
@@ -308,6 +311,28 @@ void run_predict(const PredictOptions& o, std::ostream& out) {
     out << fmt::format("Eq. (3) as printed in the paper gives {:.6f} ug (differs by {:.6f} ug)\n", *printed * 1e6,
                        (*printed - total) * 1e6);
 
+  std::optional<rectification::FrequencyPrediction> fp;
+  if (o.frequency_dependent) {
+    if (vs.type != "sine")
+      throw InputError(c.path + ": [vibration] type: --frequency-dependent takes a \"sine\" vibration");
+    if (!(vs.sine.frequency_Hz > 0))
+      throw InputError(c.path + ": [vibration] frequency_Hz: --frequency-dependent needs a positive frequency");
+    fp = rectification::sine_rectification_at_frequency(c.plant, a, vs.sine, c.range_limit_g);
+    out << fmt::format("At {:g} Hz through the plant's dynamics ({}): current amplitude |I| = {:.6g} g per {:g} g on IA, "
+                       "pendulum angle |Theta| = {:.4g} rad\n",
+                       vs.sine.frequency_Hz, c.physical ? "physical parameters" : "from coefficients",
+                       std::abs(fp->current_amplitude_g), vs.sine.amplitude_g[IA], std::abs(fp->angle_amplitude_rad));
+    out << fmt::format("  {:<20}{:>14}{:>16}\n", "term", "quasi-static", "at frequency");
+    for (int t = 0; t < rectification::kNumTerms; ++t) {
+      if (t == rectification::t_clipping && !c.range_limit_g) continue;
+      out << fmt::format("  {:<20}{:>11.6f} ug{:>13.6f} ug\n", rectification::term_name(t), terms.g[t] * 1e6,
+                         fp->terms.g[t] * 1e6);
+    }
+    out << fmt::format("  {:<20}{:>14}{:>13.6f} ug\n", "pickoff_nonlinearity", "-", fp->pickoff_g * 1e6);
+    out << fmt::format("  {:<20}{:>14}{:>13.6f} ug\n", "pendulum_geometry", "-", fp->pendulum_geometry_g * 1e6);
+    out << fmt::format("  {:<20}{:>11.6f} ug{:>13.6f} ug\n", "total", terms.total_g() * 1e6, fp->total_g() * 1e6);
+  }
+
   if (o.json_path.empty()) return;
   json j;
   j["program"] = program_record();
@@ -321,6 +346,21 @@ void run_predict(const PredictOptions& o, std::ostream& out) {
   j["terms"] = tj;
   j["omitted_by_paper_g"] = terms.omitted_by_paper_g();
   j["paper_printed_total_g"] = printed ? json(*printed) : json(nullptr);
+  if (fp) {
+    json ft = json::object();
+    for (int t = 0; t < rectification::kNumTerms; ++t) {
+      if (t == rectification::t_clipping && !c.range_limit_g) continue;
+      ft[std::string(rectification::term_name(t))] = fp->terms.g[t];
+    }
+    ft["pickoff_nonlinearity"] = fp->pickoff_g;
+    ft["pendulum_geometry"] = fp->pendulum_geometry_g;
+    j["frequency_dependent"] = {{"frequency_Hz", vs.sine.frequency_Hz},
+                                {"total_g", fp->total_g()},
+                                {"terms", ft},
+                                {"current_amplitude_g", std::abs(fp->current_amplitude_g)},
+                                {"angle_amplitude_rad", std::abs(fp->angle_amplitude_rad)},
+                                {"plant", plant_json(c.plant, c.physical.has_value())}};
+  }
   j["units"] = {{"total_g", "g"}, {"terms", "g"}};
   write_atomic(o.json_path, j.dump(2) + "\n");
 }
@@ -374,12 +414,11 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
   double top_Hz = 0;
   const bool periodic = vs.type == "sine";
   try {
-    if (vs.type == "random" && !vs.psd)
-      throw InputError(c.path + ": [vibration] a shaken random profile needs PSD tables psd_IA / psd_PA / psd_OA");
+    const std::string where = fmt::format("{}:{}: [vibration]", c.path, vs.line);
     if ((vs.type == "random" || vs.type == "sine_on_random") && !vs.psd)
-      throw InputError(c.path + ": [vibration] sine_on_random needs PSD tables psd_IA / psd_PA / psd_OA to be shaken");
+      throw InputError(where + " rms_g: a shaken " + vs.type + " profile needs PSD tables psd_IA / psd_PA / psd_OA");
     if (periodic && !(vs.sine.frequency_Hz > 0))
-      throw InputError(c.path + ": [vibration] frequency_Hz: a shaker run needs a positive frequency");
+      throw InputError(where + " frequency_Hz: a shaker run needs a positive frequency");
     std::shared_ptr<const vibration::ToneExcitation> tone;
     if (vs.type == "sine" || vs.type == "sine_on_random") tone = std::make_shared<vibration::SineExcitation>(vs.sine);
     if (vs.swept) tone = std::make_shared<vibration::SweptSineExcitation>(*vs.swept);
@@ -448,9 +487,17 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
     };
   }
   const auto start = std::chrono::steady_clock::now();
-  const rectification::ShakeResult r =
-      periodic ? rectification::shake_sine(c.plant, a, vs.sine, c.shake, sink, c.shaker.imperfect() ? motion.get() : nullptr)
-               : rectification::shake_excitation(c.plant, a, *motion, vs.duration_s, c.shake, sink);
+  rectification::ShakeResult r;
+  try {
+    r = periodic ? rectification::shake_sine(c.plant, a, vs.sine, c.shake, sink, c.shaker.imperfect() ? motion.get() : nullptr)
+                 : rectification::shake_excitation(c.plant, a, *motion, vs.duration_s, c.shake, sink);
+  } catch (...) {
+    if (series.is_open()) {
+      series.close();
+      std::filesystem::remove(series_tmp);  // no partial record
+    }
+    throw;
+  }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const double predicted = predict_terms(c).total_g();
 
@@ -566,7 +613,22 @@ void run_measure(const MeasureOptions& o, std::ostream& out) {
           if (header[i] == o.column) column = static_cast<int>(i);
         if (column < 1) throw InputError(fmt::format("{}:{}: no column named '{}'", path, line_no, o.column));
       }
+      if (column == 0) throw InputError(fmt::format("{}:{}: the output column cannot be the time column", path, line_no));
       column_name = header[static_cast<std::size_t>(column)];
+      // A header names the columns: a first line of numbers means the header is missing.
+      bool all_numbers = true;
+      for (const auto& field : header) {
+        std::size_t used = 0;
+        try {
+          std::stod(field, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        all_numbers = all_numbers && used == field.size() && used > 0;
+      }
+      if (all_numbers)
+        throw InputError(fmt::format("{}:{}: expected a header line naming the columns (e.g. time_s,output), got numbers",
+                                     path, line_no));
       continue;
     }
     if (f.size() != header.size())
@@ -651,7 +713,7 @@ int run_sweep(const SweepOptions& o, std::ostream& out) {
   const rectification::SweepGrid& grid = *c.sweep;
   // The fingerprint ties a results file to the case and the program: a resumed sweep must
   // not mix rows of different settings.
-  const std::string fingerprint = fmt::format("{:016x}", fnv1a(c.content.dump() + kProgramVersion));
+  const std::string fingerprint = fmt::format("{:016x}", fnv1a(c.content.dump() + kProgramVersion + kGitDescribe));
   const auto& ro = c.shake.readout;
   const std::string header = fmt::format(
       "# vrelab {} ({}) sweep {}\n# fingerprint {} conditions {} seed {}\n"
@@ -671,10 +733,24 @@ int run_sweep(const SweepOptions& o, std::ostream& out) {
     // A run interrupted mid-write leaves an unterminated last line: drop it.
     if (!text.empty() && text.back() != '\n') text.erase(text.rfind('\n') + 1);
     std::istringstream lines(text);
+    long line_no = 0;
     while (std::getline(lines, line)) {
+      ++line_no;
       if (line.empty() || line[0] == '#' || line.rfind("index,", 0) == 0) continue;
-      if (std::count(line.begin(), line.end(), ',') != 14) continue;
-      rows[std::stoul(line.substr(0, line.find(',')))] = line + "\n";
+      const std::string index_field = line.substr(0, line.find(','));
+      std::size_t used = 0;
+      unsigned long index = 0;
+      try {
+        index = std::stoul(index_field, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != index_field.size() || used == 0 || std::count(line.begin(), line.end(), ',') != 14 ||
+          index >= grid.size())
+        throw InputError(fmt::format("{}:{}: not a row of this sweep (index '{}', {} conditions); use --restart to "
+                                     "discard the file",
+                                     o.out_path, line_no, index_field, grid.size()));
+      rows[index] = line + "\n";
     }
   }
   // Rewrite the kept rows (dropping any partial line), then append as conditions finish.
@@ -700,7 +776,7 @@ int run_sweep(const SweepOptions& o, std::ostream& out) {
   std::size_t last_decile = 0;
   const auto start = std::chrono::steady_clock::now();
   rectification::run_sweep(
-      c.plant, c.shake, grid, skip, used,
+      c.plant, *c.coefficients, c.shake, grid, skip, used,
       [&](const rectification::SweepRow& r) {
         if (!r.ok) {
           failures.push_back(fmt::format("condition {} ({:g} Hz, {:g} g): {}", r.condition.index, r.condition.frequency_Hz,

@@ -21,6 +21,7 @@ void run_identify(const IdentifyOptions& o, std::ostream& out);
 struct PredictOptions {
   std::string case_path;
   std::string json_path;
+  bool frequency_dependent = false;  // through the plant's dynamics at [vibration] frequency_Hz
 };
 void run_predict(const PredictOptions& o, std::ostream& out);
 

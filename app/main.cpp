@@ -31,6 +31,8 @@ int main(int argc, char** argv) {
   auto* predict = app.add_subcommand("predict", "Vibration error implied by model (1): eq. (3), corrected");
   predict->add_option("case", pr.case_path, "Case file (TOML)")->required();
   predict->add_option("--json", pr.json_path, "Write the result as JSON to this file");
+  predict->add_flag("--frequency-dependent", pr.frequency_dependent,
+                    "Also eq. (3) at [vibration] frequency_Hz through the plant's dynamics ([plant]; sine only)");
 
   ShakeOptions sh;
   auto* shake = app.add_subcommand("shake", "One run on the virtual shaker: measured vibration error vs eq. (3)");

@@ -101,6 +101,23 @@ Servo design_servo(const Dynamics& d) {
   s.lead_pole_rad_per_s = wc * std::sqrt(alpha);
   const C lead = (1.0 + jw / s.lead_zero_rad_per_s) / (1.0 + jw / s.lead_pole_rad_per_s);
   s.gain_g_per_rad = 1.0 / std::abs(plant * pi * lead);
+  // The open loop must cross 0 dB once, at the requested frequency: below the pendulum's
+  // resonance the loop can cross several times and the phase margin means nothing.
+  int crossings = 0;
+  double previous = 0;
+  for (int k = 0; k <= 3000; ++k) {
+    const C jx(0, wc * std::pow(10.0, -3.0 + 6.0 * k / 3000));
+    const C p_x = d.angle_gain_rad_per_s2_per_g / (jx * jx + 2 * d.pendulum_damping_ratio * wp * jx + wp * wp);
+    const C l = s.gain_g_per_rad * p_x * (1.0 + s.integrator_rad_per_s / jx) *
+                (1.0 + jx / s.lead_zero_rad_per_s) / (1.0 + jx / s.lead_pole_rad_per_s);
+    const double level = std::log(std::abs(l));
+    if (k > 0 && (level > 0) != (previous > 0)) ++crossings;
+    previous = level;
+  }
+  if (crossings != 1)
+    throw std::invalid_argument("loop_bandwidth_Hz: the designed loop crosses 0 dB " + std::to_string(crossings) +
+                                " times between 1e-3 and 1e3 times the requested crossover; put the crossover well above "
+                                "the pendulum frequency (" + std::to_string(d.pendulum_frequency_Hz) + " Hz)");
   return s;
 }
 
@@ -326,9 +343,14 @@ Accelerometer::Linear Accelerometer::linearise() const {
 }
 
 double Accelerometer::slowest_time_constant_s(const Linear& lin) const {
+  // Leave out the quadrature (its pole is 0 by construction) and every inert state, whose
+  // row and column of A are both zero (the PI integral without an integrator, the anti-alias
+  // filter when off, the masked axes of a mechanical mode): they are not part of the loop.
   std::vector<int> keep;
-  for (int k = 0; k < n_; ++k)
-    if (k != kQuadrature && ((k != kAA1 && k != kAA2) || config_.dynamics.antialias_Hz > 0)) keep.push_back(k);
+  for (int k = 0; k < n_; ++k) {
+    const bool inert = lin.A.row(k).cwiseAbs().maxCoeff() == 0 && lin.A.col(k).cwiseAbs().maxCoeff() == 0;
+    if (k != kQuadrature && !inert) keep.push_back(k);
+  }
   const Eigen::Index m = static_cast<Eigen::Index>(keep.size());
   Eigen::MatrixXd a(m, m);
   for (Eigen::Index i = 0; i < m; ++i)

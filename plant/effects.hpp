@@ -54,6 +54,7 @@ class PickoffNonlinearity final : public Effect {
   explicit PickoffNonlinearity(double p2_per_rad);
   std::string name() const override { return "pickoff_nonlinearity"; }
   double pickoff(double theta) const override { return theta + p2_ * theta * theta; }
+  double p2_per_rad() const { return p2_; }
 
  private:
   double p2_;

@@ -16,6 +16,8 @@ void SeriesWindows::validate() const {
     throw std::invalid_argument("vibration interval: shorter than one period of frequency_Hz");
   if (!(K1 > 0) || !finite(K1)) throw std::invalid_argument("K1 must be positive");
   if (blocks < 2) throw std::invalid_argument("blocks must be at least 2");
+  if (on_from_s < baseline_to_s && baseline_from_s < on_to_s)
+    throw std::invalid_argument("the vibration interval overlaps the baseline interval");
 }
 
 SeriesMeasurer::SeriesMeasurer(const SeriesWindows& w) : w_(w) {

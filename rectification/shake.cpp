@@ -140,6 +140,13 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
     r.method = "sampled record";
     const double wanted = ro.active() ? ro.sample_rate_Hz : 50 * v.frequency_Hz;
     const long per_period = std::max<long>(2, static_cast<long>(std::ceil(wanted / v.frequency_Hz - 1e-9)));
+    // Synchronous sampling folds the output's N-th harmonic (N samples per period) exactly
+    // onto DC: demand 10 samples per period (harmonics of (1) reach the 4th, k1' more)
+    // unless the anti-alias filter is on.
+    if (per_period < 10 && !(config.dynamics.antialias_Hz > 0))
+      throw std::invalid_argument("sample_rate_Hz: " + std::to_string(per_period) +
+                                  " samples per period alias the output's harmonics onto DC; use at least 10 per "
+                                  "period (" + std::to_string(10 * v.frequency_Hz) + " Hz) or an anti-alias filter");
     r.sample_rate_Hz = per_period * v.frequency_Hz;
     const double dt = 1 / r.sample_rate_Hz;
     std::mt19937_64 rng(ro.seed);

@@ -49,7 +49,8 @@ std::vector<double> spaced(double f1, double f2, int n, bool logarithmic) {
   return f;
 }
 
-void run_sweep(const plant::PlantConfig& plant, const ShakeSettings& settings, const SweepGrid& grid,
+void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth, const ShakeSettings& settings,
+               const SweepGrid& grid,
                const std::vector<std::size_t>& skip, int threads, const std::function<void(const SweepRow&)>& on_row,
                const std::function<void(const SweepProgress&)>& on_progress) {
   std::vector<std::size_t> todo;
@@ -79,7 +80,7 @@ void run_sweep(const plant::PlantConfig& plant, const ShakeSettings& settings, c
         row.sigma_g = r.sigma_g;
         row.settle_s = r.settle_s;
         row.steps = r.steps;
-        row.predicted_eq3_g = sine_rectification(plant.coefficients, row.condition.orientation_g, v).total_g();
+        row.predicted_eq3_g = sine_rectification(truth, row.condition.orientation_g, v).total_g();
         row.ok = true;
       } catch (const plant::SolverError& e) {
         row.error = e.what();

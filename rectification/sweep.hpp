@@ -58,7 +58,9 @@ struct SweepProgress {
 
 // Runs every condition not in `skip` (sorted indices). `on_row` and `on_progress` are called
 // under a lock, from the worker threads, as rows complete.
-void run_sweep(const plant::PlantConfig& plant, const ShakeSettings& settings, const SweepGrid& grid,
+// `truth`: the coefficients eq. (3) is evaluated with (for a physical plant, the implied ones).
+void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth, const ShakeSettings& settings,
+               const SweepGrid& grid,
                const std::vector<std::size_t>& skip, int threads,
                const std::function<void(const SweepRow&)>& on_row,
                const std::function<void(const SweepProgress&)>& on_progress = {});

@@ -240,6 +240,16 @@ TEST(CliMeasure, ReproducesShakeFromItsOwnRecordAndRejectsBadSeries) {
   rejects("0.0,1.0\n0.1,abc\n", R"(bad\.csv:3: not a number)");
   rejects(short_record, R"(too few samples.*shorter than the interval)");
   rejects("0.0,1.0\n0.1", R"(bad\.csv:3: 1 fields, the header has 2)");  // a truncated last line
+  {
+    const fs::path p = d.path / "noheader.csv";
+    std::ofstream(p) << "0.0,1.0\n0.1,1.0\n";
+    MeasureOptions b = mo;
+    b.series_path = p.string();
+    EXPECT_THROW(run_measure(b, text), InputError);  // numbers where the header should be
+    b = mo;
+    b.on_s = {-1.0, 1.0};  // overlaps the baseline
+    EXPECT_THROW(run_measure(b, text), InputError);
+  }
 }
 
 TEST(CliShake, WritesTheDocumentedJsonAndRejectsWhatTheShakerCannotDo) {
@@ -310,11 +320,49 @@ TEST(CliSweep, ResumesAfterAnInterruptionWithIdenticalRowsAndRefusesAnotherCase)
     return out;
   };
   EXPECT_EQ(rows_without_wall(read_file(o.out_path)), rows_without_wall(full));
+  // A malformed row: refused, naming the line.
+  {
+    std::string text_ = read_file(o.out_path);
+    std::ofstream(o.out_path) << text_ << "99,1,5,1,0,0,0.5,0.8,0,1e-5,1e-9,1e-5,1,10,0.1\n";
+    std::ostringstream out_;
+    try {
+      run_sweep(o, out_);
+      ADD_FAILURE() << "accepted a row outside the grid";
+    } catch (const InputError& e) {
+      EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(R"(sweep\.csv:\d+: not a row of this sweep)"))) << e.what();
+    }
+    std::ofstream(o.out_path) << text_;
+  }
   // Another case on the same file: refused, the file untouched.
   const fs::path other = edited_case(d, "sweep-frequency.toml", "amplitudes_g = \\[5.0\\]", "amplitudes_g = [2.0]");
   SweepOptions b = o;
   b.case_path = other.string();
   EXPECT_THROW(run_sweep(b, text), InputError);
+}
+
+TEST(CliSweep, PredictsFromTheImpliedCoefficientsOfAPhysicalPlant) {
+  TempDir d;
+  const fs::path c = edited_case(d, "shake-physical.toml", "\\[run\\]",
+                                 "[sweep]\nfrequencies_Hz = [5.0]\namplitudes_g = [5.0]\ndirections = [[1.0, 0.0, 0.0]]\n\n[run]");
+  SweepOptions o;
+  o.case_path = c.string();
+  o.out_path = (d.path / "sweep.csv").string();
+  o.progress = false;
+  std::ostringstream text;
+  EXPECT_EQ(run_sweep(o, text), 0);
+  ShakeOptions so;
+  so.case_path = c.string();
+  so.json_path = (d.path / "shake.json").string();
+  run_shake(so, text);
+  const double predicted = json::parse(read_file(so.json_path))["predicted_eq3_g"].get<double>();
+  EXPECT_LT(predicted, -1e-4);  // k2 = -c2 = -15 ug/g^2 at 5 g: -188 ug
+  const std::string csv = read_file(o.out_path);
+  const std::string row = csv.substr(csv.rfind('\n', csv.size() - 2) + 1);
+  std::vector<std::string> f;
+  std::stringstream ss(row);
+  for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
+  ASSERT_EQ(f.size(), 15u);
+  EXPECT_NEAR(std::stod(f[11]), predicted, 1e-12);
 }
 
 TEST(CliIdentify, ReadingsFromTheOdePlantIdentifyAsModel1Does) {

@@ -85,12 +85,25 @@ TEST(ShakeSampled, StatedSigmaMatchesTheScatterOverSeeds) {
 }
 
 TEST(ShakeSampled, QuantisationWithoutNoiseIsADeterministicBiasBelowOneStep) {
+  // An ADC step of 2 ug against an error of 30 ug: the measured value moves (quantisation
+  // without dither is a deterministic bias) but by less than one step.
   const Vec3 a(1, 0, 0);
   rectification::ShakeSettings s;
   s.readout.sample_rate_Hz = 5000;
-  s.readout.quantisation_lsb_g = 1e-4;
-  const auto r = rectification::shake_sine(k2_plant(), a, sine(50, 2), s);
-  EXPECT_LT(std::abs(r.measured_g - 3e-5), 1e-4);  // within one LSB of the clean value
+  const double clean = rectification::shake_sine(k2_plant(), a, sine(50, 2), s).measured_g;
+  s.readout.quantisation_lsb_g = 2e-6;
+  const double quantised = rectification::shake_sine(k2_plant(), a, sine(50, 2), s).measured_g;
+  EXPECT_NEAR(clean, 3e-5, 0.02 * 3e-5);  // k2 w^2/2 times |H_i(50 Hz)|^2 = 1.012
+  EXPECT_NE(quantised, clean);
+  EXPECT_LT(std::abs(quantised - clean), 2e-6);
+}
+
+TEST(ShakeSampled, TooFewSamplesPerPeriodAreRefused) {
+  // Synchronous sampling with N samples per period folds the N-th harmonic onto DC: a k3
+  // plant at 3 samples per period would read -1.5 mg instead of 0.
+  rectification::ShakeSettings s;
+  s.readout.sample_rate_Hz = 900;
+  EXPECT_THROW(rectification::shake_sine(k2_plant(), Vec3(1, 0, 0), sine(300, 5), s), std::invalid_argument);
 }
 
 TEST(ShakeSampled, SinkSeesEverySampleOfTheRecord) {

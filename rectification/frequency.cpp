@@ -1,0 +1,85 @@
+#include "rectification/frequency.hpp"
+
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+namespace vrelab::rectification {
+
+using plant::Accelerometer;
+using namespace plant;
+
+FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
+                                                    std::optional<double> range_g) {
+  vibration::validate(v);
+  if (!(v.frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+  // The linear plant: the same dynamics, K1 and the linear cross terms, no nonlinear part.
+  PlantConfig lin_cfg = config;
+  for (int c : {k1_asym, k2, k3, k4, k_IP, k_IO, k_PO, k_PP, k_OO}) lin_cfg.coefficients[c] = 0.0;
+  lin_cfg.torquer_c2_per_g = lin_cfg.torquer_c3_per_g2 = 0.0;
+  lin_cfg.effects.clear();
+  double p2 = 0.0;
+  bool geometry = false;
+  for (const auto& e : config.effects) {
+    if (const auto* p = dynamic_cast<const PickoffNonlinearity*>(e.get())) p2 += p->p2_per_rad();
+    if (dynamic_cast<const PendulumGeometry*>(e.get())) geometry = true;
+    if (dynamic_cast<const MechanicalMode*>(e.get())) lin_cfg.effects.push_back(e);  // linear: keep
+  }
+  const Accelerometer plant(lin_cfg, a);
+  const Accelerometer::Linear lin = plant.linearise();
+  const int n = plant.size();
+  const double w = 2 * std::numbers::pi * v.frequency_Hz;
+  const Eigen::MatrixXcd m = std::complex<double>(0, w) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
+  Eigen::Vector3cd W;
+  for (int i = 0; i < 3; ++i) W[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
+  const Eigen::VectorXcd x = m.fullPivLu().solve(lin.B.cast<std::complex<double>>() * W);
+  // The rebalance current of the linear plant: i = k G theta + (1 - k) q + w_i r, with
+  // k = lead pole / lead zero (plant/accelerometer.cpp, the servo's realisation).
+  const plant::Servo& sv = plant.servo();
+  const double lead_ratio = sv.lead_pole_rad_per_s / sv.lead_zero_rad_per_s;
+  const std::complex<double> current = lead_ratio * sv.gain_g_per_rad * x[Accelerometer::kTheta] +
+                                       (1 - lead_ratio) * x[Accelerometer::kLead] + sv.integrator_rad_per_s * x[Accelerometer::kIntegral];
+  // DC gain of the loop from a disturbance entering before it (an input term, a torque) to
+  // the current: exactly 1 with the integrator, L0 / (1 + L0) without (L0 = b G / w_p^2).
+  // Evaluated at 0.01 Hz: within O((f / f_c)^2) ~ 1e-9 of DC, and clear of the pivot
+  // threshold that the quadrature and inert states (zero poles) would hit at f = 0.
+  const Eigen::MatrixXcd m_dc = std::complex<double>(0, 2 * std::numbers::pi * 0.01) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
+  const Eigen::VectorXcd x_dc = m_dc.fullPivLu().solve(lin.B.col(IA).cast<std::complex<double>>());
+  const double dc_gain = std::abs(lead_ratio * sv.gain_g_per_rad * x_dc[Accelerometer::kTheta] +
+                                  (1 - lead_ratio) * x_dc[Accelerometer::kLead] +
+                                  sv.integrator_rad_per_s * x_dc[Accelerometer::kIntegral]);
+  FrequencyPrediction out;
+  out.current_amplitude_g = current;
+  out.angle_amplitude_rad = x[Accelerometer::kTheta];
+
+  // Terms of (1): each through the place where it acts.
+  const double amp_i = std::abs(current);
+  vibration::SineVibration through_loop = v;
+  through_loop.amplitude_g[IA] = amp_i;
+  for (int c = k0; c < kNumCoefficients; ++c) {
+    if (c == k0 || c == delta_OA || c == delta_PA || config.coefficients[c] == 0) continue;
+    Coefficients only;
+    only[K1] = 1;
+    only[c] = config.coefficients[c];
+    const bool ia_term = c <= k4;
+    const bool filtered = ia_term && config.location[c] != Location::input;
+    const Eq3Terms t = sine_rectification(only, a, filtered ? through_loop : v);
+    // What rectifies before the loop (input, torquer) reaches the output with the loop's DC gain.
+    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
+    for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
+  }
+  if (range_g) out.terms.g[t_clipping] = clipping_sine(a[IA], amp_i, *range_g);
+  // Effects beyond (1), from the averaged torque balance.
+  const Dynamics& d = config.dynamics;
+  const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+  const std::complex<double> theta = out.angle_amplitude_rad;
+  out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * std::norm(theta) / 2;
+  if (geometry)
+    out.pendulum_geometry_g = dc_gain * (-0.5 * std::real(W[PA] * std::conj(theta)) - a[IA] * std::norm(theta) / 4);
+  out.loop_dc_gain = dc_gain;
+  return out;
+}
+
+}  // namespace vrelab::rectification
