@@ -44,6 +44,81 @@ class WithLinearCompanion final : public plant::OdeSystem {
   int n_;
 };
 
+// Standard uncertainty of the mean of equal blocks: std(block means) / sqrt(blocks).
+double batch_sigma(const std::vector<double>& means, double mean) {
+  double ss = 0;
+  for (double b : means) ss += (b - mean) * (b - mean);
+  const double k = static_cast<double>(means.size());
+  return std::sqrt(ss / (k - 1) / k);
+}
+
+// The data acquisition of a run (Readout): the record at rest first (t < 0, the equilibrium
+// output), then the vibration record; noise and quantisation on every sample; block sums
+// for the batch means and least-squares sums of the running integral for the paper's slope.
+class SampledRecorder {
+ public:
+  SampledRecorder(const Readout& ro, double k1, double baseline_g, int blocks, long block_n, double dt,
+                  const SampleSink& sink)
+      : ro_(ro), k1_(k1), baseline_(baseline_g), block_n_(block_n), dt_(dt), sink_(sink), rng_(ro.seed),
+        rest_(static_cast<std::size_t>(blocks), 0.0), vib_(rest_) {
+    const long rest_n = blocks * block_n;
+    for (long m = 0; m < rest_n; ++m) {
+      const double u = acquire(baseline_g);
+      rest_[static_cast<std::size_t>(m / block_n)] += u / k1;
+      if (sink_) sink_(static_cast<double>(m - rest_n) * dt, Vec3::Zero(), u);
+    }
+    samples_ = rest_n;
+  }
+  // One sample of the vibration record at t; `measured_index` >= 0 counts the samples of the
+  // measuring interval (negative while settling); `linear_g` is taken off (the companion).
+  void sample(double t, const Vec3& input_g, double out_g, long measured_index, double linear_g = 0.0) {
+    const double u = acquire(out_g);
+    if (sink_) sink_(t, input_g, u);
+    ++samples_;
+    if (measured_index < 0) return;
+    const double x = u / k1_ - linear_g;
+    vib_[static_cast<std::size_t>(measured_index / block_n_)] += x;
+    integral_ += (x - baseline_) * dt_;
+    const double tm = static_cast<double>(measured_index + 1) * dt_;
+    st_ += tm, stt_ += tm * tm, si_ += integral_, sti_ += tm * integral_;
+    ++n_fit_;
+  }
+  void finish(ShakeResult& r) const {
+    std::vector<double> vib_mean, rest_mean;
+    double vib_total = 0, rest_total = 0;
+    const double blocks = static_cast<double>(vib_.size());
+    for (std::size_t b = 0; b < vib_.size(); ++b) {
+      vib_mean.push_back(vib_[b] / static_cast<double>(block_n_));
+      rest_mean.push_back(rest_[b] / static_cast<double>(block_n_));
+      vib_total += vib_mean.back() / blocks;
+      rest_total += rest_mean.back() / blocks;
+    }
+    r.measured_g = vib_total - rest_total;
+    const double n = static_cast<double>(n_fit_);
+    r.integral_slope_g = (n * sti_ - st_ * si_) / (n * stt_ - st_ * st_) - (rest_total - baseline_);
+    const double sv = batch_sigma(vib_mean, vib_total), sr = batch_sigma(rest_mean, rest_total);
+    r.sigma_g = std::sqrt(sv * sv + sr * sr);
+    r.samples = samples_;
+  }
+
+ private:
+  double acquire(double out_g) {
+    double u = k1_ * (out_g + (ro_.noise_sigma_g > 0 ? ro_.noise_sigma_g * normal_(rng_) : 0.0));
+    if (ro_.quantisation_lsb_g > 0) u = k1_ * ro_.quantisation_lsb_g * std::round(u / (k1_ * ro_.quantisation_lsb_g));
+    return u;
+  }
+  const Readout& ro_;
+  double k1_, baseline_;
+  long block_n_;
+  double dt_;
+  const SampleSink& sink_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  std::vector<double> rest_, vib_;
+  double integral_ = 0, st_ = 0, stt_ = 0, si_ = 0, sti_ = 0;
+  long n_fit_ = 0, samples_ = 0;
+};
+
 }  // namespace
 
 bool ShakeSettings::IsValid(std::string* error) const {
@@ -113,11 +188,6 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
   plant::OdeSolver ode(shaken, 0.0, x0, solver);
   const double block_s = per_block * period;
   const double k1 = config.coefficients[plant::K1];
-  auto batch_sigma = [&](const std::vector<double>& means, double mean) {
-    double ss = 0;
-    for (double b : means) ss += (b - mean) * (b - mean);
-    return std::sqrt(ss / (static_cast<double>(means.size()) - 1) / static_cast<double>(means.size()));
-  };
   const Readout& ro = s.readout;
   if (!ro.active() && !sink) {
     // Continuous integral: Q is a state of the ODE.
@@ -149,55 +219,14 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
                                   "period (" + std::to_string(10 * v.frequency_Hz) + " Hz) or an anti-alias filter");
     r.sample_rate_Hz = per_period * v.frequency_Hz;
     const double dt = 1 / r.sample_rate_Hz;
-    std::mt19937_64 rng(ro.seed);
-    std::normal_distribution<double> normal(0, 1);
-    auto acquire = [&](double out_g) {
-      double u = k1 * (out_g + (ro.noise_sigma_g > 0 ? ro.noise_sigma_g * normal(rng) : 0.0));
-      if (ro.quantisation_lsb_g > 0) u = k1 * ro.quantisation_lsb_g * std::round(u / (k1 * ro.quantisation_lsb_g));
-      return u;
-    };
     const long settle_n = settle_periods * per_period, block_n = per_block * per_period;
-    // The record at rest comes first (t < 0), as a lab records the baseline before switching
-    // the shaker on; the same readout on the equilibrium output.
-    std::vector<double> rest_sum(static_cast<std::size_t>(s.blocks), 0.0);
-    const long rest_n = s.blocks * block_n;
-    for (long m = 0; m < rest_n; ++m) {
-      const double u = acquire(r.baseline_g);
-      rest_sum[static_cast<std::size_t>(m / block_n)] += u / k1;
-      if (sink) sink(static_cast<double>(m - rest_n) * dt, Vec3::Zero(), u);
-    }
+    SampledRecorder rec(ro, k1, r.baseline_g, s.blocks, block_n, dt, sink);
     const long total_n = settle_n + s.blocks * block_n;
-    std::vector<double> block_sum(static_cast<std::size_t>(s.blocks), 0.0);
-    // Running integral of (U/K1 - baseline) for the paper's slope: sums for least squares.
-    double integral = 0, st = 0, stt = 0, si = 0, sti = 0;
-    long n_fit = 0;
     for (long k = 0; k < total_n; ++k) {
-      const double t = k * dt;
-      const std::vector<double>& x = ode.advance(t);
-      const double u = acquire(shaken.output_g(t, x.data()));
-      if (sink) sink(t, table_motion(t), u);
-      if (k < settle_n) continue;
-      const long m = k - settle_n;
-      block_sum[static_cast<std::size_t>(m / block_n)] += u / k1;
-      integral += (u / k1 - r.baseline_g) * dt;
-      const double tm = (m + 1) * dt;
-      st += tm, stt += tm * tm, si += integral, sti += tm * integral;
-      ++n_fit;
+      const double t = static_cast<double>(k) * dt;
+      rec.sample(t, table_motion(t), shaken.output_g(t, ode.advance(t).data()), k - settle_n);
     }
-    r.samples = total_n + rest_n;
-    std::vector<double> vib_mean, rest_mean;
-    double vib_total = 0, rest_total = 0;
-    for (int b = 0; b < s.blocks; ++b) {
-      vib_mean.push_back(block_sum[static_cast<std::size_t>(b)] / static_cast<double>(block_n));
-      rest_mean.push_back(rest_sum[static_cast<std::size_t>(b)] / static_cast<double>(block_n));
-      vib_total += vib_mean.back() / s.blocks;
-      rest_total += rest_mean.back() / s.blocks;
-    }
-    r.measured_g = vib_total - rest_total;
-    const double fn = static_cast<double>(n_fit);
-    r.integral_slope_g = (fn * sti - st * si) / (fn * stt - st * st) - (rest_total - r.baseline_g);
-    const double sv = batch_sigma(vib_mean, vib_total), sr = batch_sigma(rest_mean, rest_total);
-    r.sigma_g = std::sqrt(sv * sv + sr * sr);
+    rec.finish(r);
   }
   r.steps = ode.steps();
   r.rhs_evaluations = ode.rhs_evaluations();
@@ -243,11 +272,6 @@ ShakeResult shake_excitation(const plant::PlantConfig& config, const Vec3& a_sta
   plant::OdeSolver ode(system, 0.0, x0, solver);
   const double k1 = config.coefficients[plant::K1];
   const int zq = n + Accelerometer::kQuadrature;
-  auto batch_sigma = [](const std::vector<double>& means, double mean) {
-    double ss = 0;
-    for (double b : means) ss += (b - mean) * (b - mean);
-    return std::sqrt(ss / (static_cast<double>(means.size()) - 1) / static_cast<double>(means.size()));
-  };
   const Readout& ro = s.readout;
   if (!ro.active() && !sink) {
     r.method = "continuous integral";
@@ -271,51 +295,16 @@ ShakeResult shake_excitation(const plant::PlantConfig& config, const Vec3& a_sta
     r.method = "sampled record";
     r.sample_rate_Hz = ro.active() ? ro.sample_rate_Hz : 8 * f_top;
     const double dt = 1 / r.sample_rate_Hz;
-    std::mt19937_64 rng(ro.seed);
-    std::normal_distribution<double> normal(0, 1);
-    auto acquire = [&](double out_g) {
-      double u = k1 * (out_g + (ro.noise_sigma_g > 0 ? ro.noise_sigma_g * normal(rng) : 0.0));
-      if (ro.quantisation_lsb_g > 0) u = k1 * ro.quantisation_lsb_g * std::round(u / (k1 * ro.quantisation_lsb_g));
-      return u;
-    };
     const long block_n = std::max<long>(2, static_cast<long>(std::llround(measure_s * r.sample_rate_Hz / s.blocks)));
     const long settle_n = static_cast<long>(std::ceil(r.settle_s * r.sample_rate_Hz));
-    const long rest_n = s.blocks * block_n;
-    std::vector<double> rest_sum(static_cast<std::size_t>(s.blocks), 0.0), vib_sum(rest_sum);
-    for (long m = 0; m < rest_n; ++m) {
-      const double u = acquire(r.baseline_g);
-      rest_sum[static_cast<std::size_t>(m / block_n)] += u / k1;
-      if (sink) sink(static_cast<double>(m - rest_n) * dt, Vec3::Zero(), u);
-    }
-    double integral = 0, st = 0, stt = 0, si = 0, sti = 0;
-    const long total_n = settle_n + rest_n;
+    SampledRecorder rec(ro, k1, r.baseline_g, s.blocks, block_n, dt, sink);
+    const long total_n = settle_n + s.blocks * block_n;
     for (long k = 0; k < total_n; ++k) {
       const double t = static_cast<double>(k) * dt;
       const std::vector<double>& x = ode.advance(t);
-      const double u = acquire(shaken.output_g(t, x.data()));
-      if (sink) sink(t, input.acceleration_g(t), u);
-      if (k < settle_n) continue;
-      const long m = k - settle_n;
-      const double linear = system.linear_output(t, x.data());
-      vib_sum[static_cast<std::size_t>(m / block_n)] += u / k1 - linear;
-      integral += (u / k1 - linear - r.baseline_g) * dt;
-      const double tm = static_cast<double>(m + 1) * dt;
-      st += tm, stt += tm * tm, si += integral, sti += tm * integral;
+      rec.sample(t, input.acceleration_g(t), shaken.output_g(t, x.data()), k - settle_n, system.linear_output(t, x.data()));
     }
-    r.samples = total_n + rest_n;
-    std::vector<double> vib_mean, rest_mean;
-    double vib_total = 0, rest_total = 0;
-    for (int b = 0; b < s.blocks; ++b) {
-      vib_mean.push_back(vib_sum[static_cast<std::size_t>(b)] / static_cast<double>(block_n));
-      rest_mean.push_back(rest_sum[static_cast<std::size_t>(b)] / static_cast<double>(block_n));
-      vib_total += vib_mean.back() / s.blocks;
-      rest_total += rest_mean.back() / s.blocks;
-    }
-    r.measured_g = vib_total - rest_total;
-    const double fn = static_cast<double>(rest_n);
-    r.integral_slope_g = (fn * sti - st * si) / (fn * stt - st * st) - (rest_total - r.baseline_g);
-    const double sv = batch_sigma(vib_mean, vib_total), sr = batch_sigma(rest_mean, rest_total);
-    r.sigma_g = std::sqrt(sv * sv + sr * sr);
+    rec.finish(r);
   }
   r.periods = 0;
   r.steps = ode.steps();
