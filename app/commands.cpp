@@ -514,8 +514,10 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
   for (const auto& e : c.plant.effects) out << "  " << e->name() << "\n";
   out << fmt::format("Static a = [{:g}, {:g}, {:g}] g; vibration: {}\n", a[0], a[1], a[2], motion->describe());
   out << "Shaker demand: " << demand.report() << "\n";
-  out << fmt::format("Measurement: {}; settled {:.4g} s ({:.3g} slowest time constants), {} periods measured{}\n",
-                     r.method, r.settle_s, r.settle_s / r.slowest_time_constant_s, r.periods,
+  out << fmt::format("Measurement: {}; settled {:.4g} s ({:.3g} slowest time constants), {}{}\n", r.method, r.settle_s,
+                     r.settle_s / r.slowest_time_constant_s,
+                     periodic ? fmt::format("{} periods measured", r.periods)
+                              : fmt::format("{:g} s measured (linear companion subtracted)", vs.duration_s),
                      r.samples ? fmt::format(", {} samples at {:g} Hz", r.samples, r.sample_rate_Hz) : "");
   out << fmt::format("  measured vibration error   {:>14.6f} ug  +/- {:.3g} ug (1 sigma)\n", r.measured_g * 1e6, r.sigma_g * 1e6);
   out << fmt::format("  eq. (3) corrected, truth   {:>14.6f} ug\n", predicted * 1e6);
