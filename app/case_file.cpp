@@ -698,6 +698,25 @@ void read_sweep(Table t, Case& c) {
   c.sweep = g;
 }
 
+void read_frequency_study(Table t, Case& c) {
+  rectification::FrequencyStudySettings f;
+  const double from = t.opt_number("from_Hz").value_or(1.0), to = t.opt_number("to_Hz").value_or(5000.0);
+  if (!(from > 0) || !(to > from)) t.fail(t.raw().get("to_Hz"), "to_Hz", "need 0 < from_Hz < to_Hz");
+  const auto points = t.integer("points", false, 80, 2, 10000);
+  const auto ode_points = t.integer("ode_points", false, 10, 0, 1000);
+  f.frequencies_Hz = rectification::spaced(from, to, static_cast<int>(points), true);
+  if (ode_points > 0) f.ode_frequencies_Hz = rectification::spaced(from, to, static_cast<int>(ode_points), true);
+  f.amplitude_g = t.opt_number("amplitude_g").value_or(f.amplitude_g);
+  if (!(f.amplitude_g > 0)) t.fail(t.raw().get("amplitude_g"), "amplitude_g", "must be positive");
+  if (auto d = t.opt_vec3("direction")) {
+    if (!(d->norm() > 0)) t.fail(t.raw().get("direction"), "direction", "must not be zero");
+    f.direction = d->normalized();
+  }
+  f.pickoff_p2_per_rad = t.opt_number("pickoff_p2_per_rad").value_or(f.pickoff_p2_per_rad);
+  t.check_unknown({"from_Hz", "to_Hz", "points", "ode_points", "amplitude_g", "direction", "pickoff_p2_per_rad"});
+  c.frequency_study = f;
+}
+
 }  // namespace
 
 Case read_case(const std::string& path) {
@@ -752,8 +771,10 @@ Case read_case(const std::string& path) {
   c.shake.readout.seed = c.seed;
   if (auto t = top.subtable("sweep", false)) read_sweep(*t, c);
   if (auto t = top.subtable("shaker", false)) read_shaker(*t, c);
+  if (auto t = top.subtable("frequency_study", false)) read_frequency_study(*t, c);
   top.check_unknown({"g_m_per_s2", "instrument", "coefficients", "orientation", "vibration", "range",
-                     "dividing_head", "identification", "run", "plant", "readout", "shake", "sweep", "shaker"});
+                     "dividing_head", "identification", "run", "plant", "readout", "shake", "sweep", "shaker",
+                     "frequency_study"});
   return c;
 }
 

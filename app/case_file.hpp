@@ -18,6 +18,7 @@
 #include "plant/model1.hpp"
 #include "plant/physical.hpp"
 #include "rectification/shake.hpp"
+#include "rectification/frequency_study.hpp"
 #include "rectification/sweep.hpp"
 #include "validation/dividing_head.hpp"
 #include "validation/identification.hpp"
@@ -81,6 +82,7 @@ struct Case {
   std::optional<plant::PhysicalParameters> physical;  // [plant] type = "physical"
   rectification::ShakeSettings shake;  // [shake] and [readout]
   std::optional<rectification::SweepGrid> sweep;  // [sweep]
+  std::optional<rectification::FrequencyStudySettings> frequency_study;  // [frequency_study]
   int sweep_threads = 0;                          // 0: all cores
 };
 

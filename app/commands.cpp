@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
 #include <iostream>
 #include <iterator>
 #include <map>
@@ -813,6 +814,94 @@ int run_sweep(const SweepOptions& o, std::ostream& out) {
                      wall, rows.size(), failures.size(), o.out_path);
   for (const auto& f : failures) out << "  failed: " << f << "\n";
   return static_cast<int>(failures.size());
+}
+
+namespace {
+
+// The first Python with matplotlib on this machine, or "" (Debian's is /usr/bin/python3).
+std::string python_with_matplotlib() {
+  for (const char* py : {"/usr/bin/python3", "python3"}) {
+    const std::string cmd = std::string(py) + " -c 'import matplotlib' >/dev/null 2>&1";
+    if (std::system(cmd.c_str()) == 0) return py;
+  }
+  return "";
+}
+
+}  // namespace
+
+void run_frequency(const FrequencyOptions& o, std::ostream& out) {
+  const Case c = read_case(o.case_path);
+  require(c, c.coefficients.has_value(), "coefficients", "frequency");
+  require(c, c.orientation_g.has_value(), "orientation", "frequency");
+  const rectification::FrequencyStudySettings fs = c.frequency_study.value_or(rectification::FrequencyStudySettings{
+      rectification::spaced(1, 5000, 80, true), rectification::spaced(1, 5000, 10, true)});
+  const auto start = std::chrono::steady_clock::now();
+  const auto curves = rectification::frequency_study(c.plant, *c.orientation_g, fs);
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  std::string grid_csv = fmt::format("# vrelab {} ({}) frequency {}; units: Hz, g\nmechanism,frequency_Hz,predicted_g,eq3_g,ratio\n",
+                                     kProgramVersion, kGitDescribe, c.path);
+  std::string ode_csv = fmt::format("# vrelab {} ({}) frequency {}; units: Hz, g\nmechanism,frequency_Hz,measured_g,sigma_g\n",
+                                    kProgramVersion, kGitDescribe, c.path);
+  std::string md = "| mechanism | eq. (3), quasi-static (ug) | eq. (3) off by 1 % above (Hz) | off by 10 % above (Hz) | "
+                   "worst ODE vs prediction |\n| --- | --- | --- | --- | --- |\n";
+  json table = json::array();
+  auto freq = [](const std::optional<double>& f) { return f ? fmt::format("{:.3g}", *f) : std::string("-"); };
+  out << fmt::format("vrelab {} ({}) frequency {}\n", kProgramVersion, kGitDescribe, c.path);
+  out << fmt::format("Static a = [{:g}, {:g}, {:g}] g; {:g} g peak along [{:.3g}, {:.3g}, {:.3g}]; {} frequencies "
+                     "{:g}-{:g} Hz; ODE at {} of them\n",
+                     (*c.orientation_g)[0], (*c.orientation_g)[1], (*c.orientation_g)[2], fs.amplitude_g, fs.direction[0],
+                     fs.direction[1], fs.direction[2], fs.frequencies_Hz.size(), fs.frequencies_Hz.front(),
+                     fs.frequencies_Hz.back(), fs.ode_frequencies_Hz.size());
+  out << fmt::format("  {:<24}{:>14}{:>16}{:>16}{:>14}\n", "mechanism", "eq.(3) (ug)", "off 1% (Hz)", "off 10% (Hz)", "ODE vs pred");
+  for (const auto& m : curves) {
+    for (std::size_t i = 0; i < fs.frequencies_Hz.size(); ++i)
+      grid_csv += fmt::format("{},{:.8g},{:.10e},{:.10e},{}\n", m.name, fs.frequencies_Hz[i], m.predicted_g[i], m.eq3_g,
+                              m.eq3_g != 0 ? fmt::format("{:.8g}", m.predicted_g[i] / m.eq3_g) : std::string(""));
+    for (std::size_t i = 0; i < fs.ode_frequencies_Hz.size(); ++i)
+      ode_csv += fmt::format("{},{:.8g},{:.10e},{:.3e}\n", m.name, fs.ode_frequencies_Hz[i], m.ode_g[i], m.ode_sigma_g[i]);
+    const std::string eq3 = m.eq3_g != 0 ? fmt::format("{:.4f}", m.eq3_g * 1e6) : std::string("not in eq.(3)");
+    out << fmt::format("  {:<24}{:>14}{:>16}{:>16}{:>14.2e}\n", m.name, eq3, freq(m.off_1_percent_Hz),
+                       freq(m.off_10_percent_Hz), m.worst_ode_deviation);
+    md += fmt::format("| {} | {} | {} | {} | {:.2e} |\n", m.name, eq3, freq(m.off_1_percent_Hz), freq(m.off_10_percent_Hz),
+                      m.worst_ode_deviation);
+    table.push_back({{"mechanism", m.name},
+                     {"eq3_g", m.eq3_g},
+                     {"off_1_percent_Hz", m.off_1_percent_Hz ? json(*m.off_1_percent_Hz) : json(nullptr)},
+                     {"off_10_percent_Hz", m.off_10_percent_Hz ? json(*m.off_10_percent_Hz) : json(nullptr)},
+                     {"worst_ode_deviation", m.worst_ode_deviation}});
+  }
+  out << fmt::format("Off by 1 %/10 %: the lowest grid frequency where |e(f)/e_eq3 - 1| exceeds it ('-': nowhere "
+                     "on the grid). {:.3g} s wall.\n",
+                     wall);
+  json j;
+  j["program"] = program_record();
+  j["command"] = "frequency";
+  j["case"] = case_record(c);
+  j["plant"] = plant_json(c.plant, c.physical.has_value());
+  j["settings"] = {{"amplitude_g", fs.amplitude_g},
+                   {"direction", vec_json(fs.direction)},
+                   {"frequencies_Hz", fs.frequencies_Hz},
+                   {"ode_frequencies_Hz", fs.ode_frequencies_Hz},
+                   {"pickoff_p2_per_rad", fs.pickoff_p2_per_rad}};
+  j["table"] = table;
+  j["units"] = {{"eq3_g", "g"}, {"off_1_percent_Hz", "Hz"}};
+  const std::string dir = o.out_dir;
+  write_atomic(dir + "/frequency.csv", grid_csv);
+  write_atomic(dir + "/ode_points.csv", ode_csv);
+  write_atomic(dir + "/summary.md", md);
+  write_atomic(dir + "/summary.json", j.dump(2) + "\n");
+  const std::string py = python_with_matplotlib();
+  if (py.empty()) {
+    out << "Figures skipped: no Python with matplotlib found (install it: apt-get install python3-matplotlib). "
+           "The data are in " << dir << "\n";
+    return;
+  }
+  const std::string cmd = py + " '" + std::string(VRELAB_SOURCE_DIR) + "/app/plots/frequency.py' '" + dir + "'";
+  if (std::system(cmd.c_str()) != 0)
+    out << "The figure script failed (" << cmd << "); the data are in " << dir << "\n";
+  else
+    out << "Wrote " << dir << "/frequency.{csv,png,svg}, ode_points.csv, summary.{md,json}\n";
 }
 
 }  // namespace vrelab::app

@@ -54,4 +54,10 @@ struct SweepOptions {
 // Returns the number of conditions that failed (their rows are not written).
 int run_sweep(const SweepOptions& o, std::ostream& out);
 
+struct FrequencyOptions {
+  std::string case_path;
+  std::string out_dir;
+};
+void run_frequency(const FrequencyOptions& o, std::ostream& out);
+
 }  // namespace vrelab::app

@@ -65,6 +65,13 @@ int main(int argc, char** argv) {
   bool no_progress = false;
   sweep->add_flag("--no-progress", no_progress, "No progress bar");
 
+  FrequencyOptions fr;
+  auto* frequency = app.add_subcommand(
+      "frequency", "Vibration error against frequency per term and place: eq. (3) through the dynamics vs the ODE");
+  frequency->add_option("case", fr.case_path, "Case file (TOML): [coefficients], [orientation], [plant], [frequency_study]")
+      ->required();
+  frequency->add_option("--out", fr.out_dir, "Output folder (CSV, JSON, Markdown table, PNG/SVG figure)")->required();
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -76,6 +83,7 @@ int main(int argc, char** argv) {
     if (*predict) run_predict(pr, std::cout);
     if (*shake) run_shake(sh, std::cout);
     if (*measure) run_measure(me, std::cout);
+    if (*frequency) run_frequency(fr, std::cout);
     if (*sweep) {
       sw.progress = !no_progress;
       if (run_sweep(sw, std::cout) > 0) return 2;

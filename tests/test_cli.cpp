@@ -377,3 +377,33 @@ TEST(CliIdentify, ReadingsFromTheOdePlantIdentifyAsModel1Does) {
     EXPECT_NEAR(ode["estimates"]["least_squares"][name].get<double>(), v.get<double>(), 1e-10 * std::max(1.0, std::abs(v.get<double>())))
         << name;
 }
+
+TEST(CliFrequency, WritesTheStudyAndItsOdePointsAgreeWithThePrediction) {
+  TempDir d;
+  // A small grid: 12 frequencies 10 Hz - 2 kHz, the ODE at 4 of them, the shipped instrument.
+  const fs::path c = edited_case(d, "frequency.toml", "from_Hz = 1.0\nto_Hz = 5000.0\npoints = 80\node_points = 10",
+                                 "from_Hz = 10.0\nto_Hz = 2000.0\npoints = 12\node_points = 4");
+  FrequencyOptions o;
+  o.case_path = c.string();
+  o.out_dir = (d.path / "freq").string();
+  std::ostringstream text;
+  run_frequency(o, text);
+  const json j = json::parse(read_file(d.path / "freq" / "summary.json"));
+  ASSERT_GE(j["table"].size(), 20u);  // 9 terms at their places + 2 effects
+  for (const auto& row : j["table"]) {
+    // The bound: the frequency-dependent eq. (3) within 1 % of the ODE.
+    EXPECT_LT(row["worst_ode_deviation"].get<double>(), 0.01) << row["mechanism"];
+    const std::string m = row["mechanism"];
+    if (m.find("(input)") != std::string::npos) {
+      EXPECT_TRUE(row["off_1_percent_Hz"].is_null()) << m;  // frequency-independent
+    }
+    if (m == "k2 (loop)") {
+      // |H_i|^2 departs from 1 by 1 % somewhere between 10 and 200 Hz (the loop crosses at 500 Hz).
+      EXPECT_GT(row["off_1_percent_Hz"].get<double>(), 10.0);
+      EXPECT_LT(row["off_1_percent_Hz"].get<double>(), 200.0);
+    }
+  }
+  EXPECT_TRUE(fs::exists(d.path / "freq" / "frequency.csv"));
+  EXPECT_TRUE(fs::exists(d.path / "freq" / "ode_points.csv"));
+  EXPECT_TRUE(fs::exists(d.path / "freq" / "summary.md"));
+}
