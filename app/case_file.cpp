@@ -566,7 +566,6 @@ void read_physical_plant(Table& t, Case& c) {
 }
 
 void read_plant(Table t, Case& c) {
-  c.has_plant_table = true;
   const std::string type = t.string("type", "from_coefficients");
   if (type == "physical") return read_physical_plant(t, c);
   if (type != "from_coefficients")

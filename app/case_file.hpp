@@ -77,7 +77,6 @@ struct Case {
   validation::FixedSet fixed{};
   std::uint64_t seed = 1;
   // The ODE plant: [plant] (defaults when absent: from the coefficients, default dynamics).
-  bool has_plant_table = false;
   plant::PlantConfig plant;
   std::optional<plant::PhysicalParameters> physical;  // [plant] type = "physical"
   rectification::ShakeSettings shake;  // [shake] and [readout]

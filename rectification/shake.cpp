@@ -35,7 +35,6 @@ class WithLinearCompanion final : public plant::OdeSystem {
     const Eigen::Map<const Eigen::VectorXd> z(x + n_, n_);
     return lin_.A.row(Accelerometer::kQuadrature).dot(z) + lin_.B.row(Accelerometer::kQuadrature).dot(input_(t));
   }
-  int n() const { return n_; }
 
  private:
   const Accelerometer& plant_;

@@ -69,8 +69,6 @@ struct ShakeResult {
   long steps = 0, rhs_evaluations = 0;
 };
 
-using SineShakeResult = ShakeResult;
-
 // Called for every sample of the record (time s, dynamic input g, output in output units):
 // first the record at rest (t < 0), then the vibration (t >= 0).
 using SampleSink = std::function<void(double t_s, const Vec3& input_g, double output)>;
