@@ -1,5 +1,7 @@
 #include "vibration/decorators.hpp"
 
+#include "vibration/detail.hpp"
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -14,12 +16,7 @@ namespace {
 constexpr const char* kAxis[3] = {"IA", "PA", "OA"};
 constexpr double kTwoPi = 2 * std::numbers::pi;
 
-std::string num(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
+using detail::num;
 
 void check_axis(int axis, const char* field) {
   if (axis < 0 || axis > 2)

@@ -1,5 +1,7 @@
 #include "vibration/demand.hpp"
 
+#include "vibration/detail.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -11,12 +13,7 @@ namespace {
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
 
-std::string num(double x) {
-  std::ostringstream s;
-  s.precision(4);
-  s << x;
-  return s.str();
-}
+std::string num(double x) { return detail::num(x, 4); }
 
 double check_g(double g) {
   if (!std::isfinite(g) || g <= 0)

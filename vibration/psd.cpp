@@ -1,5 +1,7 @@
 #include "vibration/psd.hpp"
 
+#include "vibration/detail.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -9,12 +11,7 @@
 namespace vrelab::vibration {
 namespace {
 
-std::string num(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
+using detail::num;
 
 [[noreturn]] void row_error(std::size_t i, const PsdRow& r, const std::string& what) {
   throw std::invalid_argument("PSD table row " + std::to_string(i + 1) + " (frequency_Hz = " + num(r.frequency_Hz) +

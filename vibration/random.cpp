@@ -1,5 +1,7 @@
 #include "vibration/random.hpp"
 
+#include "vibration/detail.hpp"
+
 #include <fftw3.h>
 
 #include <climits>
@@ -66,12 +68,7 @@ Plan plan_r2c(int n, double* in, fftw_complex* out) {
   return Plan(p);
 }
 
-std::string num(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
+using detail::num;
 
 void check_rate(const RandomProfile& p, double fs) {
   if (!std::isfinite(fs) || fs <= 0)

@@ -1,5 +1,7 @@
 #include "vibration/sampled.hpp"
 
+#include "vibration/detail.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -15,12 +17,7 @@ namespace {
 constexpr std::int64_t kMargin = 48;
 constexpr double kPoles[2] = {-0.43057534709997379, -0.043096288203264653};
 
-std::string num(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
+using detail::num;
 
 // In place: samples -> quintic B-spline coefficients (Unser's causal/anticausal recursions).
 // Outside the buffer the input is taken as zero; callers give kMargin samples of real

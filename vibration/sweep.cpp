@@ -1,5 +1,7 @@
 #include "vibration/sweep.hpp"
 
+#include "vibration/detail.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -11,12 +13,7 @@ namespace {
 
 constexpr double kTwoPi = 2 * std::numbers::pi;
 
-std::string num(double x) {
-  std::ostringstream s;
-  s.precision(6);
-  s << x;
-  return s.str();
-}
+using detail::num;
 
 void check_positive(double v, const char* field) {
   if (!std::isfinite(v) || v <= 0)
