@@ -159,11 +159,7 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
 
   if (o.json_path.empty()) return;
   // ---- JSON
-  json j;
-  j["program"] = program_record();
-  j["command"] = "identify";
-  j["case"] = case_record(c);
-  j["seed"] = c.seed;
+  json j = result_record("identify", c);
   j["settings"] = {{"monte_carlo_trials", o.monte_carlo},
                    {"monte_carlo_seed", o.monte_carlo > 0 ? json(c.seed + 1) : json(nullptr)},
                    {"least_squares_weights", "1 / first-order variance of each reading"},
@@ -335,10 +331,7 @@ void run_predict(const PredictOptions& o, std::ostream& out) {
   }
 
   if (o.json_path.empty()) return;
-  json j;
-  j["program"] = program_record();
-  j["command"] = "predict";
-  j["case"] = case_record(c);
+  json j = result_record("predict", c);
   j["model"] = "eq3_corrected_quasi_static";
   j["orientation_g"] = vec_json(a);
   j["vibration"] = vib;
@@ -532,11 +525,7 @@ void run_shake(const ShakeOptions& o, std::ostream& out) {
     std::filesystem::rename(series_tmp, o.series_path);
   }
   if (o.json_path.empty()) return;
-  json j;
-  j["program"] = program_record();
-  j["command"] = "shake";
-  j["case"] = case_record(c);
-  j["seed"] = c.seed;
+  json j = result_record("shake", c);
   j["measured_g"] = r.measured_g;
   j["sigma_g"] = r.sigma_g;
   j["predicted_eq3_g"] = predicted;
@@ -874,10 +863,7 @@ void run_frequency(const FrequencyOptions& o, std::ostream& out) {
   out << fmt::format("Off by 1 %/10 %: the lowest grid frequency where |e(f)/e_eq3 - 1| exceeds it ('-': nowhere "
                      "on the grid). {:.3g} s wall.\n",
                      wall);
-  json j;
-  j["program"] = program_record();
-  j["command"] = "frequency";
-  j["case"] = case_record(c);
+  json j = result_record("frequency", c);
   j["plant"] = plant_json(c.plant, c.physical.has_value());
   j["settings"] = {{"amplitude_g", fs.amplitude_g},
                    {"direction", vec_json(fs.direction)},

@@ -41,4 +41,8 @@ nlohmann::json program_record() {
 
 nlohmann::json case_record(const Case& c) { return {{"file", c.path}, {"content", c.content}}; }
 
+nlohmann::json result_record(const std::string& command, const Case& c) {
+  return {{"program", program_record()}, {"command", command}, {"case", case_record(c)}, {"seed", c.seed}};
+}
+
 }  // namespace vrelab::app

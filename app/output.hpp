@@ -17,5 +17,7 @@ void write_atomic(const std::string& path, const std::string& text);
 nlohmann::json program_record();
 // {"file", "content"}: the case a result was made from.
 nlohmann::json case_record(const Case& c);
+// The head of every result from a case: {"program", "command", "case", "seed"}.
+nlohmann::json result_record(const std::string& command, const Case& c);
 
 }  // namespace vrelab::app
