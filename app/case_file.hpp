@@ -22,6 +22,7 @@
 #include "rectification/sweep.hpp"
 #include "validation/dividing_head.hpp"
 #include "validation/identification.hpp"
+#include "validation/reproduce.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/demand.hpp"
 #include "vibration/profile.hpp"
@@ -61,6 +62,18 @@ struct ShakerSpec {
   bool imperfect() const { return transverse || !harmonics.empty() || rocking; }
 };
 
+// The [reproduce] table: the shaker runs of `vrelab reproduce` (validation/reproduce.hpp).
+struct ReproduceSpec {
+  double frequency_Hz = 20.0;
+  std::vector<double> amplitudes_g;
+  std::vector<validation::NamedVector> directions, orientations;
+  std::size_t confirmation_orientation = 0, confirmation_direction = 0;  // indices
+  double confirmation_amplitude_g = 3.0, confirmation_record_s = 2.0;
+  std::vector<double> departure_frequencies_Hz;
+  double invisible_shift_per_g = 0.0;
+  int threads = 0;
+};
+
 struct Case {
   std::string path;
   nlohmann::json content;  // the file, as JSON
@@ -83,6 +96,7 @@ struct Case {
   std::optional<rectification::SweepGrid> sweep;  // [sweep]
   std::optional<rectification::FrequencyStudySettings> frequency_study;  // [frequency_study]
   int sweep_threads = 0;                          // 0: all cores
+  std::optional<ReproduceSpec> reproduce;         // [reproduce]
 };
 
 Case read_case(const std::string& path);

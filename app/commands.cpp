@@ -33,27 +33,11 @@ using nlohmann::json;
 using plant::kNumCoefficients;
 constexpr double kArcsec = std::numbers::pi / (180.0 * 3600.0);
 
-std::string unit_of(int i, const Case& c) {
-  const std::string u(plant::coefficient_info()[i].unit);
-  return u == "out/g" ? c.output_unit + "/g" : u;
-}
-
-json coefficients_json(const plant::Coefficients& k, const validation::CoefFlags* available = nullptr) {
-  json j = json::object();
-  for (int i = 0; i < kNumCoefficients; ++i) {
-    const std::string name(plant::coefficient_name(i));
-    j[name] = (available && !(*available)[i]) ? json(nullptr) : json(k[i]);
-  }
-  return j;
-}
-
 json array_json(const validation::CoefArray& a, const validation::CoefFlags& available) {
   plant::Coefficients k;
   k.v = a;
   return coefficients_json(k, &available);
 }
-
-json vec_json(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
 
 std::string cell(double x) { return fmt::format(" {:>10.3e}", x); }
 std::string text_cell(const std::string& s) { return fmt::format(" {:>10}", s); }
@@ -230,8 +214,6 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
 
 namespace {
 
-json plant_json(const plant::PlantConfig& p, bool physical);
-
 // Eq. (3) corrected for the case's vibration (quasi-static; frequency-independent).
 rectification::Eq3Terms predict_terms(const Case& c) {
   const VibrationSpec& v = *c.vibration;
@@ -359,39 +341,6 @@ void run_predict(const PredictOptions& o, std::ostream& out) {
   write_atomic(o.json_path, j.dump(2) + "\n");
 }
 
-namespace {
-
-json plant_json(const plant::PlantConfig& p, bool physical) {
-  const plant::Dynamics& d = p.dynamics;
-  const plant::Servo sv = p.servo ? *p.servo : plant::design_servo(d);
-  json loc = json::object();
-  for (int i = 1; i < kNumCoefficients; ++i)
-    loc[std::string(plant::coefficient_name(i))] = std::string(plant::location_name(p.location[i]));
-  json effects = json::array();
-  for (const auto& e : p.effects) effects.push_back(e->name());
-  return {{"type", physical ? "physical" : "from_coefficients"},
-          {"coefficients", coefficients_json(p.coefficients)},
-          {"torquer_c2_per_g", p.torquer_c2_per_g},
-          {"torquer_c3_per_g2", p.torquer_c3_per_g2},
-          {"dynamics",
-           {{"pendulum_frequency_Hz", d.pendulum_frequency_Hz},
-            {"pendulum_damping_ratio", d.pendulum_damping_ratio},
-            {"angle_gain_rad_per_s2_per_g", d.angle_gain_rad_per_s2_per_g},
-            {"loop_bandwidth_Hz", d.loop_bandwidth_Hz},
-            {"phase_margin_deg", d.phase_margin_deg},
-            {"integrator", d.integrator},
-            {"integrator_zero_ratio", d.integrator_zero_ratio},
-            {"antialias_Hz", d.antialias_Hz}}},
-          {"servo",
-           {{"gain_g_per_rad", sv.gain_g_per_rad},
-            {"lead_zero_Hz", sv.lead_zero_rad_per_s / (2 * std::numbers::pi)},
-            {"lead_pole_Hz", sv.lead_pole_rad_per_s / (2 * std::numbers::pi)},
-            {"integrator_Hz", sv.integrator_rad_per_s / (2 * std::numbers::pi)}}},
-          {"location", loc},
-          {"effects", effects}};
-}
-
-}  // namespace
 
 void run_shake(const ShakeOptions& o, std::ostream& out) {
   Case c = read_case(o.case_path);
@@ -805,19 +754,6 @@ int run_sweep(const SweepOptions& o, std::ostream& out) {
   return static_cast<int>(failures.size());
 }
 
-namespace {
-
-// The first Python with matplotlib on this machine, or "" (Debian's is /usr/bin/python3).
-std::string python_with_matplotlib() {
-  for (const char* py : {"/usr/bin/python3", "python3"}) {
-    const std::string cmd = std::string(py) + " -c 'import matplotlib' >/dev/null 2>&1";
-    if (std::system(cmd.c_str()) == 0) return py;
-  }
-  return "";
-}
-
-}  // namespace
-
 void run_frequency(const FrequencyOptions& o, std::ostream& out) {
   const Case c = read_case(o.case_path);
   require(c, c.coefficients.has_value(), "coefficients", "frequency");
@@ -877,15 +813,9 @@ void run_frequency(const FrequencyOptions& o, std::ostream& out) {
   write_atomic(dir + "/ode_points.csv", ode_csv);
   write_atomic(dir + "/summary.md", md);
   write_atomic(dir + "/summary.json", j.dump(2) + "\n");
-  const std::string py = python_with_matplotlib();
-  if (py.empty()) {
-    out << "Figures skipped: no Python with matplotlib found (install it: apt-get install python3-matplotlib). "
-           "The data are in " << dir << "\n";
-    return;
-  }
-  const std::string cmd = py + " '" + std::string(VRELAB_SOURCE_DIR) + "/app/plots/frequency.py' '" + dir + "'";
-  if (std::system(cmd.c_str()) != 0)
-    out << "The figure script failed (" << cmd << "); the data are in " << dir << "\n";
+  const std::string why = run_plot_script("frequency.py", dir);
+  if (!why.empty())
+    out << "Figures skipped: " << why << ". The data are in " << dir << "\n";
   else
     out << "Wrote " << dir << "/frequency.{csv,png,svg}, ode_points.csv, summary.{md,json}\n";
 }

@@ -60,4 +60,13 @@ struct FrequencyOptions {
 };
 void run_frequency(const FrequencyOptions& o, std::ostream& out);
 
+struct ReproduceOptions {
+  std::string case_path = "cases/paper.toml";
+  std::string out_dir = "out/paper";
+  int threads = -1;   // -1: the case's [reproduce] threads (0: all cores)
+  bool plots = true;  // false: data and report without figures
+};
+// The paper's experiment end to end: report.html, report.md, figures, CSV/JSON (app/reproduce.cpp).
+void run_reproduce(const ReproduceOptions& o, std::ostream& out);
+
 }  // namespace vrelab::app

@@ -72,6 +72,17 @@ int main(int argc, char** argv) {
       ->required();
   frequency->add_option("--out", fr.out_dir, "Output folder (CSV, JSON, Markdown table, PNG/SVG figure)")->required();
 
+  ReproduceOptions rp;
+  auto* reproduce = app.add_subcommand(
+      "reproduce", "The paper's experiment end to end: static test, confirmation plot, eq. (3) vs the shaker; report");
+  reproduce->add_option("case", rp.case_path, "Case file (TOML) with [dividing_head] and [reproduce]")
+      ->capture_default_str();
+  reproduce->add_option("--out", rp.out_dir, "Output folder (report.html, report.md, figures, CSV/JSON)")
+      ->capture_default_str();
+  reproduce->add_option("--threads", rp.threads, "Threads (default: the case's, 0 = all cores)");
+  bool no_plots = false;
+  reproduce->add_flag("--no-plots", no_plots, "Write the data and the report without figures");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -84,6 +95,10 @@ int main(int argc, char** argv) {
     if (*shake) run_shake(sh, std::cout);
     if (*measure) run_measure(me, std::cout);
     if (*frequency) run_frequency(fr, std::cout);
+    if (*reproduce) {
+      rp.plots = !no_plots;
+      run_reproduce(rp, std::cout);
+    }
     if (*sweep) {
       sw.progress = !no_progress;
       if (run_sweep(sw, std::cout) > 0) return 2;

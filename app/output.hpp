@@ -20,4 +20,15 @@ nlohmann::json case_record(const Case& c);
 // The head of every result from a case: {"program", "command", "case", "seed"}.
 nlohmann::json result_record(const std::string& command, const Case& c);
 
+// The JSON forms shared by the commands' results.
+std::string unit_of(int coefficient, const Case& c);  // "mA/g", "1/g", ...
+nlohmann::json coefficients_json(const plant::Coefficients& k, const validation::CoefFlags* available = nullptr);
+nlohmann::json vec_json(const Vec3& v);
+nlohmann::json plant_json(const plant::PlantConfig& p, bool physical);
+
+// Runs app/plots/<script> on `dir` with the first Python that has matplotlib (Debian's
+// /usr/bin/python3 first). Returns "" when the figures were drawn, else why not (the data
+// stay in `dir`).
+std::string run_plot_script(const std::string& script, const std::string& dir);
+
 }  // namespace vrelab::app

@@ -75,7 +75,9 @@ void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth
       const auto t0 = std::chrono::steady_clock::now();
       try {
         const vibration::SineVibration v = row.condition.vibration();
-        const ShakeResult r = shake_sine(plant, row.condition.orientation_g, v, settings);
+        ShakeSettings own = settings;  // independent readout noise per condition
+        own.readout.seed = settings.readout.seed + row.condition.index;
+        const ShakeResult r = shake_sine(plant, row.condition.orientation_g, v, own);
         row.measured_g = r.measured_g;
         row.sigma_g = r.sigma_g;
         row.settle_s = r.settle_s;

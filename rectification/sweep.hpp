@@ -7,7 +7,8 @@
 // Gives: one SweepRow per condition (measured error, sigma, eq. (3) prediction), computed
 //        on `threads` threads; conditions listed in `skip` (already on disk) are not run.
 //        A solver failure in one condition is recorded in its row (ok = false, message
-//        naming the call and the simulated time); the others go on.
+//        naming the call and the simulated time); the others go on. With a readout, the
+//        noise of condition i is drawn from seed readout.seed + i (independent runs).
 #include <atomic>
 #include <cstdint>
 #include <functional>

@@ -16,7 +16,9 @@ Propagation propagate_first_order(const Estimator& estimator, const std::vector<
   double scale = 0;
   for (const Reading& r : readings) scale = std::max(scale, std::abs(r.output));
   const double h = 1e-6 * (scale > 0 ? scale : 1.0);
-  CoefArray var{}, bias{};
+  CoefArray bias{};
+  std::array<CoefArray, plant::kNumCoefficients> cov{};
+  CoefArray j{};
   std::vector<Reading> work = readings;
   for (std::size_t i = 0; i < readings.size(); ++i) {
     work[i].output = readings[i].output + h;
@@ -25,16 +27,18 @@ Propagation propagate_first_order(const Estimator& estimator, const std::vector<
     const Estimate down = estimator(work);
     work[i].output = readings[i].output;
     for (int k = 0; k < plant::kNumCoefficients; ++k) {
-      const double j = (up.value[k] - down.value[k]) / (2 * h);
-      var[k] += j * j * budget.variance[i];
-      bias[k] += j * budget.bias[i];
+      j[k] = (up.value[k] - down.value[k]) / (2 * h);
+      bias[k] += j[k] * budget.bias[i];
     }
+    for (int k = 0; k < plant::kNumCoefficients; ++k)
+      for (int l = 0; l < plant::kNumCoefficients; ++l) cov[k][l] += j[k] * j[l] * budget.variance[i];
   }
   Propagation p;
   for (int k = 0; k < plant::kNumCoefficients; ++k) {
-    p.sigma[k] = std::sqrt(var[k]);
+    p.sigma[k] = std::sqrt(cov[k][k]);
     p.bias[k] = bias[k];
   }
+  p.covariance = cov;
   return p;
 }
 

@@ -24,6 +24,9 @@ using Estimator = std::function<Estimate(const std::vector<Reading>&)>;
 struct Propagation {
   CoefArray sigma{};  // standard uncertainty, coefficient units
   CoefArray bias{};   // first-order effect of the initial orientation error
+  // Covariance of the estimates (coefficient units squared), from the same Jacobian: what a
+  // prediction that combines several coefficients (eq. (3)) needs.
+  std::array<CoefArray, plant::kNumCoefficients> covariance{};
 };
 
 Propagation propagate_first_order(const Estimator& estimator, const std::vector<Reading>& readings,
