@@ -28,8 +28,8 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release ${VRELAB_CMAKE_ARGS:-}
 cmake --build build -j"$(nproc)"
 
 if [ "$run_main" -eq 1 ]; then
-  # The main job. Until the paper reproduction exists it is the paper's static test
-  # and identification; results in out/identify.json.
-  echo "== Main job: build/vrelab identify cases/paper-static.toml --json out/identify.json --monte-carlo 1000"
-  build/vrelab identify cases/paper-static.toml --json out/identify.json --monte-carlo 1000
+  # The main job: the paper's experiment reproduced on the shipped default case; the
+  # report and its data in out/paper (report.html, report.md, figures, CSV/JSON).
+  echo "== Main job: build/vrelab reproduce cases/paper.toml --out out/paper"
+  build/vrelab reproduce cases/paper.toml --out out/paper
 fi

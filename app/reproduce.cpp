@@ -23,6 +23,14 @@ using plant::kNumCoefficients;
 using validation::RunResult;
 constexpr double kArcsec = std::numbers::pi / (180.0 * 3600.0);
 
+// A CSV field: quoted when it holds a comma, a quote or a line break (RFC 4180).
+std::string csv_field(const std::string& x) {
+  if (x.find_first_of(",\"\n") == std::string::npos) return x;
+  std::string o = "\"";
+  for (char ch : x) o += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+  return o + "\"";
+}
+
 std::string ug(double g, int decimals = 2) { return fmt::format("{:.{}f}", g * 1e6, decimals); }
 std::string sci(double x) { return fmt::format("{:.3e}", x); }
 std::string vec_text(const Vec3& v) { return fmt::format("[{:.3g}, {:.3g}, {:.3g}]", v[0], v[1], v[2]); }
@@ -165,16 +173,11 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
 
   // ---- 2. the confirmation run
   const validation::ConfirmationRecord& cf = res.confirmation;
-  std::string conf_csv = comment + "; t in s, output in " + c.output_unit + ", deviation in g, integral in g*s\n" +
-                         "t_s,output,deviation_g,integral_g_s\n";
-  {
-    double integral = 0;
-    for (std::size_t i = 0; i < cf.t_s.size(); ++i) {
-      const double dev = cf.output[i] / cf.K1 - cf.rest_mean_g;
-      if (i > 0) integral += dev * (cf.t_s[i] - cf.t_s[i - 1]);
-      conf_csv += fmt::format("{:.8g},{:.10g},{:.6e},{:.6e}\n", cf.t_s[i], cf.output[i], dev, integral);
-    }
-  }
+  std::string conf_csv = comment + "; t in s, output in " + c.output_unit + ", deviation in g, integrals in g*s\n" +
+                         "t_s,output,deviation_g,integral_g_s,integral_without_oscillation_g_s\n";
+  for (std::size_t i = 0; i < cf.t_s.size(); ++i)
+    conf_csv += fmt::format("{:.8g},{:.10g},{:.6e},{:.6e},{:.6e}\n", cf.t_s[i], cf.output[i],
+                            cf.output[i] / cf.K1 - cf.rest_mean_g, cf.integral_g_s[i], cf.integral_without_oscillation_g_s[i]);
   const Vec3 conf_dir = s.confirmation_direction.v.normalized();
   const json conf_json = {{"output_unit", c.output_unit},
                           {"K1", K1},
@@ -190,7 +193,9 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
                           {"noise_sigma_g", c.shake.readout.noise_sigma_g},
                           {"measured_g", cf.shake.measured_g},
                           {"sigma_g", cf.shake.sigma_g},
-                          {"integral_slope_g", cf.shake.integral_slope_g},
+                          {"integral_slope_g", cf.integral_slope_g},
+                          {"integral_slope_straight_line_g", cf.shake.integral_slope_g},
+                          {"oscillation_amplitude_g_s", cf.oscillation_amplitude_g_s},
                           {"predicted_g", cf.predicted.value_g},
                           {"sigma_predicted_g", cf.predicted.sigma_g}};
 
@@ -201,7 +206,7 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
   auto run_row = [](const RunResult& r) {
     return fmt::format("{},{},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8e},{:.4e},{:.8e},{:.4e},{:.8e},{:.8e},"
                        "{:.4e},{:.4e},{:.4f}\n",
-                       r.orientation, r.direction, r.orientation_g[0], r.orientation_g[1], r.orientation_g[2],
+                       csv_field(r.orientation), csv_field(r.direction), r.orientation_g[0], r.orientation_g[1], r.orientation_g[2],
                        r.direction_unit[0], r.direction_unit[1], r.direction_unit[2], r.frequency_Hz, r.amplitude_g,
                        r.measured_g, r.sigma_measured_g, r.predicted.value_g, r.predicted.sigma_g, r.printed_g,
                        r.at_frequency.value_g, r.residual_g(), r.combined_sigma_g(), r.z());
@@ -220,7 +225,7 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
         const vibration::SineVibration v{r.amplitude_g * r.direction_unit, Vec3::Zero(), s.frequency_Hz};
         const auto qs = [&](const plant::Coefficients& k3) { return rectification::sine_rectification(k3, ori.v, v).total_g(); };
         const validation::Prediction p = validation::predict_with_uncertainty(qs, res.identified, res.identified_uncertainty.covariance);
-        curves_csv += fmt::format("{},{},{:.6g},{:.8e},{:.4e},{:.8e}\n", ori.name, d.name, r.amplitude_g, p.value_g, p.sigma_g,
+        curves_csv += fmt::format("{},{},{:.6g},{:.8e},{:.4e},{:.8e}\n", csv_field(ori.name), csv_field(d.name), r.amplitude_g, p.value_g, p.sigma_g,
                                   rectification::sine_rectification_as_printed(res.identified, ori.v, v));
       }
   const Agreement amp = agreement(res.amplitude_runs);
@@ -300,7 +305,7 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
   std::string inv_csv = comment + "; units: g\ndirection,amplitude_g,measured_g,sigma_measured_g,predicted_g,sigma_predicted_g,"
                                   "expected_residual_g,residual_g\n";
   for (const auto& r : inv.runs)
-    inv_csv += fmt::format("{},{:.6g},{:.8e},{:.4e},{:.8e},{:.4e},{:.8e},{:.8e}\n", r.direction, r.amplitude_g, r.measured_g,
+    inv_csv += fmt::format("{},{:.6g},{:.8e},{:.4e},{:.8e},{:.4e},{:.8e},{:.8e}\n", csv_field(r.direction), r.amplitude_g, r.measured_g,
                            r.sigma_measured_g, r.predicted.value_g, r.predicted.sigma_g,
                            -inv.c_per_g * r.amplitude_g * r.amplitude_g / 2, r.residual_g());
 
@@ -446,14 +451,17 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
       "{:g} g peak at {:g} Hz along {} ({}), static orientation {} = {} g, sampled at {:g} Hz with {:g} ug rms noise per "
       "sample; {:.3g} s at rest (t < 0), then the vibration: {:.3g} s of settling, {:.3g} s measured. The raw output swings +-{:.3g} {} and its noise is {:g} ug per "
       "sample, so the vibration error of {} ug cannot be seen in it. The running integral of the output minus its mean at "
-      "rest is flat at rest and a straight line under vibration: its least-squares slope over the measuring interval is {} ug, "
-      "the whole-period mean is {} +- {} ug, and eq. (3) from the identified coefficients predicts {} +- {} ug: a difference "
-      "of {} ug ({:.2f} combined sigma, {:.2f} % of the prediction).",
+      "rest is flat at rest and, under vibration, a straight line plus the vibration's own swing of +-{:.3g} mg*s. Fitted "
+      "over the measured interval with that swing (a line plus three harmonics), its slope is {} ug; a straight line alone "
+      "gives {} ug, biased by the swing. The whole-period mean of the output is {} +- {} ug, and eq. (3) from the "
+      "identified coefficients predicts {} +- {} ug: a difference of {} ug ({:.2f} combined sigma, {:.2f} % of the "
+      "prediction). The figure shows the integral with the fitted swing taken off.",
       s.confirmation_amplitude_g, s.frequency_Hz, s.confirmation_direction.name, vec_text(conf_dir),
       s.confirmation_orientation.name, vec_text(s.confirmation_orientation.v), cf.shake.sample_rate_Hz,
       c.shake.readout.noise_sigma_g * 1e6, cf.t_s.empty() ? 0.0 : -cf.t_s.front(), cf.t_measure_start_s,
       cf.t_end_s - cf.t_measure_start_s, K1 * s.confirmation_amplitude_g, c.output_unit,
-      c.shake.readout.noise_sigma_g * 1e6, ug(cf.shake.measured_g, 1), ug(cf.shake.integral_slope_g),
+      c.shake.readout.noise_sigma_g * 1e6, ug(cf.shake.measured_g, 1), cf.oscillation_amplitude_g_s * 1e3,
+      ug(cf.integral_slope_g), ug(cf.shake.integral_slope_g),
       ug(cf.shake.measured_g), ug(cf.shake.sigma_g), ug(cf.predicted.value_g), ug(cf.predicted.sigma_g), ug(conf_diff),
       conf_diff / conf_comb, 100 * conf_diff / cf.predicted.value_g));
   rep.figure("fig2_confirmation",
@@ -558,7 +566,7 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
   out << fmt::format("Static test: {} readings; least-squares k2 = {} (truth {}), sigma {}\n", res.static_test.readings.size(),
                      sci(ls.estimate.value[plant::k2]), sci(truth[plant::k2]), sci(ls.first_order.sigma[plant::k2]));
   out << fmt::format("Confirmation: measured {} +- {} ug, integral slope {} ug, eq. (3) {} +- {} ug ({:.2f} sigma)\n",
-                     ug(cf.shake.measured_g), ug(cf.shake.sigma_g), ug(cf.shake.integral_slope_g), ug(cf.predicted.value_g),
+                     ug(cf.shake.measured_g), ug(cf.shake.sigma_g), ug(cf.integral_slope_g), ug(cf.predicted.value_g),
                      ug(cf.predicted.sigma_g), conf_diff / conf_comb);
   out << fmt::format("Amplitude study: {}/{} runs within 2 sigma, {}/{} within 3, max |z| {:.2f}, rms residual {} ug\n",
                      amp.within_2, amp.n, amp.within_3, amp.n, amp.max_abs_z, ug(amp.rms_residual_g));

@@ -61,5 +61,9 @@ sed 's/^psd_IA = .*/psd_IA = [[20.0, 0.026], [800.0, 0.16], [50.0, 0.16], [2000.
 expect 2 'psd_IA: .*row 3' shake "$tmp/psd.toml" --json "$tmp/o/psd.json"
 [ -e "$tmp/o/psd.json" ] && { echo "FAIL: psd: partial output written"; fail=$((fail + 1)); }
 expect 0 'measured vibration error' shake "$cases/shake-physical.toml"
+# reproduce: a case without the [reproduce] table, and a missing case, exit 2 with no report.
+expect 2 'reproduce needs a \[reproduce\] table' reproduce "$cases/paper-static.toml" --out "$tmp/o/rep"
+expect 2 'missing.toml: cannot open the case file' reproduce "$tmp/missing.toml" --out "$tmp/o/rep"
+[ -e "$tmp/o/rep" ] && { echo "FAIL: reproduce: output written for bad input"; fail=$((fail + 1)); }
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <stdexcept>
 #include <thread>
 
@@ -167,6 +168,39 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
     c.rest_mean_g = n_rest > 0 ? rest / static_cast<double>(n_rest) : c.shake.baseline_g;
     c.t_measure_start_s = c.shake.settle_s;
     c.t_end_s = c.t_s.empty() ? 0.0 : c.t_s.back();
+    // The running integral (rectangle rule at the sampling step) and its fit.
+    const std::size_t n = c.t_s.size();
+    c.integral_g_s.assign(n, 0.0);
+    for (std::size_t i = 1; i < n; ++i)
+      c.integral_g_s[i] = c.integral_g_s[i - 1] + (c.output[i] / c.K1 - c.rest_mean_g) * (c.t_s[i] - c.t_s[i - 1]);
+    constexpr int kHarmonics = 3;
+    const double w = 2 * std::numbers::pi * s.frequency_Hz;
+    auto row = [&](double t) {
+      Eigen::RowVectorXd r(2 + 2 * kHarmonics);
+      r(0) = 1, r(1) = t;
+      for (int h = 1; h <= kHarmonics; ++h) r(2 * h) = std::cos(h * w * t), r(2 * h + 1) = std::sin(h * w * t);
+      return r;
+    };
+    std::vector<std::size_t> fit;
+    for (std::size_t i = 0; i < n; ++i)
+      if (c.t_s[i] >= c.t_measure_start_s) fit.push_back(i);
+    c.integral_without_oscillation_g_s = c.integral_g_s;
+    if (fit.size() > 4 * (2 + 2 * kHarmonics)) {
+      Eigen::MatrixXd A(static_cast<Eigen::Index>(fit.size()), 2 + 2 * kHarmonics);
+      Eigen::VectorXd y(A.rows());
+      for (Eigen::Index k = 0; k < A.rows(); ++k) {
+        A.row(k) = row(c.t_s[fit[static_cast<std::size_t>(k)]]);
+        y(k) = c.integral_g_s[fit[static_cast<std::size_t>(k)]];
+      }
+      const Eigen::VectorXd beta = A.colPivHouseholderQr().solve(y);
+      c.integral_slope_g = beta(1);
+      c.oscillation_amplitude_g_s = std::hypot(beta(2), beta(3));
+      // Taken off from t = 0 on, as p(t) - p(0): the swing starts with the vibration.
+      const auto p = [&](double t) { return row(t).segment(2, 2 * kHarmonics).dot(beta.segment(2, 2 * kHarmonics)); };
+      const double p0 = p(0.0);
+      for (std::size_t i = 0; i < n; ++i)
+        if (c.t_s[i] >= 0) c.integral_without_oscillation_g_s[i] -= p(c.t_s[i]) - p0;
+    }
     RunResult r;
     r.orientation_g = s.confirmation_orientation.v, r.direction_unit = s.confirmation_direction.v.normalized();
     r.amplitude_g = s.confirmation_amplitude_g, r.frequency_Hz = s.frequency_Hz;

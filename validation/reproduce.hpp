@@ -79,10 +79,19 @@ struct RunResult {
   double z() const { return residual_g() / combined_sigma_g(); }
 };
 
+// The confirmation run's record and the paper's integral. The running integral of
+// (output/K1 - mean at rest) swings by w_IA/omega at the vibration frequency; a straight
+// line fitted to it is biased by that swing (shake.integral_slope_g). The slope here is
+// fitted with the swing: a line plus the first three harmonics of the vibration frequency
+// over the measured interval; `integral_without_oscillation_g_s` is the integral with those
+// fitted harmonics taken off from t = 0 on (as p(t) - p(0), p the fitted periodic part).
 struct ConfirmationRecord {
   std::vector<double> t_s, output;  // output in output units; rest at t < 0
+  std::vector<double> integral_g_s, integral_without_oscillation_g_s;  // g*s
   double K1 = 1, rest_mean_g = 0;
   double t_measure_start_s = 0, t_end_s = 0;
+  double integral_slope_g = 0;  // line + harmonics fit over the measured interval, g
+  double oscillation_amplitude_g_s = 0;  // of the fitted fundamental in the integral
   rectification::ShakeResult shake;
   Prediction predicted;
 };

@@ -66,9 +66,26 @@ class MissingInput(Exception):
     pass
 
 
+class BadInput(Exception):
+    pass
+
+
 def read(path):
     with open(path) as f:
-        return list(csv.DictReader(row for row in f if not row.startswith("#")))
+        rows = list(csv.reader(row for row in f if not row.startswith("#")))
+    if not rows:
+        return []
+    header, body = rows[0], []
+    for r in rows[1:]:
+        if not r:
+            continue
+        if len(r) != len(header):
+            raise BadInput(f"{path}: a row has {len(r)} fields, the header {len(header)}: {','.join(r)[:80]}")
+        body.append(dict(zip(header, r)))
+    return body
+
+
+_cache = {}
 
 
 def load(out, name, columns):
@@ -76,7 +93,9 @@ def load(out, name, columns):
     path = os.path.join(out, name)
     if not os.path.isfile(path):
         raise MissingInput(f"{path} not found")
-    rows = read(path)
+    if path not in _cache:
+        _cache[path] = read(path)
+    rows = list(_cache[path])
     if not rows:
         raise MissingInput(f"{path} has no data rows")
     missing = [c for c in columns if c not in rows[0]]
@@ -247,31 +266,6 @@ def fig_static(out):
 
 # --- fig2: the confirmation run -------------------------------------------------------------
 
-def remove_periodic(t, dev, integral, f_Hz, fit_mask, harmonics=3):
-    """The running integral with the periodic response at f_Hz (and harmonics), fitted to the
-    deviation over fit_mask, taken off from t = 0 on. The part taken off is integrated with the
-    rule the file's integral was made with (fitted: I[k] - I[k-1] = (al dev[k] + be dev[k-1]) dt),
-    so that no trace of the oscillation is left. Returns (integral, amplitude taken off, g s)."""
-    w = 2 * math.pi * f_Hz
-    cols = [np.ones(fit_mask.sum())]
-    for k in range(1, harmonics + 1):
-        cols += [np.sin(k * w * t[fit_mask]), np.cos(k * w * t[fit_mask])]
-    coef, *_ = np.linalg.lstsq(np.column_stack(cols), dev[fit_mask], rcond=None)
-    on = t >= 0
-    p = np.zeros_like(t)
-    amp = 0.0
-    for k in range(1, harmonics + 1):
-        a, b = coef[2 * k - 1], coef[2 * k]
-        p[on] += a * np.sin(k * w * t[on]) + b * np.cos(k * w * t[on])
-        amp += math.hypot(a, b) / (k * w)
-    dt = np.diff(t)
-    rule, *_ = np.linalg.lstsq(np.column_stack([dev[1:] * dt, dev[:-1] * dt]), np.diff(integral), rcond=None)
-    if not np.all(np.isfinite(rule)) or abs(rule.sum() - 1) > 0.05:
-        rule = np.array([0.5, 0.5])  # not a running sum of the deviation: trapezoid
-    taken = np.concatenate([[0.0], np.cumsum((rule[0] * p[1:] + rule[1] * p[:-1]) * dt)])
-    return integral - taken, amp
-
-
 def g_s(x):
     """A time integral of acceleration, x in g s, as text in a readable unit."""
     for scale, unit in ((1e6, f"{MU}g s"), (1e3, "mg s"), (1.0, "g s")):
@@ -283,27 +277,19 @@ def fig_confirmation(out):
     c = load_json(out, "confirmation.json", ["output_unit", "K1", "frequency_Hz", "amplitude_g", "t_measure_start_s",
                                              "t_end_s", "measured_g", "integral_slope_g", "predicted_g",
                                              "sigma_predicted_g"])
-    rows = load(out, "confirmation.csv", ["t_s", "output", "deviation_g", "integral_g_s"])
+    rows = load(out, "confirmation.csv", ["t_s", "output", "integral_without_oscillation_g_s"])
     t, u = col(rows, "t_s"), col(rows, "output")
-    dev, integral = col(rows, "deviation_g"), col(rows, "integral_g_s")
     unit, K1, f0, amp = c["output_unit"], float(c["K1"]), float(c["frequency_Hz"]), float(c["amplitude_g"])
     t0, t1 = float(c["t_measure_start_s"]), float(c["t_end_s"])
     slope, pred = float(c["integral_slope_g"]), float(c["predicted_g"])
+    straight = c.get("integral_slope_straight_line_g")
     sp = float(c["sigma_predicted_g"] or 0.0)
     meas, smeas = float(c["measured_g"]), float(c.get("sigma_g") or 0.0)
     meas_mask = (t >= t0) & (t <= t1)
-
-    # The running integral of the raw deviation oscillates with the vibration (amplitude about
-    # w_IA/omega, far above the rectified part over a few seconds): take the fitted periodic
-    # response off when it would hide the slope, and say so.
-    shown, osc = integral, 0.0
-    trend = abs(slope) * (t1 - t0)
-    if meas_mask.sum() > 20 and f0 > 0:
-        cleaned, osc = remove_periodic(t, dev, integral, f0, meas_mask)
-        if osc > 0.02 * max(trend, 1e-12):
-            shown = cleaned
-        else:
-            osc = 0.0
+    # The integral with the vibration's own swing (fitted by vrelab: a line plus three
+    # harmonics over the measured interval) taken off; the swing's size is in the JSON.
+    shown = col(rows, "integral_without_oscillation_g_s")
+    osc = float(c.get("oscillation_amplitude_g_s") or 0.0)
     intercept = float(np.mean(shown[meas_mask] - slope * t[meas_mask]))
     i0 = intercept + slope * t0
     scale, iunit = (UG, f"{MU}g s") if np.nanmax(np.abs(shown)) < 2e-3 else (1e3, "mg s")
@@ -326,9 +312,11 @@ def fig_confirmation(out):
         lab = "running integral of the deviation"
     ax2.plot(t, shown * scale, lw=0.8, color="k", label=lab, zorder=3, rasterized=len(t) > 5000)
     tl = np.array([t0, t1])
-    ax2.plot(tl, (intercept + slope * tl) * scale, color="tab:blue", lw=3.5, alpha=0.55, zorder=2,
-             label=f"least-squares line: slope {slope * UG:.2f} {MU}g (measured {meas * UG:.2f}"
-                   + (f" $\\pm$ {smeas * UG:.2f}" if smeas > 0 else "") + f" {MU}g)")
+    ls_label = (f"least-squares fit: slope {slope * UG:.2f} {MU}g (whole-period mean {meas * UG:.2f}"
+                + (f" $\\pm$ {smeas * UG:.2f}" if smeas > 0 else "") + f" {MU}g)")
+    if straight is not None:
+        ls_label += f"\n  (a straight line through the swing gives {float(straight) * UG:.2f} {MU}g)"
+    ax2.plot(tl, (intercept + slope * tl) * scale, color="tab:blue", lw=3.5, alpha=0.55, zorder=2, label=ls_label)
     tt = np.linspace(t0, t1, 50)
     ax2.plot(tt, (i0 + pred * (tt - t0)) * scale, color="tab:red", lw=1.4, ls="--", zorder=4,
              label=f"eq. (3): slope {pred * UG:.2f} $\\pm$ {sp * UG:.2f} {MU}g")
@@ -429,7 +417,7 @@ def fig_amplitude(out):
 def dodge(dirs, x_span):
     """Small horizontal offsets, per direction, so points at the same amplitude do not overlap."""
     n = len(dirs)
-    step = 0.012 * x_span
+    step = 0.018 * x_span
     return {d: (k - (n - 1) / 2) * step for k, d in enumerate(dirs)}
 
 
@@ -474,6 +462,21 @@ def fig_residuals(out):
         axes[0][0].set_ylim(-10 ** math.ceil(math.log10(zm * 1.5)), 10 ** math.ceil(math.log10(zm * 1.5)))
     else:
         axes[0][0].set_ylim(-max(3.0, zm * 1.15), max(3.0, zm * 1.15))
+    # Residuals in ug: a symlog axis when they span decades (large runs along IA beside
+    # sub-ug ones along PA), linear through the smallest combined sigma.
+    cs = np.abs(col(rows, "combined_sigma_g")) * UG
+    rr = np.abs(col(rows, "residual_g")) * UG
+    cs_pos = cs[np.isfinite(cs) & (cs > 0)]
+    top = np.nanmax(rr + np.nan_to_num(cs)) if np.isfinite(rr).any() else 0.0
+    if cs_pos.size and top / cs_pos.min() > 100:
+        lin = 10 ** math.floor(math.log10(cs_pos.min()))
+        axes[1][0].set_yscale("symlog", linthresh=lin, linscale=0.6)
+        e0, e1 = int(round(math.log10(lin))), int(math.ceil(math.log10(top * 1.2)))
+        dec = [10.0**k for k in range(e0, e1 + 1)]
+        axes[1][0].yaxis.set_major_locator(FixedLocator(sorted([-d for d in dec] + [0] + dec)))
+        axes[1][0].yaxis.set_minor_locator(NullLocator())
+        axes[1][0].yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}".replace("-", "\u2212")))
+        axes[1][0].set_ylim(-10.0**e1, 10.0**e1)
     for ax in axes[1]:
         ax.set_xlim(left=0)
     handles = [Line2D([], [], marker=DIRECTION_STYLE[k % len(DIRECTION_STYLE)][1],
@@ -522,16 +525,14 @@ def fig_frequency(out):
     handles, labels = ax.get_legend_handles_labels()
     handles.insert(1, (Patch(color="tab:blue", alpha=0.22), Line2D([], [], color="tab:blue", lw=1.4)))
     labels.insert(1, r"eq. (3), frequency-dependent ($\pm1\sigma$)")
-    ax.legend(handles, labels, loc="best", framealpha=0.95)
     ax.set_xscale("log")
     ax.set_ylabel(f"vibration error ({MU}g)")
     title = "Departure from eq. (3) with frequency (confirmation condition)"
     try:
         c = load_json(out, "confirmation.json")
-        title = f"Confirmation condition over frequency: {float(c['amplitude_g']):g} g {condition(c)}"
+        title = f"Confirmation condition over frequency\n{float(c['amplitude_g']):g} g {condition(c)}"
     except (MissingInput, KeyError, ValueError, TypeError):
         pass
-    ax.set_title(title)
     last = ax
     if has_z:
         az.plot(f, col(rows, "z_quasi_static"), "s", color="0.35", ms=4, mfc="none", label="against quasi-static")
@@ -555,7 +556,7 @@ def fig_frequency(out):
         last = az
     last.set_xlabel("vibration frequency (Hz)")
     last.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
-    fig.tight_layout(h_pad=0.5)
+    fig.tight_layout(rect=(0, 0, 1, header(fig, title, handles, labels, columnspacing=1.2)), h_pad=0.5)
     return fig
 
 
@@ -608,6 +609,10 @@ def fig_invisible(out):
         labels.insert(1, r"fitted $-\hat c\,w^2/2$ ($\pm1\sigma$)")
     ax.legend(handles, labels, loc="lower left", framealpha=0.95)
     ax.axhline(0, color="k", lw=0.6)
+    # The scale of the residuals and the curve, not of the largest error bars (those of the IA
+    # runs carry the prediction's k2/k4 uncertainty and are clipped).
+    span = max(np.nanmax(np.abs(res)), c * x[-1] ** 2 / 2) * UG
+    ax.set_ylim(-1.6 * span, 0.5 * span)
     ax.set_xlim(0, x[-1])
     ax.set_xlabel("vibration amplitude |w| (g)")
     ax.set_ylabel(f"measured $-$ eq. (3) ({MU}g)")
@@ -642,7 +647,7 @@ def main(argv):
     written, failed = [], []
     for name, make, required in FIGURES:
         try:
-            fig = make(out)
+            save(make(out), out, name, written)
         except MissingInput as e:
             if required:
                 print(f"reproduce.py: error: {name} not written: {e}", file=sys.stderr)
@@ -650,14 +655,15 @@ def main(argv):
             else:
                 print(f"reproduce.py: {name} skipped: {e}", file=sys.stderr)
             plt.close("all")
-            continue
+        except BadInput as e:
+            print(f"reproduce.py: error: {name} not written: {e}", file=sys.stderr)
+            failed.append(name)
+            plt.close("all")
         except Exception:  # a bad input must not cost the other figures
             print(f"reproduce.py: error: {name} failed:", file=sys.stderr)
             traceback.print_exc()
             failed.append(name)
             plt.close("all")
-            continue
-        save(fig, out, name, written)
     print(f"reproduce.py: wrote {', '.join(written) if written else 'nothing'} (.png, .svg) in {out}"
           + (f"; FAILED: {', '.join(failed)}" if failed else ""))
     return 1 if failed else 0
