@@ -11,48 +11,67 @@ namespace vrelab::rectification {
 using plant::Accelerometer;
 using namespace plant;
 
-FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
-                                                    std::optional<double> range_g) {
-  vibration::validate(v);
-  if (!(v.frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
+  if (!(frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive");
   // The linear plant: the same dynamics, K1 and the linear cross terms, no nonlinear part.
   PlantConfig lin_cfg = config;
   for (int c : {k1_asym, k2, k3, k4, k_IP, k_IO, k_PO, k_PP, k_OO}) lin_cfg.coefficients[c] = 0.0;
   lin_cfg.torquer_c2_per_g = lin_cfg.torquer_c3_per_g2 = 0.0;
   lin_cfg.effects.clear();
-  double p2 = 0.0;
-  bool geometry = false;
-  for (const auto& e : config.effects) {
-    if (const auto* p = dynamic_cast<const PickoffNonlinearity*>(e.get())) p2 += p->p2_per_rad();
-    if (dynamic_cast<const PendulumGeometry*>(e.get())) geometry = true;
+  for (const auto& e : config.effects)
     if (dynamic_cast<const MechanicalMode*>(e.get())) lin_cfg.effects.push_back(e);  // linear: keep
-  }
-  const Accelerometer plant(lin_cfg, a);
+  // Linear: the response does not depend on the static orientation (IA up is as good as any).
+  const Accelerometer plant(lin_cfg, Vec3(1, 0, 0));
   const Accelerometer::Linear lin = plant.linearise();
   const int n = plant.size();
-  const double w = 2 * std::numbers::pi * v.frequency_Hz;
+  const double w = 2 * std::numbers::pi * frequency_Hz;
   const Eigen::MatrixXcd m = std::complex<double>(0, w) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
-  Eigen::Vector3cd W;
-  for (int i = 0; i < 3; ++i) W[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
-  const Eigen::VectorXcd x = m.fullPivLu().solve(lin.B.cast<std::complex<double>>() * W);
+  const Eigen::MatrixXcd x = m.fullPivLu().solve(lin.B.cast<std::complex<double>>());  // n x 3: per unit input axis
   // The rebalance current of the linear plant: i = k G theta + (1 - k) q + w_i r, with
   // k = lead pole / lead zero (plant/accelerometer.cpp, the servo's realisation).
   const plant::Servo& sv = plant.servo();
   const double lead_ratio = sv.lead_pole_rad_per_s / sv.lead_zero_rad_per_s;
-  const std::complex<double> current = lead_ratio * sv.gain_g_per_rad * x[Accelerometer::kTheta] +
-                                       (1 - lead_ratio) * x[Accelerometer::kLead] + sv.integrator_rad_per_s * x[Accelerometer::kIntegral];
+  LoopResponse out;
+  out.frequency_Hz = frequency_Hz;
+  for (int j = 0; j < 3; ++j) {
+    out.current[j] = lead_ratio * sv.gain_g_per_rad * x(Accelerometer::kTheta, j) + (1 - lead_ratio) * x(Accelerometer::kLead, j) +
+                     sv.integrator_rad_per_s * x(Accelerometer::kIntegral, j);
+    out.angle_rad[j] = x(Accelerometer::kTheta, j);
+  }
   // DC gain of the loop from a disturbance entering before it (an input term, a torque) to
   // the current: exactly 1 with the integrator, L0 / (1 + L0) without (L0 = b G / w_p^2).
   // Evaluated at 0.01 Hz: within O((f / f_c)^2) ~ 1e-9 of DC, and clear of the pivot
   // threshold that the quadrature and inert states (zero poles) would hit at f = 0.
   const Eigen::MatrixXcd m_dc = std::complex<double>(0, 2 * std::numbers::pi * 0.01) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
   const Eigen::VectorXcd x_dc = m_dc.fullPivLu().solve(lin.B.col(IA).cast<std::complex<double>>());
-  const double dc_gain = std::abs(lead_ratio * sv.gain_g_per_rad * x_dc[Accelerometer::kTheta] +
-                                  (1 - lead_ratio) * x_dc[Accelerometer::kLead] +
-                                  sv.integrator_rad_per_s * x_dc[Accelerometer::kIntegral]);
+  out.dc_gain = std::abs(lead_ratio * sv.gain_g_per_rad * x_dc[Accelerometer::kTheta] +
+                         (1 - lead_ratio) * x_dc[Accelerometer::kLead] + sv.integrator_rad_per_s * x_dc[Accelerometer::kIntegral]);
+  return out;
+}
+
+FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
+                                                    std::optional<double> range_g) {
+  vibration::validate(v);
+  return sine_rectification_at_frequency(config, a, v, range_g, loop_response(config, v.frequency_Hz));
+}
+
+FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
+                                                    std::optional<double> range_g, const LoopResponse& h) {
+  if (std::abs(h.frequency_Hz - v.frequency_Hz) > 1e-9 * v.frequency_Hz)
+    throw std::invalid_argument("sine_rectification_at_frequency: the loop response is for another frequency");
+  double p2 = 0.0;
+  bool geometry = false;
+  for (const auto& e : config.effects) {
+    if (const auto* p = dynamic_cast<const PickoffNonlinearity*>(e.get())) p2 += p->p2_per_rad();
+    if (dynamic_cast<const PendulumGeometry*>(e.get())) geometry = true;
+  }
+  Eigen::Vector3cd W;
+  for (int i = 0; i < 3; ++i) W[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
+  const std::complex<double> current = h.current[0] * W[0] + h.current[1] * W[1] + h.current[2] * W[2];
+  const double dc_gain = h.dc_gain;
   FrequencyPrediction out;
   out.current_amplitude_g = current;
-  out.angle_amplitude_rad = x[Accelerometer::kTheta];
+  out.angle_amplitude_rad = h.angle_rad[0] * W[0] + h.angle_rad[1] * W[1] + h.angle_rad[2] * W[2];
 
   // Terms of (1): each through the place where it acts.
   const double amp_i = std::abs(current);

@@ -18,6 +18,7 @@
 // output with the loop's DC gain: 1 with the integrator, L0/(1 + L0) without (L0 = b G/w_p^2).
 // The pickoff formula assumes the integrator (<u> = 0).
 // Not covered: input-placed terms behind a mechanical mode (they are computed unfiltered).
+#include <array>
 #include <complex>
 
 #include "plant/accelerometer.hpp"
@@ -39,5 +40,21 @@ struct FrequencyPrediction {
 FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
                                                     const vibration::SineVibration& v,
                                                     std::optional<double> range_limit_g = std::nullopt);
+
+// The linear plant's response at one frequency (what the prediction filters through):
+// the rebalance current and the pendulum angle per g of vibration on each sensor axis, and
+// the loop's DC gain. It depends on the dynamics and the linear effects (a mechanical mode)
+// only, not on the coefficients, the orientation or the amplitude: compute it once per
+// (plant dynamics, frequency) and reuse it.
+struct LoopResponse {
+  double frequency_Hz = 0;
+  std::array<std::complex<double>, 3> current{}, angle_rad{};
+  double dc_gain = 1;
+};
+LoopResponse loop_response(const plant::PlantConfig& plant, double frequency_Hz);
+// The same prediction with the response given (its frequency must be v's).
+FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
+                                                    const vibration::SineVibration& v, std::optional<double> range_limit_g,
+                                                    const LoopResponse& response);
 
 }  // namespace vrelab::rectification

@@ -1,0 +1,117 @@
+#include "validation/campaign.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <random>
+#include <stdexcept>
+#include <thread>
+
+#include "plant/effects.hpp"
+#include "rectification/shake.hpp"
+#include "vibration/decorators.hpp"
+#include "vibration/excitation.hpp"
+
+namespace vrelab::validation {
+
+CampaignDesign default_design() {
+  CampaignDesign d;
+  constexpr double arcsec = std::numbers::pi / (180 * 3600);
+  d.errors.initial_error_rad = Vec3(3, -2, 4) * arcsec;
+  d.errors.angle_sigma_rad = 0.5 * arcsec;
+  d.errors.noise_sigma_g = 0.5e-6;
+  d.errors.repeats = 2;
+  d.frequencies_Hz = {10, 40, 100, 200, 400, 800, 1500};
+  d.amplitudes_g = {1, 2, 4};
+  d.directions = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 0).normalized()};
+  d.orientations_g = {Vec3(1, 0, 1).normalized()};
+  return d;
+}
+
+bool is_out_of_library(const std::string& name) { return name == "shaker_harmonic_distortion"; }
+
+Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
+                           const CampaignDesign& design, std::uint64_t seed, int threads) {
+  for (const auto& h : hidden)
+    if (!find_effect(h.name) && !is_out_of_library(h.name))
+      throw std::invalid_argument("campaign: unknown hidden effect '" + h.name + "'");
+  Campaign c;
+  c.dynamics = truth.dynamics;
+  c.fixed[plant::k_PP] = 0.0;  // the one coefficient a 1 g test cannot separate (its common part)
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01;
+
+  // The truth plant with its hidden effects (those that live in the plant).
+  plant::PlantConfig plant = truth;
+  for (const auto& h : hidden) {
+    if (is_out_of_library(h.name)) continue;
+    vibration::SineVibration dummy;
+    std::optional<double> range;
+    find_effect(h.name)->apply(h.parameter, plant, dummy, range);
+    if (range) plant.effects.push_back(std::make_shared<plant::CurrentSaturation>(*range));
+  }
+
+  // Static test: the plant settled in each position.
+  const std::vector<Position> positions = equally_spaced_positions(design.positions_per_series);
+  const double K1 = plant.coefficients[plant::K1];
+  const OutputSource source = [&plant, K1](const Vec3& a) { return K1 * plant::settled_output_g(plant, a); };
+  const std::vector<Reading> readings = simulate_static_test(source, K1, positions, design.errors, rng);
+  const ReadingBudget budget = reading_budget(plant.coefficients, positions, readings, design.errors);
+  for (std::size_t i = 0; i < readings.size(); ++i)
+    c.statics.push_back({positions[static_cast<std::size_t>(readings[i].position)].nominal_g, readings[i].output,
+                         std::sqrt(budget.variance[i]), ""});
+
+  // Shaker runs.
+  for (const Vec3& o : design.orientations_g)
+    for (const Vec3& dir : design.directions)
+      for (double a : design.amplitudes_g)
+        for (double f : design.frequencies_Hz) {
+          RunRecord r;
+          r.id = "run" + std::to_string(c.runs.size() + 1);
+          r.frequency_Hz = f, r.amplitude_g = a, r.direction = dir.normalized(), r.orientation_g = o;
+          r.sigma_g = design.run_sigma_g;
+          c.runs.push_back(r);
+        }
+  std::vector<double> noise(c.runs.size());
+  for (double& x : noise) x = n01(rng);
+  std::atomic<std::size_t> next{0};
+  std::vector<std::string> failures(c.runs.size());
+  auto worker = [&] {
+    for (std::size_t k = next++; k < c.runs.size(); k = next++) {
+      RunRecord& r = c.runs[k];
+      const vibration::SineVibration commanded = r.vibration();
+      vibration::SineVibration table = commanded;
+      std::vector<vibration::Harmonic> harmonics;
+      for (const auto& h : hidden) {
+        if (is_out_of_library(h.name)) {
+          harmonics.push_back({2, h.parameter, 0.0});
+          continue;
+        }
+        plant::PlantConfig unused = truth;
+        std::optional<double> range;
+        find_effect(h.name)->apply(h.parameter, unused, table, range);  // the shaker's own motion
+      }
+      std::shared_ptr<const vibration::Excitation> motion;
+      auto tone = std::make_shared<vibration::SineExcitation>(table);
+      if (!harmonics.empty()) motion = std::make_shared<vibration::HarmonicDistortion>(tone, harmonics);
+      else motion = tone;
+      try {
+        const rectification::ShakeResult s = rectification::shake_sine(plant, r.orientation_g, commanded, {}, {}, motion.get());
+        r.measured_g = s.measured_g + r.sigma_g * noise[k];
+      } catch (const std::exception& e) {
+        failures[k] = e.what();
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  for (std::size_t k = 0; k < failures.size(); ++k)
+    if (!failures[k].empty()) throw std::runtime_error("campaign: " + c.runs[k].id + ": " + failures[k]);
+  return c;
+}
+
+}  // namespace vrelab::validation

@@ -1,0 +1,529 @@
+#include "validation/diagnose.hpp"
+
+#include <algorithm>
+#include <cstdio>
+#include <numbers>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+#include "plant/effects.hpp"
+#include "rectification/frequency.hpp"
+#include "validation/reproduce.hpp"
+
+namespace vrelab::validation {
+namespace {
+
+using plant::Coefficients;
+using plant::PlantConfig;
+
+std::vector<double> geometric(double from, double to, int n) {
+  std::vector<double> v;
+  for (int k = 0; k < n; ++k) v.push_back(from * std::pow(to / from, k / (n - 1.0)));
+  return v;
+}
+
+std::vector<EffectModel> make_library() {
+  std::vector<EffectModel> lib;
+  {
+    EffectModel e;
+    e.name = "pickoff_nonlinearity";
+    e.parameter = "p2", e.unit = "1/rad";
+    e.physics = "the pickoff reads theta + p2 theta^2: under vibration <theta> = -p2 <theta^2>, an output shift "
+                "growing with the pendulum's angle amplitude (quadratic in amplitude, rising towards the pendulum's "
+                "and the loop's resonances)";
+    e.linear = true, e.unit_value = 10;
+    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&, std::optional<double>&) {
+      if (p != 0) c.effects.push_back(std::make_shared<plant::PickoffNonlinearity>(p));
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "pendulum_geometry";
+    e.parameter = "fraction", e.unit = "1";
+    e.physics = "vibropendulous coupling: the input axis turns with the pendulum, so vibration along IA and PA in "
+                "phase rectifies as -<a_PA theta>; zero for vibration along one axis only";
+    e.linear = true, e.unit_value = 1;
+    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&, std::optional<double>&) {
+      if (p != 0) c.effects.push_back(std::make_shared<plant::PendulumGeometry>());
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "quadratic_cross_axis";
+    e.parameter = "k_PP", e.unit = "1/g";
+    e.physics = "k_PP a_PA^2 (and the common part of k_PP, k_OO, k2 with k0): invisible to any static test in 1 g, "
+                "so held at 0 by the identification; rectifies k_PP |w|^2 / 2 whatever the direction, frequency-"
+                "independent";
+    e.linear = true, e.unit_value = 1e-6;
+    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&, std::optional<double>&) {
+      // The static test identified (k0 + p, k2 - p, 0, k_OO - p): give the part back.
+      c.coefficients[plant::k0] -= p;
+      for (int i : {plant::k2, plant::k_PP, plant::k_OO}) c.coefficients[i] += p;
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "nonlinearity_at_input";
+    e.parameter = "fraction", e.unit = "1";
+    e.physics = "the input-axis nonlinearity (k1', k2, k3, k4) acts on the mechanical input, not in the torquer: it "
+                "sees the vibration itself, not the rebalance current, so it stays flat with frequency where the "
+                "loop-placed one peaks near the crossover and falls above it";
+    e.linear = true, e.unit_value = 1;
+    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&, std::optional<double>&) {
+      if (p >= 0.5)
+        for (int i : {plant::k1_asym, plant::k2, plant::k3, plant::k4}) c.location[i] = plant::Location::input;
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "servo_dynamics";
+    e.changes_dynamics = true;
+    e.parameter = "bandwidth_ratio", e.unit = "1";
+    e.physics = "the servo loop's crossover differs from nominal: the rebalance current's resonance, and with it "
+                "the loop-placed terms' rectification, moves in frequency; no effect at low frequency";
+    e.nominal = 1;
+    e.grid = geometric(0.5, 2.0, 41);
+    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&, std::optional<double>&) {
+      c.dynamics.loop_bandwidth_Hz *= p;
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "mechanical_mode";
+    e.changes_dynamics = true;
+    e.parameter = "frequency_Hz", e.unit = "Hz";
+    e.physics = "a second mechanical mode (flexure or mount, along IA, damping 0.05) amplifies the IA vibration "
+                "that reaches the pendulum near its frequency: a resonance in the gap over frequency, along IA";
+    e.nominal = 0;  // 0: no mode
+    e.grid = geometric(100, 5000, 41);
+    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&, std::optional<double>&) {
+      if (p > 0) c.effects.push_back(std::make_shared<plant::MechanicalMode>(p, 0.05, Vec3(1, 0, 0)));
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "shaker_transverse_motion";
+    e.parameter = "ratio_at_1kHz", e.unit = "1";
+    e.physics = "the shaker moves transversely, in phase, by ratio x (f / 1 kHz) of the commanded amplitude, on the "
+                "next sensor axis (IA -> PA -> OA -> IA): the cross terms and the other axis's quadratic terms "
+                "rectify, growing with frequency";
+    e.linear = false;
+    e.grid = {-0.2, -0.15, -0.1, -0.07, -0.05, -0.03, -0.02, -0.01, -0.005, 0, 0.005, 0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2};
+    e.apply = [](double p, PlantConfig&, vibration::SineVibration& v, std::optional<double>&) {
+      if (p == 0) return;
+      const double r = p * v.frequency_Hz / 1000;
+      Vec3 a;  // signed, in-phase amplitudes (phase 0 or 180 deg)
+      for (int i = 0; i < 3; ++i) a[i] = v.amplitude_g[i] * std::cos(v.phase_rad[i]);
+      a += r * Vec3(a[2], a[0], a[1]);
+      for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(a[i]), v.phase_rad[i] = a[i] < 0 ? M_PI : 0.0;
+    };
+    lib.push_back(e);
+  }
+  return lib;
+}
+
+
+Eigen::VectorXd sub(const Eigen::VectorXd& v, const std::vector<int>& idx) {
+  Eigen::VectorXd s(idx.size());
+  for (std::size_t i = 0; i < idx.size(); ++i) s(i) = v(idx[i]);
+  return s;
+}
+Eigen::MatrixXd rows(const Eigen::MatrixXd& m, const std::vector<int>& idx) {
+  Eigen::MatrixXd s(idx.size(), m.cols());
+  for (std::size_t i = 0; i < idx.size(); ++i) s.row(i) = m.row(idx[i]);
+  return s;
+}
+
+// The simulation of every run under one effect value: pred = f0 + G c (exact: the
+// prediction is linear in the coefficients), evaluated at the identified coefficients.
+struct Table {
+  Eigen::VectorXd pred;  // at the identified coefficients
+  Eigen::MatrixXd G;     // d pred / d coefficient
+};
+
+// The loop responses, per (dynamics-changing effect value, frequency).
+class ResponseCache {
+ public:
+  const rectification::LoopResponse& get(const PlantConfig& cfg, const std::string& key, double f) {
+    auto k = std::make_pair(key, f);
+    auto it = cache_.find(k);
+    if (it == cache_.end()) it = cache_.emplace(k, rectification::loop_response(cfg, f)).first;
+    return it->second;
+  }
+
+ private:
+  std::map<std::pair<std::string, double>, rectification::LoopResponse> cache_;
+};
+
+Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const EffectModel* e, double p,
+               ResponseCache& cache) {
+  const int n = static_cast<int>(runs.size());
+  Table t{Eigen::VectorXd(n), Eigen::MatrixXd(n, plant::kNumCoefficients)};
+  const std::string key = e && e->changes_dynamics ? e->name + "=" + std::to_string(p) : std::string();
+  for (int k = 0; k < n; ++k) {
+    const RunRecord& r = runs[static_cast<std::size_t>(k)];
+    PlantConfig cfg = nominal;
+    vibration::SineVibration v = r.vibration();
+    std::optional<double> range;
+    if (e) e->apply(p, cfg, v, range);
+    const rectification::LoopResponse& h = cache.get(cfg, key, r.frequency_Hz);
+    // Coefficients as identified, then the effect's own change of them (if any) on top.
+    const Coefficients shift = [&] {
+      Coefficients z = nominal.coefficients;
+      for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] = cfg.coefficients[i] - nominal.coefficients[i];
+      return z;
+    }();
+    const auto f = [&](const Coefficients& co) {
+      PlantConfig q = cfg;
+      for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
+      return rectification::sine_rectification_at_frequency(q, r.orientation_g, v, range, h).total_g();
+    };
+    const CoefArray g = prediction_gradient(f, nominal.coefficients);
+    for (int i = 0; i < plant::kNumCoefficients; ++i) t.G(k, i) = g[i];
+    t.pred(k) = f(nominal.coefficients);
+  }
+  return t;
+}
+
+// -2 log(likelihood) of the runs `idx` (up to a constant), with the residual's covariance
+// V = diag(sigma_run^2 + (f_model pred)^2) + G Sigma G^T; and chi^2 = r^T V^-1 r.
+struct Likelihood {
+  double m2logl = 0, chi2 = 0;
+};
+struct Data {
+  Eigen::VectorXd measured, sigma2;
+  Eigen::MatrixXd Sigma;
+  double model_accuracy = 0;
+};
+
+Eigen::MatrixXd covariance(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
+  const Eigen::MatrixXd Gi = rows(G, idx);
+  Eigen::MatrixXd V = Gi * d.Sigma * Gi.transpose();
+  for (std::size_t i = 0; i < idx.size(); ++i)
+    V(i, i) += d.sigma2(idx[i]) + std::pow(d.model_accuracy * pred(idx[i]), 2);
+  return V;
+}
+
+Likelihood likelihood(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, pred, G, idx));
+  const Eigen::VectorXd r = sub(d.measured, idx) - sub(pred, idx);
+  Likelihood l;
+  l.chi2 = r.dot(ldlt.solve(r));
+  l.m2logl = l.chi2 + ldlt.vectorD().array().abs().log().sum();
+  return l;
+}
+
+// The residual the static test's coefficient errors cannot take up: r - G dc*, with dc* the
+// coefficients' correction estimated from the runs `from` (and the static test's prior).
+Eigen::VectorXd adjusted_residual(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G,
+                                  const std::vector<int>& from, const std::vector<int>& at) {
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, pred, G, from));
+  const Eigen::VectorXd rf = sub(d.measured, from) - sub(pred, from);
+  const Eigen::VectorXd dc = d.Sigma * rows(G, from).transpose() * ldlt.solve(rf);
+  return sub(d.measured, at) - sub(pred, at) - rows(G, at) * dc;
+}
+
+// One effect: its tables (linear effects: nominal and unit, interpolated), the fit of its
+// parameter on a set of runs, the model at any parameter value.
+class EffectFitter {
+ public:
+  EffectFitter(const EffectModel& e, const Table& nominal, const PlantConfig& plant, const std::vector<RunRecord>& runs,
+               ResponseCache& cache)
+      : e_(e), nominal_(nominal), plant_(plant), runs_(runs), cache_(cache) {
+    if (e.linear) {
+      unit_ = tabulate(plant, runs, &e, e.unit_value, cache);
+    } else {
+      for (double p : e.grid) grid_.push_back(p == e.nominal ? nominal : tabulate(plant, runs, &e, p, cache));
+    }
+  }
+  Table at(double p) const {
+    if (e_.linear) {
+      const double u = (p - e_.nominal) / (e_.unit_value - e_.nominal);
+      return {nominal_.pred + u * (unit_.pred - nominal_.pred), nominal_.G + u * (unit_.G - nominal_.G)};
+    }
+    // Nonlinear: the grid's tables, or the simulation at p itself (kept: the folds' fits
+    // and the final one revisit the same values).
+    const auto& g = e_.grid;
+    const auto node = std::find(g.begin(), g.end(), p);
+    if (node != g.end()) return grid_[static_cast<std::size_t>(node - g.begin())];
+    auto it = extra_.find(p);
+    if (it == extra_.end()) it = extra_.emplace(p, tabulate(plant_, runs_, &e_, p, cache_)).first;
+    return it->second;
+  }
+  // Maximum likelihood over the runs `idx`; sigma from the curvature of -2 log L.
+  std::pair<double, double> fit(const Data& d, const std::vector<int>& idx) const {
+    auto L = [&](double p) {
+      const Table t = at(p);
+      return likelihood(d, t.pred, t.G, idx).m2logl;
+    };
+    std::vector<double> xs;
+    if (e_.linear) {
+      // A bracket from the fixed-covariance (nominal V) estimate, then a scan and a refinement.
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, nominal_.pred, nominal_.G, idx));
+      const double du = e_.unit_value - e_.nominal;
+      const Eigen::VectorXd s = sub(unit_.pred, idx) - sub(nominal_.pred, idx);
+      const Eigen::VectorXd r = sub(d.measured, idx) - sub(nominal_.pred, idx);
+      const double info = s.dot(ldlt.solve(s));
+      const double u0 = info > 0 ? s.dot(ldlt.solve(r)) / info : 0.0;
+      const double su = info > 0 ? 1 / std::sqrt(info) : 1.0;
+      const double half = 3 * std::abs(u0) + 20 * su;
+      for (int k = 0; k <= 60; ++k) xs.push_back(e_.nominal + du * (u0 - half + 2 * half * k / 60.0));
+    } else {
+      xs = e_.grid;
+    }
+    std::vector<double> ls;
+    for (double x : xs) ls.push_back(L(x));
+    const std::size_t b = static_cast<std::size_t>(std::min_element(ls.begin(), ls.end()) - ls.begin());
+    double best = xs[b], lbest = ls[b], sigma = INFINITY;
+    if (b > 0 && b + 1 < xs.size()) {
+      // Golden-section refinement in [x_{b-1}, x_{b+1}], then the curvature there.
+      double lo = xs[b - 1], hi = xs[b + 1];
+      const double gr = (std::sqrt(5.0) - 1) / 2;
+      double x1 = hi - gr * (hi - lo), x2 = lo + gr * (hi - lo), f1 = L(x1), f2 = L(x2);
+      for (int it = 0; it < (e_.linear ? 40 : 20); ++it) {
+        if (f1 < f2) hi = x2, x2 = x1, f2 = f1, x1 = hi - gr * (hi - lo), f1 = L(x1);
+        else lo = x1, x1 = x2, f1 = f2, x2 = lo + gr * (hi - lo), f2 = L(x2);
+      }
+      const double xm = 0.5 * (lo + hi), lm = L(xm);
+      if (lm < lbest) best = xm, lbest = lm;
+      const double h = 0.25 * (xs[b + 1] - xs[b - 1]);
+      const double curv = (L(best + h) - 2 * lbest + L(best - h)) / (h * h);  // d2(-2 log L)/dp2
+      if (curv > 0) sigma = std::sqrt(2 / curv);
+    }
+    return {best, sigma};
+  }
+
+ private:
+  const EffectModel& e_;
+  const Table& nominal_;
+  const PlantConfig& plant_;
+  const std::vector<RunRecord>& runs_;
+  ResponseCache& cache_;
+  Table unit_;
+  std::vector<Table> grid_;
+  mutable std::map<double, Table> extra_;
+};
+
+// chi^2 with n degrees of freedom as a normal deviate (Wilson-Hilferty).
+double chi2_as_sigma(double chi2, int n) {
+  const double v = 2.0 / (9.0 * n);
+  return (std::cbrt(chi2 / n) - (1 - v)) / std::sqrt(v);
+}
+
+}  // namespace
+
+vibration::SineVibration RunRecord::vibration() const {
+  vibration::SineVibration v;
+  for (int i = 0; i < 3; ++i) {
+    v.amplitude_g[i] = amplitude_g * std::abs(direction[i]);
+    v.phase_rad[i] = direction[i] < 0 ? std::numbers::pi : 0.0;
+  }
+  v.frequency_Hz = frequency_Hz;
+  return v;
+}
+
+const std::vector<EffectModel>& effect_library() {
+  static const std::vector<EffectModel> lib = make_library();
+  return lib;
+}
+
+const EffectModel* find_effect(const std::string& name) {
+  for (const auto& e : effect_library())
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
+double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const EffectModel* e, double p) {
+  PlantConfig cfg = nominal;
+  vibration::SineVibration v = r.vibration();
+  std::optional<double> range;
+  if (e) e->apply(p, cfg, v, range);
+  return rectification::sine_rectification_at_frequency(cfg, r.orientation_g, v, range).total_g();
+}
+
+Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
+  if (c.statics.empty()) throw std::invalid_argument("diagnose: the campaign has no static readings");
+  if (c.runs.empty()) throw std::invalid_argument("diagnose: the campaign has no usable shaker runs");
+  Diagnosis d;
+  // 1. Identification from the static readings, weighted by their sigma.
+  std::vector<Position> positions;
+  std::vector<Reading> readings;
+  std::vector<double> weights;
+  ReadingBudget budget;
+  for (std::size_t i = 0; i < c.statics.size(); ++i) {
+    positions.push_back(vector_position(c.statics[i].orientation_g.normalized()));
+    readings.push_back({static_cast<int>(i), c.statics[i].output});
+    const double var = std::max(c.statics[i].sigma_output * c.statics[i].sigma_output, 1e-30);
+    weights.push_back(1 / var);
+    budget.variance.push_back(var);
+    budget.bias.push_back(0.0);
+  }
+  const LeastSquaresResult ls = least_squares(positions, readings, weights, c.fixed);
+  if (!ls.identifiability.full_rank()) {
+    std::string msg = "the static readings do not determine the free coefficients (rank " +
+                      std::to_string(ls.identifiability.rank) + " of " + std::to_string(ls.identifiability.parameters) + ")";
+    for (const auto& w : ls.identifiability.confounded) msg += "; " + w;
+    throw std::invalid_argument(msg + ": hold more coefficients in the manifest's [identification] fixed, or add positions");
+  }
+  d.identified = ls.estimate.value;
+  const Estimator est = [&](const std::vector<Reading>& r) { return least_squares(positions, r, weights, c.fixed).estimate; };
+  d.identified_uncertainty = propagate_first_order(est, readings, budget);
+
+  PlantConfig plant;
+  plant.coefficients = d.identified;
+  plant.dynamics = c.dynamics;
+  const int n = static_cast<int>(c.runs.size());
+  Data data;
+  data.measured.resize(n), data.sigma2.resize(n);
+  for (int k = 0; k < n; ++k) {
+    data.measured(k) = c.runs[static_cast<std::size_t>(k)].measured_g;
+    data.sigma2(k) = std::pow(c.runs[static_cast<std::size_t>(k)].sigma_g, 2);
+  }
+  data.Sigma.resize(plant::kNumCoefficients, plant::kNumCoefficients);
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    for (int j = 0; j < plant::kNumCoefficients; ++j) data.Sigma(i, j) = d.identified_uncertainty.covariance[i][j];
+  data.model_accuracy = s.model_accuracy;
+
+  // 2. The nominal simulation: gap, significance, where.
+  ResponseCache cache;
+  const Table nominal = tabulate(plant, c.runs, nullptr, 0, cache);
+  std::vector<int> all(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) all[static_cast<std::size_t>(k)] = k;
+  const Eigen::MatrixXd V = covariance(data, nominal.pred, nominal.G, all);
+  const Eigen::LDLT<Eigen::MatrixXd> Vl(V);
+  const Eigen::VectorXd r = data.measured - nominal.pred;
+  const Eigen::MatrixXd Vinv = Vl.solve(Eigen::MatrixXd::Identity(n, n));
+  const Eigen::VectorXd u = Vinv * r;
+  d.chi2_nominal = r.dot(u);
+  const double chi2_sigma = chi2_as_sigma(d.chi2_nominal, n);
+  d.runs.resize(static_cast<std::size_t>(n));
+  std::vector<std::pair<double, double>> la;  // log amplitude, log |adjusted gap| of significant runs
+  const Eigen::VectorXd adj = adjusted_residual(data, nominal.pred, nominal.G, all, all);
+  std::set<std::string> dirs;
+  double f_lo = INFINITY, f_hi = 0, a_lo = INFINITY, a_hi = 0;
+  for (int k = 0; k < n; ++k) {
+    RunDiagnosis& rd = d.runs[static_cast<std::size_t>(k)];
+    rd.predicted_g = nominal.pred(k);
+    rd.sigma_predicted_g = std::sqrt(std::max(0.0, (nominal.G.row(k) * data.Sigma * nominal.G.row(k).transpose())(0, 0)));
+    rd.gap_g = r(k);
+    rd.sigma_g = std::sqrt(V(k, k));
+    // Standardised against all the other runs (the gap the shared coefficient errors cannot
+    // take up): u_k / sqrt((V^-1)_kk).
+    rd.z = u(k) / std::sqrt(Vinv(k, k));
+    d.max_abs_z = std::max(d.max_abs_z, std::abs(rd.z));
+    if (std::abs(rd.z) >= s.significance_sigma) {
+      ++d.significant_runs;
+      const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
+      char dir[64];
+      std::snprintf(dir, sizeof dir, "[%.2g, %.2g, %.2g]", run.direction[0], run.direction[1], run.direction[2]);
+      dirs.insert(dir);
+      f_lo = std::min(f_lo, run.frequency_Hz), f_hi = std::max(f_hi, run.frequency_Hz);
+      a_lo = std::min(a_lo, run.amplitude_g), a_hi = std::max(a_hi, run.amplitude_g);
+      if (adj(k) != 0) la.emplace_back(std::log(run.amplitude_g), std::log(std::abs(adj(k))));
+    }
+  }
+  d.gap_significant = d.significant_runs > 0 || chi2_sigma >= s.significance_sigma;
+  {
+    std::ostringstream w;
+    w.precision(3);
+    w << "chi^2 " << d.chi2_nominal << " for " << n << " runs (" << chi2_sigma << " sigma); ";
+    if (d.significant_runs > 0) {
+      w << d.significant_runs << " run(s) beyond " << s.significance_sigma << " sigma: " << f_lo << "-" << f_hi << " Hz, "
+        << a_lo << "-" << a_hi << " g, direction(s)";
+      for (const auto& x : dirs) w << " " << x;
+    } else {
+      w << "no single run beyond " << s.significance_sigma << " sigma";
+    }
+    d.where = w.str();
+    if (la.size() >= 3 && a_hi > a_lo) {
+      double mx = 0, my = 0;
+      for (auto [x, y] : la) mx += x, my += y;
+      mx /= static_cast<double>(la.size()), my /= static_cast<double>(la.size());
+      double sxy = 0, sxx = 0;
+      for (auto [x, y] : la) sxy += (x - mx) * (y - my), sxx += (x - mx) * (x - mx);
+      d.amplitude_power = sxx > 0 ? sxy / sxx : 0;
+    }
+  }
+
+  // 3. Each effect: leave-one-frequency-out fits and the evidence on the held-out runs.
+  std::map<double, std::vector<int>> folds;
+  // Folds: leave one amplitude out. Every frequency and direction stays in the training set
+  // (a resonance cannot be located from the other frequencies), and the held-out runs test
+  // the effect's scaling with amplitude, which is what tells most effects apart.
+  const auto fold_key = [&](int k) { return c.runs[static_cast<std::size_t>(k)].amplitude_g; };
+  for (int k = 0; k < n; ++k) folds[fold_key(k)].push_back(k);
+  struct Scored {
+    EffectFit fit;
+    Eigen::VectorXd heldout;  // held-out adjusted residual per run
+  };
+  std::vector<Scored> scored;
+  Eigen::VectorXd heldout_nominal = Eigen::VectorXd::Zero(n);
+  for (const auto& [f, test] : folds) {
+    std::vector<int> train;
+    for (int k = 0; k < n; ++k)
+      if (fold_key(k) != f) train.push_back(k);
+    if (train.empty()) train = all;
+    const Eigen::VectorXd a = adjusted_residual(data, nominal.pred, nominal.G, train, test);
+    for (std::size_t i = 0; i < test.size(); ++i) heldout_nominal(test[i]) = a(static_cast<Eigen::Index>(i));
+  }
+  for (const EffectModel& e : effect_library()) {
+    const EffectFitter fitter(e, nominal, plant, c.runs, cache);
+    Scored sc;
+    sc.fit.name = e.name, sc.fit.parameter = e.parameter, sc.fit.unit = e.unit;
+    sc.heldout = Eigen::VectorXd::Zero(n);
+    for (const auto& [f, test] : folds) {
+      std::vector<int> train;
+      for (int k = 0; k < n; ++k)
+        if (fold_key(k) != f) train.push_back(k);
+      if (train.empty()) train = all;
+      const double p = fitter.fit(data, train).first;
+      const Table t = fitter.at(p);
+      const Likelihood with = likelihood(data, t.pred, t.G, test), without = likelihood(data, nominal.pred, nominal.G, test);
+      sc.fit.evidence += without.m2logl - with.m2logl;
+      sc.fit.heldout_chi2 += with.chi2;
+      const Eigen::VectorXd a = adjusted_residual(data, t.pred, t.G, train, test);
+      for (std::size_t i = 0; i < test.size(); ++i) sc.heldout(test[i]) = a(static_cast<Eigen::Index>(i));
+    }
+    const auto [p, sp] = fitter.fit(data, all);
+    sc.fit.value = p, sc.fit.sigma = sp;
+    scored.push_back(std::move(sc));
+  }
+  std::sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
+  for (const auto& sc : scored) d.effects.push_back(sc.fit);
+
+  // 4. The verdict and the held-out shrinkage of the chosen effect.
+  const Scored& best = scored.front();
+  double ss_b = 0, ss_a = 0, zs_b = 0, zs_a = 0;
+  for (int k = 0; k < n; ++k) {
+    const double sk2 = data.sigma2(k) + std::pow(s.model_accuracy * nominal.pred(k), 2);
+    ss_b += heldout_nominal(k) * heldout_nominal(k), ss_a += best.heldout(k) * best.heldout(k);
+    zs_b += heldout_nominal(k) * heldout_nominal(k) / sk2, zs_a += best.heldout(k) * best.heldout(k) / sk2;
+    d.runs[static_cast<std::size_t>(k)].heldout_after_g = best.heldout(k);
+  }
+  d.rms_before_g = std::sqrt(ss_b / n), d.rms_after_g = std::sqrt(ss_a / n);
+  d.rms_before_sigma = std::sqrt(zs_b / n), d.rms_after_sigma = std::sqrt(zs_a / n);
+  if (!d.gap_significant) {
+    d.verdict = "no significant gap";
+  } else if (best.fit.evidence > s.significance_sigma * s.significance_sigma &&
+             best.fit.heldout_chi2 / n <= s.explained_chi2_per_run) {
+    d.explained = true;
+    d.verdict = "explained by " + best.fit.name;
+  } else {
+    d.verdict = "not explained by any known effect";
+  }
+  return d;
+}
+
+}  // namespace vrelab::validation

@@ -1,0 +1,119 @@
+#pragma once
+// validation/diagnose.hpp -- the sim-to-real gap: where it lies, which effect causes it, how
+// far it shrinks (issue 5; docs/diagnose.md).
+//
+// Takes: a campaign (a lab's static readings and shaker-run summaries, in memory; the lab
+//        data format of docs/data-format.md is read by the app) and the nominal dynamics.
+// Gives: the identified coefficients; per run the prediction of the nominal simulation (the
+//        frequency-dependent eq. (3) of the plant built from the identified coefficients and
+//        the nominal dynamics), the gap and its significance; each candidate effect of the
+//        library fitted and scored on held-out runs (leave one frequency out); the verdict
+//        (no significant gap / explained by <effect> / not explained by any known effect);
+//        the held-out gap rms before and after the chosen effect.
+//
+// The statistics: the predictions share the static test's coefficient errors, so the gap
+// vector r has covariance V = diag(sigma_run^2 + (f_model pred)^2) + G Sigma G^T (G: the
+// prediction's gradient in the coefficients, Sigma their covariance from the static test,
+// f_model the simulation's own relative accuracy). Fits and chi^2 use V.
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "plant/accelerometer.hpp"
+#include "validation/identification.hpp"
+#include "validation/uncertainty.hpp"
+#include "vibration/profile.hpp"
+
+namespace vrelab::validation {
+
+// One static reading: the orientation (gravity in sensor axes, g), the mean output (output
+// units) and its standard uncertainty.
+struct StaticRecord {
+  Vec3 orientation_g = Vec3::Zero();
+  double output = 0, sigma_output = 0;
+  std::string where;  // file:line, for messages
+};
+
+// One shaker run, summarised: a sine of amplitude_g peak along `direction` (unit, sensor
+// axes, in phase) at frequency_Hz, the sensor statically at orientation_g; the measured
+// vibration error (g) and its standard uncertainty.
+struct RunRecord {
+  std::string id;
+  double frequency_Hz = 0, amplitude_g = 0;
+  Vec3 direction = Vec3::UnitX(), orientation_g = Vec3::UnitX();
+  double measured_g = 0, sigma_g = 0;
+  std::string where;
+  vibration::SineVibration vibration() const;
+};
+
+struct Campaign {
+  std::string name;
+  plant::Dynamics dynamics;  // nominal
+  FixedSet fixed{};          // coefficients the identification holds
+  std::vector<StaticRecord> statics;
+  std::vector<RunRecord> runs;
+  std::vector<std::string> skipped;  // runs the reader could not use, each with why
+};
+
+// A candidate effect: a physical parameter that changes the nominal simulation (the plant
+// or the shaker's motion). `nominal` is the value without the effect.
+struct EffectModel {
+  std::string name, parameter, unit, physics;
+  double nominal = 0;
+  bool linear = false;          // the prediction is linear in the parameter
+  bool changes_dynamics = false;  // the loop's linear response depends on the parameter
+  std::vector<double> grid;     // values tried (nonlinear effects)
+  double unit_value = 1;        // the parameter value used for the signature (linear effects)
+  // Applies parameter p to the nominal plant and to the vibration (sensor axes).
+  std::function<void(double p, plant::PlantConfig&, vibration::SineVibration&, std::optional<double>& range_g)> apply;
+};
+const std::vector<EffectModel>& effect_library();
+const EffectModel* find_effect(const std::string& name);
+
+// The simulation's prediction of one run: eq. (3) through the plant's dynamics, with an
+// effect (name, parameter) applied when given. g.
+double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, const EffectModel* e = nullptr, double p = 0);
+
+struct DiagnoseSettings {
+  double model_accuracy = 0.002;      // relative accuracy of the simulation (f_model)
+  double significance_sigma = 5.0;    // a run's gap is significant beyond this many sigma
+  double explained_chi2_per_run = 2.0;  // held-out chi^2 per run at most this to call a gap explained
+};
+
+struct EffectFit {
+  std::string name, parameter, unit;
+  double value = 0, sigma = 0;   // fitted on all runs
+  double evidence = 0;           // held-out chi^2 reduction, summed over folds
+  double heldout_chi2 = 0;       // held-out chi^2 with the effect, summed over folds
+};
+
+struct RunDiagnosis {
+  double predicted_g = 0, sigma_predicted_g = 0;  // nominal simulation
+  double gap_g = 0, sigma_g = 0, z = 0;           // measured - predicted; sigma from V's diagonal
+  double heldout_after_g = 0;                     // gap left by the chosen effect, fitted without this run's fold
+};
+
+struct Diagnosis {
+  plant::Coefficients identified;
+  Propagation identified_uncertainty;
+  std::vector<RunDiagnosis> runs;
+  double chi2_nominal = 0;
+  int significant_runs = 0;
+  bool gap_significant = false;
+  double max_abs_z = 0;
+  // Where: the significant runs' span, and the gap's scaling with amplitude (power p of
+  // |gap| ~ A^p, least squares on the significant runs; 0 when fewer than 3).
+  std::string where;
+  double amplitude_power = 0;
+  std::vector<EffectFit> effects;  // best first (evidence)
+  bool explained = false;
+  std::string verdict;             // "no significant gap", "explained by <name>", "not explained by any known effect"
+  double rms_before_g = 0, rms_after_g = 0;          // held-out, over all runs
+  double rms_before_sigma = 0, rms_after_sigma = 0;  // the same in units of each run's sigma
+};
+
+Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {});
+
+}  // namespace vrelab::validation
