@@ -767,11 +767,17 @@ void read_reproduce(Table t, Case& c) {
   r.confirmation_record_s = conf->number("record_s");
   if (!(r.confirmation_record_s > 0)) conf->fail(conf->raw().get("record_s"), "record_s", "must be positive");
   conf->check_unknown({"orientation", "direction", "amplitude_g", "record_s"});
-  if (c.shake.readout.active())
+  // Each run is sampled with at least 10 samples per period (shake.hpp).
+  if (c.shake.readout.active()) {
+    if (10 * r.frequency_Hz > c.shake.readout.sample_rate_Hz)
+      t.fail(t.raw().get("frequency_Hz"), "frequency_Hz",
+             fmt::format("{:g} Hz needs at least 10 samples per period: [readout] sample_rate_Hz >= {:g}", r.frequency_Hz,
+                         10 * r.frequency_Hz));
     for (double f : r.departure_frequencies_Hz)
-      if (10 * std::max(f, r.frequency_Hz) > c.shake.readout.sample_rate_Hz)
+      if (10 * f > c.shake.readout.sample_rate_Hz)
         t.fail(t.raw().get("departure_frequencies_Hz"), "departure_frequencies_Hz",
                fmt::format("{:g} Hz needs at least 10 samples per period: [readout] sample_rate_Hz >= {:g}", f, 10 * f));
+  }
   t.check_unknown({"frequency_Hz", "amplitudes_g", "directions", "direction_names", "orientations_g",
                    "orientation_names", "departure_frequencies_Hz", "invisible_shift_per_g", "threads",
                    "confirmation"});

@@ -106,7 +106,13 @@ std::string run_plot_script(const std::string& script, const std::string& dir) {
     }
   }
   if (py.empty()) return "no Python with matplotlib found (install it: apt-get install python3-matplotlib)";
-  const std::string cmd = py + " '" + std::string(VRELAB_SOURCE_DIR) + "/app/plots/" + script + "' '" + dir + "'";
+  // Single-quoted for the shell, with any ' inside written as '\'' (a path may hold one).
+  const auto quote = [](const std::string& x) {
+    std::string q = "'";
+    for (char ch : x) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    return q + "'";
+  };
+  const std::string cmd = py + " " + quote(std::string(VRELAB_SOURCE_DIR) + "/app/plots/" + script) + " " + quote(dir);
   if (std::system(cmd.c_str()) != 0) return "the figure script failed: " + cmd;
   return "";
 }

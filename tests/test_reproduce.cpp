@@ -260,22 +260,19 @@ TEST(Reproduce, SmallCaseAgreesAtLowFrequencyFlagsFrequencyAndRecoversTheInvisib
 
   // The departure in frequency: a loop-placed k2 sees the rebalance current, whose
   // amplitude peaks near 300 Hz for this loop (docs/frequency.md), so the measured error
-  // there is well above its 20 Hz value (1.87x in the shipped case; bound 1.5x), and the
-  // frequency-dependent eq. (3) with the true coefficients gives the same ratio within 4
-  // standard uncertainties of the measured ratio (from the two runs' sigmas).
+  // there is well above its 20 Hz value (1.87x in the shipped case; bound 1.5x). The change
+  // from 20 Hz predicted by the frequency-dependent eq. (3) agrees with the measured change
+  // within 4 combined sigma (identified coefficients, their sigma included), and within 4
+  // measurement sigma with the true coefficients.
   const auto& fd = s["frequency_departure"];
   EXPECT_EQ(fd["reference_Hz"], 20.0);
-  EXPECT_EQ(fd["changes_by_3_sigma_from_Hz"], 300.0);
+  ASSERT_EQ(fd["departs_by_3_sigma_at_Hz"].size(), 1u);
+  EXPECT_EQ(fd["departs_by_3_sigma_at_Hz"][0], 300.0);
   const auto& fr = fd["runs"];
   ASSERT_EQ(fr.size(), 2u);
-  const double m0 = fr[0]["measured_g"], m1 = fr[1]["measured_g"];
-  const double ratio = m1 / m0;
-  const double ratio_sigma = ratio * std::hypot(fr[0]["sigma_measured_g"].get<double>() / m0,
-                                                fr[1]["sigma_measured_g"].get<double>() / m1);
-  EXPECT_GT(ratio, 1.5);
-  const double true_ratio = fr[1]["true_at_frequency_g"].get<double>() / fr[0]["true_at_frequency_g"].get<double>();
-  EXPECT_NEAR(ratio, true_ratio, 4 * ratio_sigma);
-  EXPECT_LT(ratio_sigma, 0.05);
+  EXPECT_GT(fr[1]["measured_g"].get<double>() / fr[0]["measured_g"].get<double>(), 1.5);
+  EXPECT_LT(fd["max_abs_z_change"].get<double>(), 4.0);
+  EXPECT_LT(fd["max_abs_z_change_true_coefficients"].get<double>(), 4.0);
 
   // The invisible shift: the static outputs agree to the solver's precision, the residuals
   // give c back (GLS): within 4 sigma, and sigma small enough for the test to mean something.
@@ -335,6 +332,8 @@ TEST(Reproduce, BadReproduceTableIsNamedWithFileLineAndKey) {
   expect_rejects(R"(departure_frequencies_Hz = \[20\.0, 300\.0\])", "departure_frequencies_Hz = [20.0, 800.0]",
                  R"(departure_frequencies_Hz: 800 Hz needs at least 10 samples per period)");
   expect_rejects("amplitude_g = 2.0\n", "amplitude_g = -2.0\n", R"(\[reproduce.confirmation\] amplitude_g: must be positive)");
+  expect_rejects("frequency_Hz = 20.0\n", "frequency_Hz = 600.0\n",
+                 R"(\[reproduce\] frequency_Hz: 600 Hz needs at least 10 samples per period)");
 }
 
 TEST(Report, MarkdownAndHtmlCarryTheSameContentAndHtmlIsEscaped) {

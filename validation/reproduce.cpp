@@ -46,6 +46,18 @@ void predict_run(RunResult& r, const plant::PlantConfig& nominal,
   r.at_frequency = predict_with_uncertainty(at_frequency, c, cov);
 }
 
+Prediction predicted_change(const RunResult& r, const RunResult& ref, const plant::PlantConfig& nominal,
+                            const std::array<CoefArray, plant::kNumCoefficients>& cov) {
+  const auto at = [&](const RunResult& x, const Coefficients& k) {
+    plant::PlantConfig p = nominal;
+    p.coefficients = k;
+    return rectification::sine_rectification_at_frequency(p, x.orientation_g,
+                                                          sine_of(x.direction_unit, x.amplitude_g, x.frequency_Hz))
+        .terms.total_g();
+  };
+  return predict_with_uncertainty([&](const Coefficients& k) { return at(r, k) - at(ref, k); }, nominal.coefficients, cov);
+}
+
 namespace {
 
 // Runs the grid on the plant and returns one RunResult per condition (grid order), with
@@ -211,7 +223,14 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
   // 3. The amplitude study.
   const rectification::SweepGrid grid = grid_of({s.frequency_Hz}, s.amplitudes_g, s.directions, s.orientations);
   say("amplitude study: " + std::to_string(grid.size()) + " shaker runs");
-  out.amplitude_runs = shake_grid(truth_plant, s.shake, grid, s.directions, s.orientations, threads);
+  // Each section draws its readout noise from its own seed range (run i of section k:
+  // seed + k * 1000003 + i), so no two runs share a noise record.
+  const auto section = [&s](int k) {
+    rectification::ShakeSettings x = s.shake;
+    x.readout.seed = s.shake.readout.seed + static_cast<std::uint64_t>(k) * 1000003u;
+    return x;
+  };
+  out.amplitude_runs = shake_grid(truth_plant, section(1), grid, s.directions, s.orientations, threads);
   for (RunResult& r : out.amplitude_runs) predict_run(r, nominal, cov);
 
   // 4. The departure in frequency.
@@ -220,7 +239,9 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
     const rectification::SweepGrid fg = grid_of(s.departure_frequencies_Hz, {s.confirmation_amplitude_g},
                                                 {s.confirmation_direction}, {s.confirmation_orientation});
     out.frequency_runs =
-        shake_grid(truth_plant, s.shake, fg, {s.confirmation_direction}, {s.confirmation_orientation}, threads);
+        shake_grid(truth_plant, section(2), fg, {s.confirmation_direction}, {s.confirmation_orientation}, threads);
+    std::sort(out.frequency_runs.begin(), out.frequency_runs.end(),
+              [](const RunResult& a, const RunResult& b) { return a.frequency_Hz < b.frequency_Hz; });
     for (RunResult& r : out.frequency_runs) predict_run(r, nominal, cov);
   }
 
@@ -238,7 +259,7 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
     const std::vector<NamedVector> axes = {{"IA", Vec3(1, 0, 0)}, {"PA", Vec3(0, 1, 0)}, {"OA", Vec3(0, 0, 1)}};
     say("invisible shift: 3 x " + std::to_string(s.amplitudes_g.size()) + " shaker runs on the second instrument");
     const rectification::SweepGrid ig = grid_of({s.frequency_Hz}, s.amplitudes_g, axes, {s.confirmation_orientation});
-    inv.runs = shake_grid(other, s.shake, ig, axes, {s.confirmation_orientation}, threads);
+    inv.runs = shake_grid(other, section(3), ig, axes, {s.confirmation_orientation}, threads);
     // Generalised least squares for c in residual = -c |w|^2 / 2: the runs share the
     // prediction's coefficient errors, so V = diag(sigma_m^2) + G Sigma G^T.
     const int n = static_cast<int>(inv.runs.size());

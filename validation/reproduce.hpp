@@ -14,13 +14,15 @@
 //     printed) from the least-squares coefficients, each with its standard uncertainty; the
 //     prediction's uncertainty is g^T Sigma g, g the gradient of eq. (3) in the coefficients
 //     (eq. (3) is linear in them) and Sigma their covariance from the static test;
-//  4. the departure in frequency: the confirmation condition measured over frequency, with
-//     the quasi-static and the frequency-dependent eq. (3) (plant built from the identified
-//     coefficients and the nominal dynamics);
+//  4. the departure in frequency: the confirmation condition measured over frequency
+//     (sorted), with the quasi-static and the frequency-dependent eq. (3) (plant built from
+//     the identified coefficients and the nominal dynamics);
 //  5. what no static test can see: a second instrument whose (k0, k2, k_PP, k_OO) differ by
 //     c (1, -1, -1, -1) reads the same in every static position; it is shaken along IA, PA
 //     and OA, and c is fitted back from the residuals, which should be -c |w|^2 / 2.
-// All errors in g; amplitudes in g peak; frequencies in Hz; times in s.
+// All errors in g; amplitudes in g peak; frequencies in Hz; times in s. With a readout, run i
+// of section k (1 amplitude, 2 frequency, 3 invisible) draws its noise from seed
+// readout.seed + k * 1000003 + i; the confirmation run from readout.seed.
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -122,6 +124,12 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
 // the coefficients of `nominal` and their covariance.
 void predict_run(RunResult& r, const plant::PlantConfig& nominal,
                  const std::array<CoefArray, plant::kNumCoefficients>& covariance);
+
+// The change of the frequency-dependent eq. (3) from run `ref` to run `r` (same condition,
+// another frequency), with its standard uncertainty: the coefficient errors do not cancel in
+// it (terms scale differently with frequency), so it has its own sigma.
+Prediction predicted_change(const RunResult& r, const RunResult& ref, const plant::PlantConfig& nominal,
+                            const std::array<CoefArray, plant::kNumCoefficients>& covariance);
 
 // The gradient of a prediction that is linear in the rectifying coefficients (k1_asym, k2,
 // k3, k4, k_IP, k_IO, k_PO, k_PP, k_OO): g_i = f(c with only coefficient i = h) / h - f(0).

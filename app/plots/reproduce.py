@@ -299,10 +299,11 @@ def fig_confirmation(out):
     ax1.set_ylabel(f"instrument output ({unit})")
     ax1.set_title(f"Confirmation run: {amp:g} g at {f0:g} Hz {condition(c)}")
     lo, hi = np.nanmin(u), np.nanmax(u)
+    swing = float(np.ptp(u[meas_mask]) / 2) if meas_mask.any() else 0.0
     ax1.set_ylim(lo - 0.08 * (hi - lo), hi + 0.45 * (hi - lo))
     ax1.text(0.015, 0.95,
-             f"vibration error {meas * UG:.3g} {MU}g, i.e. {K1 * meas:.2g} {unit} on a {K1 * amp:.3g} {unit} "
-             f"oscillation\n({meas / amp:.1e} of it): invisible in the raw output",
+             f"vibration error {meas * UG:.3g} {MU}g, i.e. {K1 * meas:.2g} {unit} on a $\\pm${swing:.3g} {unit} "
+             f"swing\n({abs(K1 * meas) / swing if swing > 0 else 0:.1e} of it)",
              transform=ax1.transAxes, va="top", ha="left", fontsize=8,
              bbox=dict(boxstyle="round,pad=0.3", fc="white", ec="0.7", alpha=0.95))
 
