@@ -784,6 +784,50 @@ void read_reproduce(Table t, Case& c) {
   c.reproduce = r;
 }
 
+void read_campaign(Table t, Case& c) {
+  CampaignSpec s;
+  s.name = t.string("name", s.name);
+  if (const toml::node* n = t.get("hidden", false)) {
+    const toml::array* a = n->as_array();
+    if (!a) t.fail(n, "hidden", "expected an array of tables { name = \"...\", parameter = ... }");
+    for (auto&& x : *a) {
+      const toml::table* e = x.as_table();
+      if (!e) t.fail(&x, "hidden", "expected a table { name = \"...\", parameter = ... }");
+      Table et(*e, "campaign.hidden", "");
+      validation::HiddenEffect h;
+      h.name = et.string("name", "");
+      if (!validation::find_effect(h.name) && !validation::is_out_of_library(h.name)) {
+        std::string names;
+        for (const auto& m : validation::effect_library()) names += " " + m.name;
+        t.fail(&x, "hidden", "unknown effect '" + h.name + "'; known:" + names + " shaker_harmonic_distortion");
+      }
+      const toml::node* p = e->get("parameter");
+      if (!p || !p->is_number()) t.fail(&x, "hidden", "each hidden effect needs a numeric parameter");
+      h.parameter = p->value<double>().value();
+      s.hidden.push_back(h);
+    }
+  }
+  validation::CampaignDesign& d = s.design;
+  if (auto f = number_list(t, "frequencies_Hz"); !f.empty()) d.frequencies_Hz = f;
+  if (auto a = number_list(t, "amplitudes_g"); !a.empty()) d.amplitudes_g = a;
+  if (auto v = vec3_list(t, "directions", true); !v.empty()) d.directions = v;
+  if (auto v = vec3_list(t, "orientations_g", false); !v.empty()) d.orientations_g = v;
+  for (double f : d.frequencies_Hz)
+    if (!(f > 0)) t.fail(t.raw().get("frequencies_Hz"), "frequencies_Hz", "frequencies must be positive");
+  for (double a : d.amplitudes_g)
+    if (!(a > 0)) t.fail(t.raw().get("amplitudes_g"), "amplitudes_g", "amplitudes must be positive");
+  d.run_sigma_g = t.non_negative("run_sigma_ug", d.run_sigma_g * 1e6) * 1e-6;
+  if (!(d.run_sigma_g > 0)) t.fail(t.raw().get("run_sigma_ug"), "run_sigma_ug", "must be positive");
+  d.positions_per_series = static_cast<int>(t.integer("positions_per_series", false, d.positions_per_series, 8, 360));
+  if (const toml::node* n = t.get("raw_series", false)) {
+    if (!n->is_boolean()) t.fail(n, "raw_series", "expected true or false");
+    s.raw_series = n->as_boolean()->get();
+  }
+  t.check_unknown({"name", "hidden", "frequencies_Hz", "amplitudes_g", "directions", "orientations_g", "run_sigma_ug",
+                   "positions_per_series", "raw_series"});
+  c.campaign = s;
+}
+
 }  // namespace
 
 Case read_case(const std::string& path) {
@@ -840,9 +884,10 @@ Case read_case(const std::string& path) {
   if (auto t = top.subtable("shaker", false)) read_shaker(*t, c);
   if (auto t = top.subtable("frequency_study", false)) read_frequency_study(*t, c);
   if (auto t = top.subtable("reproduce", false)) read_reproduce(*t, c);
+  if (auto t = top.subtable("campaign", false)) read_campaign(*t, c);
   top.check_unknown({"g_m_per_s2", "instrument", "coefficients", "orientation", "vibration", "range",
                      "dividing_head", "identification", "run", "plant", "readout", "shake", "sweep", "shaker",
-                     "frequency_study", "reproduce"});
+                     "frequency_study", "reproduce", "campaign"});
   return c;
 }
 

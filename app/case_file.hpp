@@ -22,6 +22,7 @@
 #include "rectification/sweep.hpp"
 #include "validation/dividing_head.hpp"
 #include "validation/identification.hpp"
+#include "validation/campaign.hpp"
 #include "validation/reproduce.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/demand.hpp"
@@ -74,6 +75,14 @@ struct ReproduceSpec {
   int threads = 0;
 };
 
+// The [campaign] table: what `vrelab campaign` hides in the truth and how the lab tests it.
+struct CampaignSpec {
+  std::vector<validation::HiddenEffect> hidden;
+  validation::CampaignDesign design = validation::default_design();
+  bool raw_series = false;  // write each run's record (time, output) instead of its summary
+  std::string name = "campaign";
+};
+
 struct Case {
   std::string path;
   nlohmann::json content;  // the file, as JSON
@@ -97,6 +106,7 @@ struct Case {
   std::optional<rectification::FrequencyStudySettings> frequency_study;  // [frequency_study]
   int sweep_threads = 0;                          // 0: all cores
   std::optional<ReproduceSpec> reproduce;         // [reproduce]
+  std::optional<CampaignSpec> campaign;           // [campaign]
 };
 
 Case read_case(const std::string& path);

@@ -69,4 +69,24 @@ struct ReproduceOptions {
 // The paper's experiment end to end: report.html, report.md, figures, CSV/JSON (app/reproduce.cpp).
 void run_reproduce(const ReproduceOptions& o, std::ostream& out);
 
+// Issue 5 (app/diagnose.cpp): the virtual lab, the diagnosis, and the blind test.
+struct CampaignOptions {
+  std::string case_path, out_dir, key_path;  // key: default <out_dir>.key.json
+  std::optional<std::uint64_t> seed;
+};
+void run_campaign(const CampaignOptions& o, std::ostream& out);
+
+struct DiagnoseOptions {
+  std::string dir, json_path, report_dir;
+};
+void run_diagnose(const DiagnoseOptions& o, std::ostream& out);
+
+struct BlindOptions {
+  int n = 40;
+  std::uint64_t seed = 7;
+  std::string out_dir = "out/blind";
+  int threads = 0;  // 0: all cores
+};
+void run_blind(const BlindOptions& o, std::ostream& out);
+
 }  // namespace vrelab::app

@@ -83,6 +83,27 @@ int main(int argc, char** argv) {
   bool no_plots = false;
   reproduce->add_flag("--no-plots", no_plots, "Write the data and the report without figures");
 
+  CampaignOptions cp;
+  auto* campaign = app.add_subcommand("campaign", "The virtual lab: a whole campaign from a truth with hidden effects, "
+                                                  "in the lab data format, and its answer key");
+  campaign->add_option("case", cp.case_path, "Case file (TOML) with [coefficients], [plant] and [campaign]")->required();
+  campaign->add_option("--out", cp.out_dir, "Campaign folder (docs/data-format.md)")->required();
+  campaign->add_option("--key", cp.key_path, "Answer key (JSON; default <out>.key.json); diagnose never reads it");
+  campaign->add_option("--seed", cp.seed, "Seed (default: the case's [run] seed)");
+
+  DiagnoseOptions dg;
+  auto* diagnose = app.add_subcommand("diagnose", "The sim-to-real gap of a campaign: where, which effect, how far it shrinks");
+  diagnose->add_option("dir", dg.dir, "Campaign folder (docs/data-format.md)")->required();
+  diagnose->add_option("--json", dg.json_path, "Write the diagnosis as JSON");
+  diagnose->add_option("--report", dg.report_dir, "Write report.md, report.html and diagnosis.json to this folder");
+
+  BlindOptions bl;
+  auto* blind = app.add_subcommand("blind", "Campaigns with random hidden effects, diagnosed without their keys, then scored");
+  blind->add_option("--n", bl.n, "Number of campaigns")->capture_default_str();
+  blind->add_option("--seed", bl.seed, "Seed of the draw")->capture_default_str();
+  blind->add_option("--out", bl.out_dir, "Output folder (scores.json, confusion.csv)")->capture_default_str();
+  blind->add_option("--threads", bl.threads, "Threads (0: all cores)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -95,6 +116,9 @@ int main(int argc, char** argv) {
     if (*shake) run_shake(sh, std::cout);
     if (*measure) run_measure(me, std::cout);
     if (*frequency) run_frequency(fr, std::cout);
+    if (*campaign) run_campaign(cp, std::cout);
+    if (*diagnose) run_diagnose(dg, std::cout);
+    if (*blind) run_blind(bl, std::cout);
     if (*reproduce) {
       rp.plots = !no_plots;
       run_reproduce(rp, std::cout);

@@ -1,0 +1,350 @@
+// app/diagnose.cpp -- `vrelab campaign`, `vrelab diagnose`, `vrelab blind` (issue 5).
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <random>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "app/case_file.hpp"
+#include "app/commands.hpp"
+#include "app/lab_data.hpp"
+#include "app/output.hpp"
+#include "app/report.hpp"
+#include "validation/campaign.hpp"
+#include "validation/diagnose.hpp"
+#include "vrelab_version.hpp"
+
+namespace vrelab::app {
+namespace {
+
+using nlohmann::json;
+
+json diagnosis_json(const validation::Diagnosis& d, const validation::Campaign& c) {
+  json effects = json::array();
+  for (const auto& e : d.effects)
+    effects.push_back({{"name", e.name},
+                       {"parameter", e.value},
+                       {"parameter_name", e.parameter},
+                       {"unit", e.unit},
+                       {"sigma", std::isfinite(e.sigma) ? json(e.sigma) : json(nullptr)},
+                       {"evidence", e.evidence},
+                       {"heldout_chi2", e.heldout_chi2}});
+  json runs = json::array();
+  for (std::size_t k = 0; k < c.runs.size(); ++k) {
+    const auto& r = c.runs[k];
+    const auto& x = d.runs[k];
+    runs.push_back({{"id", r.id},
+                    {"frequency_Hz", r.frequency_Hz},
+                    {"amplitude_g", r.amplitude_g},
+                    {"direction", vec_json(r.direction)},
+                    {"orientation_g", vec_json(r.orientation_g)},
+                    {"measured_g", r.measured_g},
+                    {"sigma_measured_g", r.sigma_g},
+                    {"predicted_g", x.predicted_g},
+                    {"sigma_predicted_g", x.sigma_predicted_g},
+                    {"gap_g", x.gap_g},
+                    {"z", x.z},
+                    {"heldout_after_g", x.heldout_after_g}});
+  }
+  return {{"gap_significant", d.gap_significant},
+          {"verdict", d.verdict},
+          {"explained", d.explained},
+          {"where", d.where},
+          {"significant_runs", d.significant_runs},
+          {"chi2_nominal", d.chi2_nominal},
+          {"amplitude_power", d.amplitude_power},
+          {"effects", effects},
+          {"shrinkage",
+           {{"rms_before_g", d.rms_before_g},
+            {"rms_after_g", d.rms_after_g},
+            {"rms_before_sigma", d.rms_before_sigma},
+            {"rms_after_sigma", d.rms_after_sigma},
+            {"fraction_removed", d.rms_before_g > 0 ? 1 - d.rms_after_g / d.rms_before_g : 0.0},
+            {"on", "held-out runs (leave one amplitude out), gap the static test's coefficient errors cannot take up"}}},
+          {"identified", coefficients_json(d.identified)},
+          {"skipped_runs", c.skipped},
+          {"runs", runs}};
+}
+
+// The truth of a blind campaign: paper-like coefficients, each perturbed, drawn from rng.
+plant::PlantConfig random_truth(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.7, 1.3);
+  std::bernoulli_distribution sign(0.5);
+  plant::PlantConfig p;
+  auto& c = p.coefficients;
+  c[plant::K1] = 1.25 * u(rng), c[plant::k0] = 1.5e-3 * u(rng), c[plant::k1_asym] = 2e-5 * u(rng);
+  c[plant::k2] = 1.5e-5 * u(rng), c[plant::k3] = 1e-6 * u(rng), c[plant::k4] = 2e-7 * u(rng);
+  c[plant::delta_OA] = 1e-4 * u(rng), c[plant::delta_PA] = -5e-5 * u(rng);
+  for (int i : {plant::k_IP, plant::k_IO, plant::k_PO}) c[i] = (sign(rng) ? 1 : -1) * 5e-6 * u(rng);
+  return p;
+}
+
+double log_uniform(std::mt19937_64& rng, double lo, double hi) {
+  return std::exp(std::uniform_real_distribution<double>(std::log(lo), std::log(hi))(rng));
+}
+
+// A hidden effect's parameter, drawn where its gap is several sigma in the default design.
+validation::HiddenEffect draw_effect(const std::string& name, std::mt19937_64& rng) {
+  std::bernoulli_distribution sign(0.5);
+  const double s = sign(rng) ? 1 : -1;
+  if (name == "pickoff_nonlinearity") return {name, s * log_uniform(rng, 5, 50)};
+  if (name == "pendulum_geometry") return {name, 1};
+  if (name == "quadratic_cross_axis") return {name, s * log_uniform(rng, 0.5e-6, 5e-6)};
+  if (name == "nonlinearity_at_input") return {name, 1};
+  if (name == "servo_dynamics") return {name, sign(rng) ? log_uniform(rng, 0.6, 0.85) : log_uniform(rng, 1.15, 1.6)};
+  if (name == "mechanical_mode") return {name, log_uniform(rng, 300, 1200)};
+  if (name == "shaker_transverse_motion") return {name, s * log_uniform(rng, 0.02, 0.1)};
+  if (name == "shaker_harmonic_distortion") return {name, log_uniform(rng, 0.1, 0.3)};
+  throw std::invalid_argument("blind: no parameter range for " + name);
+}
+
+}  // namespace
+
+void run_campaign(const CampaignOptions& o, std::ostream& out) {
+  Case c = read_case(o.case_path);
+  require(c, c.coefficients.has_value(), "coefficients", "campaign");
+  require(c, c.campaign.has_value(), "campaign", "campaign");
+  if (c.physical) throw InputError(c.path + ": campaign takes a plant built from coefficients");
+  if (o.seed) c.seed = *o.seed;
+  const CampaignSpec& spec = *c.campaign;
+  if (spec.raw_series)
+    throw InputError(c.path + ": [campaign] raw_series: writing raw records is not implemented yet (summaries only)");
+  const auto start = std::chrono::steady_clock::now();
+  validation::Campaign camp = validation::simulate_campaign(c.plant, spec.hidden, spec.design, c.seed, 0);
+  camp.name = spec.name;
+  LabManifest m;
+  m.name = spec.name, m.output_unit = c.output_unit, m.g_m_per_s2 = c.g_m_per_s2;
+  write_campaign(o.out_dir, camp, m);
+  json key = result_record("campaign", c);
+  key["hidden"] = json::array();
+  for (const auto& h : spec.hidden) key["hidden"].push_back({{"name", h.name}, {"parameter", h.parameter}});
+  key["truth"] = coefficients_json(c.plant.coefficients);
+  key["data"] = o.out_dir;
+  const std::string key_path = o.key_path.empty() ? o.out_dir + ".key.json" : o.key_path;
+  write_atomic(key_path, key.dump(2) + "\n");
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out << fmt::format("vrelab {} ({}) campaign {}  [seed {}]\n", kProgramVersion, kGitDescribe, c.path, c.seed);
+  out << fmt::format("Wrote {} static readings and {} shaker runs to {} (lab data format, docs/data-format.md); the answer "
+                     "key to {} ({:.1f} s wall)\n",
+                     camp.statics.size(), camp.runs.size(), o.out_dir, key_path, wall);
+}
+
+void run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
+  LabManifest m;
+  const validation::Campaign c = read_campaign(o.dir, &m);
+  if (c.runs.empty()) throw InputError(o.dir + ": no usable shaker run" + (c.skipped.empty() ? "" : ": " + c.skipped.front()));
+  const auto start = std::chrono::steady_clock::now();
+  validation::Diagnosis d;
+  try {
+    d = validation::diagnose(c);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(o.dir + ": " + e.what());
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  out << fmt::format("vrelab {} ({}) diagnose {}\n", kProgramVersion, kGitDescribe, o.dir);
+  out << fmt::format("{} static readings, {} shaker runs ({} skipped)\n", c.statics.size(), c.runs.size(), c.skipped.size());
+  for (const auto& s : c.skipped) out << "  skipped: " << s << "\n";
+  out << "Gap: " << d.where << "\n";
+  out << "Verdict: " << d.verdict << "\n";
+  out << fmt::format("  {:<26}{:>16}{:>12}{:>12}{:>14}\n", "effect", "parameter", "sigma", "evidence", "held-out chi2");
+  for (const auto& e : d.effects)
+    out << fmt::format("  {:<26}{:>16.5g}{:>12.3g}{:>12.1f}{:>14.1f}  {} ({})\n", e.name, e.value, e.sigma, e.evidence,
+                       e.heldout_chi2, e.parameter, e.unit);
+  out << fmt::format("Held-out gap rms: {:.4g} ug ({:.3g} sigma) before, {:.4g} ug ({:.3g} sigma) after {} ({:.1f} s wall)\n",
+                     d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, d.effects.front().name,
+                     wall);
+  json j = {{"program", program_record()}, {"command", "diagnose"}, {"data", o.dir}, {"campaign", c.name}};
+  j.update(diagnosis_json(d, c));
+  j["units"] = {{"gap", "g"}, {"parameter", "see each effect's unit"}};
+  if (!o.json_path.empty()) write_atomic(o.json_path, j.dump(2) + "\n");
+  if (!o.report_dir.empty()) {
+    Report rep("vrelab diagnose: " + o.dir);
+    rep.paragraph(fmt::format("vrelab {} ({}). {} static readings, {} shaker runs, {} skipped.", kProgramVersion, kGitDescribe,
+                              c.statics.size(), c.runs.size(), c.skipped.size()));
+    if (!c.skipped.empty()) rep.list(c.skipped);
+    rep.heading("1. Where the gap lies");
+    rep.paragraph(d.where + fmt::format(". |gap| scales as amplitude^{:.2f} over the significant runs.", d.amplitude_power));
+    rep.heading("2. Which effect");
+    std::vector<std::vector<std::string>> rows = {{"effect", "parameter", "value", "sigma", "evidence (held-out -2 ln L)",
+                                                   "held-out chi2"}};
+    for (const auto& e : d.effects)
+      rows.push_back({e.name, e.parameter + " (" + e.unit + ")", fmt::format("{:.5g}", e.value), fmt::format("{:.3g}", e.sigma),
+                      fmt::format("{:.1f}", e.evidence), fmt::format("{:.1f}", e.heldout_chi2)});
+    rep.table(rows);
+    rep.paragraph("Verdict: " + d.verdict + ".");
+    rep.heading("3. How far it shrinks");
+    rep.paragraph(fmt::format(
+        "On the held-out runs (each amplitude predicted from the others), the gap the static test's coefficient errors "
+        "cannot take up has rms {:.4g} ug ({:.3g} sigma) with the nominal simulation and {:.4g} ug ({:.3g} sigma) with {} "
+        "added: {:.0f} % removed.",
+        d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, d.effects.front().name,
+        d.rms_before_g > 0 ? 100 * (1 - d.rms_after_g / d.rms_before_g) : 0.0));
+    write_atomic(o.report_dir + "/report.md", rep.markdown());
+    write_atomic(o.report_dir + "/report.html", rep.html());
+    write_atomic(o.report_dir + "/diagnosis.json", j.dump(2) + "\n");
+  }
+}
+
+void run_blind(const BlindOptions& o, std::ostream& out) {
+  if (o.n < 1) throw InputError("--n: at least one campaign");
+  const int threads = o.threads > 0 ? o.threads : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  struct Case1 {
+    int index = 0;
+    std::uint64_t seed = 0;
+    std::string category;  // clean, single, two, out_of_library
+    std::vector<validation::HiddenEffect> hidden;
+    validation::Diagnosis d;
+    std::string error;
+  };
+  std::vector<Case1> cases(static_cast<std::size_t>(o.n));
+  std::vector<std::string> library;
+  for (const auto& e : validation::effect_library()) library.push_back(e.name);
+  for (int i = 0; i < o.n; ++i) {
+    Case1& k = cases[static_cast<std::size_t>(i)];
+    k.index = i, k.seed = o.seed * 1000003u + static_cast<std::uint64_t>(i);
+    std::mt19937_64 rng(k.seed);
+    const int slot = i % 10;  // 2 clean, 1 out of library, 1 with two effects, 6 single in 10
+    if (slot < 2) {
+      k.category = "clean";
+    } else if (slot == 2) {
+      k.category = "out_of_library";
+      k.hidden.push_back(draw_effect("shaker_harmonic_distortion", rng));
+    } else if (slot == 3) {
+      k.category = "two";
+      std::vector<std::string> pick = library;
+      std::shuffle(pick.begin(), pick.end(), rng);
+      k.hidden = {draw_effect(pick[0], rng), draw_effect(pick[1], rng)};
+    } else {
+      k.category = "single";
+      k.hidden.push_back(draw_effect(library[std::uniform_int_distribution<std::size_t>(0, library.size() - 1)(rng)], rng));
+    }
+  }
+  const auto start = std::chrono::steady_clock::now();
+  std::atomic<int> next{0}, done{0};
+  std::mutex lock;
+  auto worker = [&] {
+    for (int i = next++; i < o.n; i = next++) {
+      Case1& k = cases[static_cast<std::size_t>(i)];
+      try {
+        std::mt19937_64 rng(k.seed + 17);
+        const plant::PlantConfig truth = random_truth(rng);
+        const validation::Campaign camp = validation::simulate_campaign(truth, k.hidden, validation::default_design(), k.seed, 1);
+        k.d = validation::diagnose(camp);  // the key (k.hidden) is not passed
+      } catch (const std::exception& e) {
+        k.error = e.what();
+      }
+      std::lock_guard<std::mutex> g(lock);
+      ++done;
+      out << fmt::format("\r  {}/{} campaigns", done.load(), o.n) << std::flush;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < threads; ++t) pool.emplace_back(worker);
+  worker();
+  for (auto& t : pool) t.join();
+  out << "\n";
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  // Scores against the keys.
+  int single = 0, single_right = 0, clean = 0, false_alarms = 0, ool = 0, ool_unexplained = 0, two = 0, two_hit = 0;
+  std::vector<double> shrink;
+  std::map<std::string, std::map<std::string, int>> confusion;
+  json rows = json::array();
+  std::vector<std::string> wrong;
+  for (const Case1& k : cases) {
+    const std::string truth = k.category == "single" ? k.hidden[0].name : k.category;
+    std::string called = "error";
+    if (k.error.empty()) called = !k.d.gap_significant ? "clean" : k.d.explained ? k.d.effects.front().name : "unexplained";
+    ++confusion[truth][called];
+    const std::string top = k.error.empty() ? k.d.effects.front().name : "";
+    if (k.category == "single") {
+      ++single;
+      const bool right = k.error.empty() && k.d.gap_significant && top == k.hidden[0].name;
+      single_right += right;
+      if (k.error.empty() && k.d.rms_before_g > 0) shrink.push_back(1 - k.d.rms_after_g / k.d.rms_before_g);
+      if (!right)
+        wrong.push_back(fmt::format("campaign {} (seed {}): {} = {:.4g} hidden; called {} (top {}){}", k.index, k.seed,
+                                    k.hidden[0].name, k.hidden[0].parameter, called, top,
+                                    k.error.empty() ? "" : ": " + k.error));
+    } else if (k.category == "clean") {
+      ++clean;
+      false_alarms += called != "clean";
+      if (called != "clean") wrong.push_back(fmt::format("campaign {} (seed {}): clean, called {}", k.index, k.seed, called));
+    } else if (k.category == "out_of_library") {
+      ++ool;
+      ool_unexplained += called == "unexplained";
+      if (called != "unexplained")
+        wrong.push_back(fmt::format("campaign {} (seed {}): out of library ({} = {:.3g}), called {}", k.index, k.seed,
+                                    k.hidden[0].name, k.hidden[0].parameter, called));
+    } else {
+      ++two;
+      two_hit += k.error.empty() && (top == k.hidden[0].name || top == k.hidden[1].name);
+    }
+    json h = json::array();
+    for (const auto& x : k.hidden) h.push_back({{"name", x.name}, {"parameter", x.parameter}});
+    json row = {{"index", k.index}, {"seed", k.seed}, {"category", k.category}, {"hidden", h}, {"called", called}};
+    if (k.error.empty()) {
+      row["top"] = top;
+      row["top_parameter"] = k.d.effects.front().value;
+      row["rms_before_g"] = k.d.rms_before_g, row["rms_after_g"] = k.d.rms_after_g;
+      row["where"] = k.d.where;
+    } else {
+      row["error"] = k.error;
+    }
+    rows.push_back(row);
+  }
+  std::sort(shrink.begin(), shrink.end());
+  const double median_shrink = shrink.empty() ? 0.0 : shrink[shrink.size() / 2];
+  json scores = {{"program", program_record()},
+                 {"command", "blind"},
+                 {"n", o.n},
+                 {"seed", o.seed},
+                 {"wall_s", wall},
+                 {"threads", threads},
+                 {"top1_accuracy", single ? static_cast<double>(single_right) / single : 0.0},
+                 {"single_effect_campaigns", single},
+                 {"false_alarm_rate", clean ? static_cast<double>(false_alarms) / clean : 0.0},
+                 {"clean_campaigns", clean},
+                 {"unexplained_recognition", ool ? static_cast<double>(ool_unexplained) / ool : 0.0},
+                 {"out_of_library_campaigns", ool},
+                 {"two_effect_top1_is_one_of_them", two ? static_cast<double>(two_hit) / two : 0.0},
+                 {"two_effect_campaigns", two},
+                 {"median_shrinkage", median_shrink},
+                 {"wrong", wrong},
+                 {"confusion", confusion},
+                 {"campaigns", rows}};
+  write_atomic(o.out_dir + "/scores.json", scores.dump(2) + "\n");
+  std::vector<std::string> called_names = {"clean"};
+  for (const auto& n : library) called_names.push_back(n);
+  called_names.push_back("unexplained");
+  std::string csv = "# rows: the hidden truth; columns: what diagnose called it (without the key)\ntruth";
+  for (const auto& n : called_names) csv += "," + n;
+  csv += "\n";
+  std::vector<std::string> truths = {"clean"};
+  for (const auto& n : library) truths.push_back(n);
+  truths.push_back("out_of_library");
+  truths.push_back("two");
+  for (const auto& t : truths) {
+    csv += t;
+    for (const auto& n : called_names) csv += fmt::format(",{}", confusion.count(t) && confusion[t].count(n) ? confusion[t][n] : 0);
+    csv += "\n";
+  }
+  write_atomic(o.out_dir + "/confusion.csv", csv);
+  out << fmt::format("vrelab {} ({}) blind --n {} --seed {}: {:.1f} s wall on {} threads\n", kProgramVersion, kGitDescribe, o.n,
+                     o.seed, wall, threads);
+  out << fmt::format("  top-1 attribution (single in-library effects): {}/{} = {:.0f} %\n", single_right, single,
+                     single ? 100.0 * single_right / single : 0.0);
+  out << fmt::format("  false alarms on clean campaigns: {}/{}\n", false_alarms, clean);
+  out << fmt::format("  out-of-library called unexplained: {}/{}\n", ool_unexplained, ool);
+  out << fmt::format("  two effects, top-1 one of them: {}/{}\n", two_hit, two);
+  out << fmt::format("  median held-out shrinkage of the gap rms: {:.0f} %\n", 100 * median_shrink);
+  for (const auto& w : wrong) out << "  wrong: " << w << "\n";
+  out << "Wrote " << o.out_dir << "/scores.json and confusion.csv\n";
+}
+
+}  // namespace vrelab::app
