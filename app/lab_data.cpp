@@ -371,7 +371,7 @@ void write_campaign(const std::string& dir, const validation::Campaign& c, const
     rn += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.12g},{:.12g},{:.12g},", r.id, r.frequency_Hz, r.amplitude_g,
                       r.direction[0], r.direction[1], r.direction[2], r.orientation_g[0], r.orientation_g[1], r.orientation_g[2]);
     if (raw.empty())
-      rn += fmt::format("{:.8g},{:.6g}\n", r.measured_g * 1e6, r.sigma_g * 1e6);
+      rn += fmt::format("{:.10g},{:.6g}\n", r.measured_g * 1e6, r.sigma_g * 1e6);
     else
       rn += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g}\n", raw[k].file, raw[k].rest_from_s, raw[k].rest_to_s,
                         raw[k].on_from_s, raw[k].on_to_s);

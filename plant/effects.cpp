@@ -27,6 +27,12 @@ MechanicalMode::MechanicalMode(double f, double z, const Vec3& mask)
   if (!(z > 0) || !std::isfinite(z)) throw std::invalid_argument("mode damping_ratio must be positive");
 }
 
+std::complex<double> MechanicalMode::transmissibility(int axis, double w) const {
+  if (mask_[axis] == 0) return 1.0;
+  const std::complex<double> s(0, w);
+  return (w_ * w_ + 2 * z_ * w_ * s) / (s * s + 2 * z_ * w_ * s + w_ * w_);
+}
+
 double MechanicalMode::state_scale(int k) const { return k % 2 == 0 ? 1 / (w_ * w_) : 1 / w_; }
 
 void MechanicalMode::rest_state(const Vec3& a, double* s) const {

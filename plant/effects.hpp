@@ -7,6 +7,7 @@
 // a new class here and a line in the case reader. Each hook's default is the identity, so
 // an effect overrides only where it acts. None of the shipped effects changes the static
 // response inside the range: the static identification cannot see them.
+#include <complex>
 #include <memory>
 #include <string>
 
@@ -82,6 +83,8 @@ class MechanicalMode final : public Effect {
   double state_scale(int k) const override;
   void rest_state(const Vec3& a_static_g, double* s) const override;
   Vec3 input(const Vec3& a_g, const double* s, double* ds) const override;
+  // Its transmissibility on axis i at angular frequency w (1 on an axis it does not act on).
+  std::complex<double> transmissibility(int axis, double w_rad_per_s) const;
 
  private:
   double w_, z_;

@@ -18,8 +18,13 @@ LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
   for (int c : {k1_asym, k2, k3, k4, k_IP, k_IO, k_PO, k_PP, k_OO}) lin_cfg.coefficients[c] = 0.0;
   lin_cfg.torquer_c2_per_g = lin_cfg.torquer_c3_per_g2 = 0.0;
   lin_cfg.effects.clear();
+  LoopResponse out;
+  const double w_rad = 2 * std::numbers::pi * frequency_Hz;
   for (const auto& e : config.effects)
-    if (dynamic_cast<const MechanicalMode*>(e.get())) lin_cfg.effects.push_back(e);  // linear: keep
+    if (const auto* mode = dynamic_cast<const MechanicalMode*>(e.get())) {
+      lin_cfg.effects.push_back(e);  // linear: keep
+      for (int j = 0; j < 3; ++j) out.mechanical[static_cast<std::size_t>(j)] *= mode->transmissibility(j, w_rad);
+    }
   // Linear: the response does not depend on the static orientation (IA up is as good as any).
   const Accelerometer plant(lin_cfg, Vec3(1, 0, 0));
   const Accelerometer::Linear lin = plant.linearise();
@@ -31,7 +36,6 @@ LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
   // k = lead pole / lead zero (plant/accelerometer.cpp, the servo's realisation).
   const plant::Servo& sv = plant.servo();
   const double lead_ratio = sv.lead_pole_rad_per_s / sv.lead_zero_rad_per_s;
-  LoopResponse out;
   out.frequency_Hz = frequency_Hz;
   for (int j = 0; j < 3; ++j) {
     out.current[j] = lead_ratio * sv.gain_g_per_rad * x(Accelerometer::kTheta, j) + (1 - lead_ratio) * x(Accelerometer::kLead, j) +
@@ -65,8 +69,14 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
     if (const auto* p = dynamic_cast<const PickoffNonlinearity*>(e.get())) p2 += p->p2_per_rad();
     if (dynamic_cast<const PendulumGeometry*>(e.get())) geometry = true;
   }
-  Eigen::Vector3cd W;
-  for (int i = 0; i < 3; ++i) W[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
+  Eigen::Vector3cd W, F;  // the case's vibration, and what the pendulum's base feels
+  vibration::SineVibration felt = v;
+  for (int i = 0; i < 3; ++i) {
+    W[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
+    F[i] = h.mechanical[static_cast<std::size_t>(i)] * W[i];
+    felt.amplitude_g[i] = std::abs(F[i]);
+    felt.phase_rad[i] = std::arg(F[i]);
+  }
   const std::complex<double> current = h.current[0] * W[0] + h.current[1] * W[1] + h.current[2] * W[2];
   const double dc_gain = h.dc_gain;
   FrequencyPrediction out;
@@ -75,7 +85,7 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
 
   // Terms of (1): each through the place where it acts.
   const double amp_i = std::abs(current);
-  vibration::SineVibration through_loop = v;
+  vibration::SineVibration through_loop = felt;
   through_loop.amplitude_g[IA] = amp_i;
   for (int c = k0; c < kNumCoefficients; ++c) {
     if (c == k0 || c == delta_OA || c == delta_PA || config.coefficients[c] == 0) continue;
@@ -84,7 +94,7 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
     only[c] = config.coefficients[c];
     const bool ia_term = c <= k4;
     const bool filtered = ia_term && config.location[c] != Location::input;
-    const Eq3Terms t = sine_rectification(only, a, filtered ? through_loop : v);
+    const Eq3Terms t = sine_rectification(only, a, filtered ? through_loop : felt);
     // What rectifies before the loop (input, torquer) reaches the output with the loop's DC gain.
     const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
     for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
@@ -96,7 +106,7 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
   const std::complex<double> theta = out.angle_amplitude_rad;
   out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * std::norm(theta) / 2;
   if (geometry)
-    out.pendulum_geometry_g = dc_gain * (-0.5 * std::real(W[PA] * std::conj(theta)) - a[IA] * std::norm(theta) / 4);
+    out.pendulum_geometry_g = dc_gain * (-0.5 * std::real(F[PA] * std::conj(theta)) - a[IA] * std::norm(theta) / 4);
   out.loop_dc_gain = dc_gain;
   return out;
 }

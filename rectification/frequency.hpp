@@ -17,7 +17,8 @@
 // rectifies before the loop (input terms, the torquer, the pendulum geometry) reaches the
 // output with the loop's DC gain: 1 with the integrator, L0/(1 + L0) without (L0 = b G/w_p^2).
 // The pickoff formula assumes the integrator (<u> = 0).
-// Not covered: input-placed terms behind a mechanical mode (they are computed unfiltered).
+// Behind a mechanical mode, the input-placed terms, the cross terms and the pendulum geometry
+// see the vibration through the mode's transmissibility (what the pendulum's base feels).
 #include <array>
 #include <complex>
 
@@ -49,6 +50,9 @@ FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& pl
 struct LoopResponse {
   double frequency_Hz = 0;
   std::array<std::complex<double>, 3> current{}, angle_rad{};
+  // What the pendulum's base feels per g of case vibration on each axis: the mechanical
+  // modes' transmissibility (1 without a mode).
+  std::array<std::complex<double>, 3> mechanical{1.0, 1.0, 1.0};
   double dc_gain = 1;
 };
 LoopResponse loop_response(const plant::PlantConfig& plant, double frequency_Hz);

@@ -1,0 +1,233 @@
+// Issue 5: the effect library's predictions against the ODE truth, diagnose on small
+// simulated campaigns (clean, one hidden effect, one outside the library), and the lab data
+// format (round trip, the hand-written example, bad input that skips runs or stops).
+// Seeds here (31, 32, 33, 41) were not used to develop the diagnosis (that used 7 and
+// blind --seed 3).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <regex>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "app/case_file.hpp"
+#include "app/lab_data.hpp"
+#include "plant/effects.hpp"
+#include "rectification/shake.hpp"
+#include "validation/campaign.hpp"
+#include "validation/diagnose.hpp"
+#include "vibration/excitation.hpp"
+
+using namespace vrelab;
+using namespace vrelab::validation;
+namespace fs = std::filesystem;
+
+namespace {
+
+plant::PlantConfig truth() {
+  plant::PlantConfig p;
+  auto& c = p.coefficients;
+  c[plant::K1] = 1.25, c[plant::k0] = 1.5e-3, c[plant::k1_asym] = 2e-5, c[plant::k2] = 1.5e-5, c[plant::k3] = 1e-6;
+  c[plant::k4] = 2e-7, c[plant::delta_OA] = 1e-4, c[plant::delta_PA] = -5e-5, c[plant::k_IP] = 8e-6;
+  c[plant::k_IO] = -5e-6, c[plant::k_PO] = 3e-6;
+  return p;
+}
+
+// A smaller design than the default (36 runs), for test time.
+CampaignDesign small_design() {
+  CampaignDesign d = default_design();
+  d.frequencies_Hz = {10, 100, 400, 1000};
+  d.amplitudes_g = {1, 2, 4};
+  d.directions = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0).normalized()};
+  return d;
+}
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    path = fs::temp_directory_path() / ("vrelab-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+                                        "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+}  // namespace
+
+TEST(EffectLibrary, EachEffectsPredictionMatchesTheOdeWithThatEffect) {
+  // The diagnosis compares the campaign (the ODE with the hidden effect) with the
+  // frequency-dependent eq. (3) with the candidate effect: they must agree where the effect
+  // matters. 4 g along IA+PA (every effect acts), at 40 and 400 Hz; bound 1 % of the
+  // prediction + 0.05 ug (the first-order model; docs/frequency.md measured <= 0.1 %).
+  const struct {
+    const char* name;
+    double p;
+  } cases[] = {{"pickoff_nonlinearity", 20},  {"pendulum_geometry", 1},   {"quadratic_cross_axis", 2e-6},
+               {"nonlinearity_at_input", 1},  {"servo_dynamics", 0.7},    {"mechanical_mode", 700},
+               {"shaker_transverse_motion", 0.05}};
+  for (const auto& c : cases) {
+    const EffectModel* e = find_effect(c.name);
+    ASSERT_NE(e, nullptr) << c.name;
+    for (double f : {40.0, 400.0}) {
+      RunRecord r;
+      r.frequency_Hz = f, r.amplitude_g = 4, r.direction = Vec3(1, 1, 0).normalized(), r.orientation_g = Vec3(1, 0, 1).normalized();
+      plant::PlantConfig p = truth();
+      vibration::SineVibration table = r.vibration();
+      std::optional<double> range;
+      e->apply(c.p, p, table, range);
+      const vibration::SineExcitation motion(table);
+      const double ode = rectification::shake_sine(p, r.orientation_g, r.vibration(), {}, {}, &motion).measured_g;
+      const double pred = predict_run_g(truth(), r, e, c.p);
+      EXPECT_NEAR(pred, ode, 0.01 * std::abs(pred) + 0.05e-6) << c.name << " at " << f << " Hz";
+      // And the effect is not nothing there (the test could not fail otherwise).
+      if (f == 400.0) {
+        EXPECT_GT(std::abs(pred - predict_run_g(truth(), r)), 0.3e-6) << c.name;  // a run's sigma in the campaigns
+      }
+    }
+  }
+}
+
+TEST(Diagnose, CleanCampaignHasNoSignificantGap) {
+  const Campaign c = simulate_campaign(truth(), {}, small_design(), 31, 2);
+  const Diagnosis d = diagnose(c);
+  EXPECT_FALSE(d.gap_significant) << d.where;
+  EXPECT_EQ(d.verdict, "no significant gap");
+  EXPECT_LT(d.max_abs_z, 5.0);
+}
+
+TEST(Diagnose, HiddenPickoffNonlinearityIsFoundFittedAndRemoved) {
+  const Campaign c = simulate_campaign(truth(), {{"pickoff_nonlinearity", -12.0}}, small_design(), 32, 2);
+  const Diagnosis d = diagnose(c);
+  ASSERT_TRUE(d.gap_significant);
+  EXPECT_TRUE(d.explained) << d.verdict;
+  EXPECT_EQ(d.effects.front().name, "pickoff_nonlinearity");
+  // The parameter: within 2 % of the truth (its statistical sigma is ~0.03 /rad; the
+  // first-order model's own error, ~0.1 %, dominates).
+  EXPECT_NEAR(d.effects.front().value, -12.0, 0.24);
+  // The issue's bar: >= 80 % of the held-out gap rms removed.
+  EXPECT_LT(d.rms_after_g, 0.2 * d.rms_before_g);
+  // The gap grows as amplitude^2 (the pendulum angle squared).
+  EXPECT_NEAR(d.amplitude_power, 2.0, 0.3);
+}
+
+TEST(Diagnose, ServoDynamicsAreTellApartFromAResonance) {
+  const Campaign c = simulate_campaign(truth(), {{"servo_dynamics", 1.3}}, small_design(), 33, 2);
+  const Diagnosis d = diagnose(c);
+  ASSERT_TRUE(d.gap_significant);
+  EXPECT_EQ(d.effects.front().name, "servo_dynamics");
+  EXPECT_NEAR(d.effects.front().value, 1.3, 0.02);
+}
+
+TEST(Diagnose, AnEffectOutsideTheLibraryIsNotExplained) {
+  const Campaign c = simulate_campaign(truth(), {{"shaker_harmonic_distortion", 0.3}}, small_design(), 41, 2);
+  const Diagnosis d = diagnose(c);
+  ASSERT_TRUE(d.gap_significant) << d.where;
+  EXPECT_FALSE(d.explained) << d.verdict;
+}
+
+TEST(LabData, RoundTripAndTheHandWrittenExample) {
+  TempDir t;
+  const Campaign c = simulate_campaign(truth(), {}, small_design(), 31, 2);
+  app::LabManifest m;
+  m.name = "round trip";
+  app::write_campaign(t.path.string(), c, m);
+  app::LabManifest m2;
+  const Campaign back = app::read_campaign(t.path.string(), &m2);
+  EXPECT_EQ(m2.name, "round trip");
+  ASSERT_EQ(back.runs.size(), c.runs.size());
+  ASSERT_EQ(back.statics.size(), c.statics.size());
+  for (std::size_t k = 0; k < c.runs.size(); ++k) {
+    EXPECT_NEAR(back.runs[k].measured_g, c.runs[k].measured_g, 1e-9 * std::abs(c.runs[k].measured_g) + 1e-16);  // 10 digits
+    EXPECT_NEAR((back.runs[k].direction - c.runs[k].direction).norm(), 0, 1e-9);
+  }
+  for (std::size_t k = 0; k < c.statics.size(); ++k) EXPECT_NEAR(back.statics[k].output, c.statics[k].output, 1e-14);
+  EXPECT_EQ(back.fixed[plant::k_PP], 0.0);
+
+  // The shipped hand-written campaign: positions by series and angle, averaged readings.
+  const Campaign ex = app::read_campaign(std::string(VRELAB_CASES_DIR) + "/lab-example");
+  EXPECT_EQ(ex.statics.size(), 36u);
+  EXPECT_EQ(ex.runs.size(), 10u);
+  EXPECT_TRUE(ex.skipped.empty());
+  const Diagnosis d = diagnose(ex);
+  EXPECT_TRUE(d.gap_significant);
+  EXPECT_EQ(d.effects.front().name, "pickoff_nonlinearity");  // what cases/campaign.toml hid
+}
+
+TEST(LabData, BadRunsAreSkippedWithFileAndLineAndBadFilesStop) {
+  TempDir t;
+  const std::string dir = (t.path / "c").string();
+  fs::copy(std::string(VRELAB_CASES_DIR) + "/lab-example", dir);
+  auto edit = [&](const std::string& file, const std::string& pattern, const std::string& with) {
+    std::ifstream in(dir + "/" + file);
+    std::stringstream s;
+    s << in.rdbuf();
+    const std::string text = s.str(), edited = std::regex_replace(text, std::regex(pattern), with);
+    ASSERT_NE(edited, text) << pattern;
+    std::ofstream(dir + "/" + file) << edited;
+  };
+  // A NaN in one run and a raw record shorter than its window in another: both skipped, the
+  // other runs read.
+  edit("runs.csv", "ia-10Hz-2g,10,2,1,0,0,0.7071,0,0.7071,[^,]*,", "ia-10Hz-2g,10,2,1,0,0,0.7071,0,0.7071,nan,");
+  {
+    std::ofstream s(dir + "/short.csv");
+    s << "time_s,output_mA\n";
+    for (int i = 0; i < 100; ++i) s << i * 1e-3 << "," << 0.88 << "\n";
+  }
+  edit("runs.csv", "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,measured_ug,sigma_ug",
+       "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,measured_ug,sigma_ug,series,rest_from_s,rest_to_s,on_from_s,on_to_s");
+  edit("runs.csv", "(ia-40Hz-4g,[^\\n]*)", "$1,short.csv,0,0.04,0.05,0.5");
+  const Campaign c = app::read_campaign(dir);
+  EXPECT_EQ(c.runs.size(), 8u);
+  ASSERT_EQ(c.skipped.size(), 2u);
+  EXPECT_TRUE(std::regex_search(c.skipped[0], std::regex(R"(runs\.csv:\d+ \(run 'ia-10Hz-2g'\): .*measured_ug: nan is not a finite number)")))
+      << c.skipped[0];
+  EXPECT_TRUE(std::regex_search(c.skipped[1], std::regex(R"(short\.csv: the record ends at 0\.099 s, before on_to_s = 0\.5 s)")))
+      << c.skipped[1];
+
+  // Files that stop the diagnosis, each named.
+  edit("static.csv", "output_mA,sigma_mA", "output_V,sigma_V");
+  try {
+    app::read_campaign(dir);
+    ADD_FAILURE() << "accepted a unit mismatch";
+  } catch (const app::InputError& e) {
+    EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(R"(static\.csv: column 'output_V' is in 'V', the manifest's output unit is 'mA')")))
+        << e.what();
+  }
+  fs::remove(dir + "/static.csv");
+  try {
+    app::read_campaign(dir);
+    ADD_FAILURE() << "accepted a missing static.csv";
+  } catch (const app::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("static.csv: cannot open"), std::string::npos) << e.what();
+  }
+}
+
+TEST(LabData, RawRecordIsMeasuredAsTheSummaryWouldBe) {
+  // A synthetic record: 0.88 mA at rest, then a 50 Hz sine of 1 mA with a 25 ug (x K1) offset.
+  TempDir t;
+  const std::string dir = (t.path / "c").string();
+  fs::copy(std::string(VRELAB_CASES_DIR) + "/lab-example", dir);
+  const double K1 = 1.25;  // the example instrument's (the reader uses the static test's, within 1e-5)
+  {
+    std::ofstream s(dir + "/rec.csv");
+    s << "# time_s, output in mA\ntime_s,output_mA\n";
+    for (int i = 0; i < 20000; ++i) {
+      const double tt = -1.0 + i * 1e-4;
+      const double u = 0.88 + (tt >= 0 ? std::sin(2 * std::numbers::pi * 50 * tt) + K1 * 25e-6 : 0.0);
+      s << fmt::format("{:.6f},{:.12f}\n", tt, u);
+    }
+  }
+  std::ofstream(dir + "/runs.csv") << "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,series,rest_from_s,"
+                                      "rest_to_s,on_from_s,on_to_s\n"
+                                      "raw1,50,1,1,0,0,0.7071,0,0.7071,rec.csv,-1,0,0,0.9999\n";
+  const Campaign c = app::read_campaign(dir);
+  ASSERT_EQ(c.runs.size(), 1u) << (c.skipped.empty() ? "" : c.skipped[0]);
+  // The offset in g through the identified K1 (within 0.1 % of 1.25): 25 ug to 0.05 ug.
+  EXPECT_NEAR(c.runs[0].measured_g, 25e-6, 0.05e-6);
+  EXPECT_GT(c.runs[0].sigma_g, 0.0);
+}
