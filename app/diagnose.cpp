@@ -251,7 +251,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   // Scores against the keys.
-  int single = 0, single_right = 0, clean = 0, false_alarms = 0, ool = 0, ool_unexplained = 0, two = 0, two_hit = 0;
+  int single = 0, single_right = 0, single_explained = 0, clean = 0, false_alarms = 0, ool = 0, ool_unexplained = 0, two = 0, two_hit = 0;
   std::vector<double> shrink;
   std::map<std::string, std::map<std::string, int>> confusion;
   json rows = json::array();
@@ -266,6 +266,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
       ++single;
       const bool right = k.error.empty() && k.d.gap_significant && top == k.hidden[0].name;
       single_right += right;
+      single_explained += right && k.d.explained;
       if (k.error.empty() && k.d.rms_before_g > 0) shrink.push_back(1 - k.d.rms_after_g / k.d.rms_before_g);
       if (!right)
         wrong.push_back(fmt::format("campaign {} (seed {}): {} = {:.4g} hidden; called {} (top {}){}", k.index, k.seed,
@@ -308,6 +309,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
                  {"threads", threads},
                  {"top1_accuracy", single ? static_cast<double>(single_right) / single : 0.0},
                  {"single_effect_campaigns", single},
+                 {"explained_by_the_right_effect", single ? static_cast<double>(single_explained) / single : 0.0},
                  {"false_alarm_rate", clean ? static_cast<double>(false_alarms) / clean : 0.0},
                  {"clean_campaigns", clean},
                  {"unexplained_recognition", ool ? static_cast<double>(ool_unexplained) / ool : 0.0},
@@ -339,12 +341,15 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
                      o.seed, wall, threads);
   out << fmt::format("  top-1 attribution (single in-library effects): {}/{} = {:.0f} %\n", single_right, single,
                      single ? 100.0 * single_right / single : 0.0);
+  out << fmt::format("  of these, verdict 'explained by' the right effect: {}/{}\n", single_explained, single);
   out << fmt::format("  false alarms on clean campaigns: {}/{}\n", false_alarms, clean);
   out << fmt::format("  out-of-library called unexplained: {}/{}\n", ool_unexplained, ool);
   out << fmt::format("  two effects, top-1 one of them: {}/{}\n", two_hit, two);
   out << fmt::format("  median held-out shrinkage of the gap rms: {:.0f} %\n", 100 * median_shrink);
   for (const auto& w : wrong) out << "  wrong: " << w << "\n";
-  out << "Wrote " << o.out_dir << "/scores.json and confusion.csv\n";
+  const std::string why = run_plot_script("confusion.py", o.out_dir);
+  out << "Wrote " << o.out_dir << "/scores.json and confusion.csv"
+      << (why.empty() ? ", confusion.png/svg" : "; figure skipped: " + why) << "\n";
 }
 
 }  // namespace vrelab::app

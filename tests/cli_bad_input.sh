@@ -65,5 +65,8 @@ expect 0 'measured vibration error' shake "$cases/shake-physical.toml"
 expect 2 'reproduce needs a \[reproduce\] table' reproduce "$cases/paper-static.toml" --out "$tmp/o/rep"
 expect 2 'missing.toml: cannot open the case file' reproduce "$tmp/missing.toml" --out "$tmp/o/rep"
 [ -e "$tmp/o/rep" ] && { echo "FAIL: reproduce: output written for bad input"; fail=$((fail + 1)); }
+# diagnose: a folder without a manifest; a campaign folder that works.
+expect 2 'nowhere/manifest.toml: cannot open the manifest' diagnose "$tmp/nowhere"
+expect 0 'Verdict: explained by pickoff_nonlinearity' diagnose "$cases/lab-example"
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
