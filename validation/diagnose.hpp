@@ -80,6 +80,7 @@ struct DiagnoseSettings {
   double model_accuracy = 0.002;      // relative accuracy of the simulation (f_model)
   double significance_sigma = 5.0;    // a run's gap is significant beyond this many sigma
   double explained_chi2_per_run = 2.0;  // held-out chi^2 per run at most this to call a gap explained
+  int resimulate_runs = 12;             // runs (largest gaps first) re-simulated on the ODE; 0: none
 };
 
 struct EffectFit {
@@ -92,7 +93,8 @@ struct EffectFit {
 struct RunDiagnosis {
   double predicted_g = 0, sigma_predicted_g = 0;  // nominal simulation
   double gap_g = 0, sigma_g = 0, z = 0;           // measured - predicted; sigma from V's diagonal
-  double heldout_after_g = 0;                     // gap left by the chosen effect, fitted without this run's fold
+  double heldout_before_g = 0;                    // the gap the coefficient errors cannot take up (nominal), held out
+  double heldout_after_g = 0;                     // the same with the chosen effect, fitted without this run's fold
 };
 
 struct Diagnosis {
@@ -112,6 +114,10 @@ struct Diagnosis {
   std::string verdict;             // "no significant gap", "explained by <name>", "not explained by any known effect"
   double rms_before_g = 0, rms_after_g = 0;          // held-out, over all runs
   double rms_before_sigma = 0, rms_after_sigma = 0;  // the same in units of each run's sigma
+  // The confirmation on the ODE plant (the runs with the largest gaps; coefficients corrected
+  // by all runs under the chosen effect): rms of measured - ODE without and with the effect.
+  int resimulated_runs = 0;
+  double resimulated_rms_before_g = 0, resimulated_rms_after_g = 0;
 };
 
 Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {});
