@@ -1,5 +1,6 @@
 #include "app/lab_data.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -153,6 +154,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     m.g_m_per_s2 = toml_number(*t, "instrument", "g_m_per_s2", m.g_m_per_s2, mpath);
   }
   if (auto* t = root["dynamics"].as_table()) {
+    m.dynamics_given = true;
     check_keys(*t, "dynamics",
                {"pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g", "loop_bandwidth_Hz",
                 "phase_margin_deg", "integrator", "integrator_zero_ratio"},
@@ -213,7 +215,8 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     }
     r.output = get("output_" + m.output_unit);
     const double sigma = get("sigma_" + m.output_unit);
-    const double count = st.has("count") ? get("count") : 1.0;
+    const bool has_count = st.has("count") && st.column.at("count") < row.second.size() && !row.second[st.column.at("count")].empty();
+    const double count = has_count ? get("count") : 1.0;
     if (!(sigma > 0)) throw InputError(fmt::format("{}:{}: column sigma_{}: must be positive", st.path, row.first, m.output_unit));
     if (!(count >= 1)) throw InputError(fmt::format("{}:{}: column count: must be at least 1", st.path, row.first));
     r.sigma_output = sigma / std::sqrt(count);
@@ -246,6 +249,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
   for (const auto& row : rn.rows) {
     const std::string idc = rn.column.at("id") < row.second.size() ? row.second[rn.column.at("id")] : "";
     const std::string label = fmt::format("{}:{} (run '{}')", rn.path, row.first, idc);
+    const std::string named = fmt::format("run '{}'", idc);  // `why` already names the file and line
     std::string why;
     auto get = [&](const std::string& col) { return number(rn, row, col, &why); };
     validation::RunRecord r;
@@ -254,7 +258,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     const auto f = get("frequency_Hz"), a = get("amplitude_g"), d0 = get("d_IA"), d1 = get("d_PA"), d2 = get("d_OA"),
                o0 = get("a_IA_g"), o1 = get("a_PA_g"), o2 = get("a_OA_g");
     if (!f || !a || !d0 || !d1 || !d2 || !o0 || !o1 || !o2) {
-      c.skipped.push_back(label + ": " + why);
+      c.skipped.push_back(named + ": " + why);
       continue;
     }
     const Vec3 d(*d0, *d1, *d2);
@@ -263,11 +267,20 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       continue;
     }
     r.frequency_Hz = *f, r.amplitude_g = *a, r.direction = d.normalized(), r.orientation_g = Vec3(*o0, *o1, *o2);
+    if (std::abs(r.orientation_g.norm() - 1) > 0.01) {
+      c.skipped.push_back(fmt::format("{}: the static orientation has |a| = {:.4g} g; gravity is 1 g (a_*_g in g)", label,
+                                      r.orientation_g.norm()));
+      continue;
+    }
+    if (std::any_of(c.runs.begin(), c.runs.end(), [&](const validation::RunRecord& x) { return x.id == idc; })) {
+      c.skipped.push_back(label + ": the id is used by an earlier run");
+      continue;
+    }
     const std::string file = series && rn.column.at("series") < row.second.size() ? row.second[rn.column.at("series")] : "";
     if (!file.empty()) {
       const auto rf = get("rest_from_s"), rt = get("rest_to_s"), of = get("on_from_s"), ot = get("on_to_s");
       if (!rf || !rt || !of || !ot) {
-        c.skipped.push_back(label + ": " + why);
+        c.skipped.push_back(named + ": " + why);
         continue;
       }
       rectification::SeriesWindows win;
@@ -287,7 +300,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
         double last_t = -INFINITY;
         while (std::getline(in, line)) {
           ++ln;
-          if (line.empty() || line[0] == '#') continue;
+          if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
           const auto cells = split(line);
           if (!header) {
             header = true;
@@ -302,9 +315,12 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
           }
           if (tcol >= cells.size() || ucol >= cells.size())
             throw std::invalid_argument(fmt::format("{}:{}: too few columns", spath, ln));
-          const double t = std::strtod(cells[tcol].c_str(), nullptr), u = std::strtod(cells[ucol].c_str(), nullptr);
-          if (!std::isfinite(t) || !std::isfinite(u))
+          char* e1 = nullptr;
+          char* e2 = nullptr;
+          const double t = std::strtod(cells[tcol].c_str(), &e1), u = std::strtod(cells[ucol].c_str(), &e2);
+          if (cells[tcol].empty() || cells[ucol].empty() || *e1 != '\0' || *e2 != '\0' || !std::isfinite(t) || !std::isfinite(u))
             throw std::invalid_argument(fmt::format("{}:{}: a sample is not a finite number", spath, ln));
+          if (!(t > last_t)) throw std::invalid_argument(fmt::format("{}:{}: time does not increase", spath, ln));
           last_t = t;
           meas.add(t, u);
         }
@@ -323,7 +339,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       }
       const auto mu = get("measured_ug"), su = get("sigma_ug");
       if (!mu || !su) {
-        c.skipped.push_back(label + ": " + why);
+        c.skipped.push_back(named + ": " + why);
         continue;
       }
       if (!(*su > 0)) {
@@ -352,7 +368,12 @@ void write_campaign(const std::string& dir, const validation::Campaign& c, const
                            "angle_gain_rad_per_s2_per_g = {:.10g}\nloop_bandwidth_Hz = {:.10g}\nphase_margin_deg = {:.10g}\n"
                            "integrator = {}\nintegrator_zero_ratio = {:.10g}\n\n"
                            "[identification]\nfixed = {{ {} }}\n\n[files]\nstatic = \"static.csv\"\nruns = \"runs.csv\"\n",
-                           m.name, m.output_unit, m.g_m_per_s2, d.pendulum_frequency_Hz, d.pendulum_damping_ratio,
+                           [&] {
+                             std::string e;
+                             for (char ch : m.name) e += ch == '"' || ch == '\\' ? std::string("\\") + ch : std::string(1, ch);
+                             return e;
+                           }(),
+                           m.output_unit, m.g_m_per_s2, d.pendulum_frequency_Hz, d.pendulum_damping_ratio,
                            d.angle_gain_rad_per_s2_per_g, d.loop_bandwidth_Hz, d.phase_margin_deg, d.integrator ? "true" : "false",
                            d.integrator_zero_ratio, fixed));
   std::string st = fmt::format("# static readings: orientation in g (sensor axes), mean output and one reading's sigma in {}\n"

@@ -27,6 +27,7 @@ struct LabManifest {
   std::string name = "campaign";
   std::string output_unit = "mA";
   double g_m_per_s2 = 9.80665;
+  bool dynamics_given = false;  // the manifest has a [dynamics] table
 };
 
 validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest = nullptr);

@@ -184,7 +184,7 @@ TEST(LabData, BadRunsAreSkippedWithFileAndLineAndBadFilesStop) {
   const Campaign c = app::read_campaign(dir);
   EXPECT_EQ(c.runs.size(), 8u);
   ASSERT_EQ(c.skipped.size(), 2u);
-  EXPECT_TRUE(std::regex_search(c.skipped[0], std::regex(R"(runs\.csv:\d+ \(run 'ia-10Hz-2g'\): .*measured_ug: nan is not a finite number)")))
+  EXPECT_TRUE(std::regex_search(c.skipped[0], std::regex(R"(run 'ia-10Hz-2g': .*runs\.csv:\d+: column measured_ug: nan is not a finite number)")))
       << c.skipped[0];
   EXPECT_TRUE(std::regex_search(c.skipped[1], std::regex(R"(short\.csv: the record ends at 0\.099 s, before on_to_s = 0\.5 s)")))
       << c.skipped[1];
@@ -230,4 +230,22 @@ TEST(LabData, RawRecordIsMeasuredAsTheSummaryWouldBe) {
   // The offset in g through the identified K1 (within 0.1 % of 1.25): 25 ug to 0.05 ug.
   EXPECT_NEAR(c.runs[0].measured_g, 25e-6, 0.05e-6);
   EXPECT_GT(c.runs[0].sigma_g, 0.0);
+
+  // A sample that is not a number, and time that goes back: the run is skipped, the line named.
+  for (const auto& [bad, expect] : {std::pair<std::string, std::string>{"0.5,abc", R"(rec\.csv:\d+: a sample is not a finite number)"},
+                                    {"0.1,0.88", R"(rec\.csv:\d+: time does not increase)"}}) {
+    std::ifstream in(dir + "/rec.csv");
+    std::stringstream all;
+    all << in.rdbuf();
+    std::string text = all.str();
+    const auto pos = text.find("0.500000,");  // insert the bad line in the middle of the record
+    ASSERT_NE(pos, std::string::npos);
+    text.insert(pos, bad + "\n");
+    std::ofstream(dir + "/rec.csv") << text;
+    const Campaign b = app::read_campaign(dir);
+    ASSERT_EQ(b.skipped.size(), 1u);
+    EXPECT_TRUE(std::regex_search(b.skipped[0], std::regex(expect))) << b.skipped[0];
+    text.erase(pos, bad.size() + 1);
+    std::ofstream(dir + "/rec.csv") << text;
+  }
 }

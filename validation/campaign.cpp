@@ -34,9 +34,13 @@ bool is_out_of_library(const std::string& name) { return name == "shaker_harmoni
 
 Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
                            const CampaignDesign& design, std::uint64_t seed, int threads) {
-  for (const auto& h : hidden)
+  for (const auto& h : hidden) {
     if (!find_effect(h.name) && !is_out_of_library(h.name))
       throw std::invalid_argument("campaign: unknown hidden effect '" + h.name + "'");
+    // These two are hypotheses (present or not), not scalable: the truth takes 0 or 1.
+    if ((h.name == "pendulum_geometry" || h.name == "nonlinearity_at_input") && h.parameter != 0 && h.parameter != 1)
+      throw std::invalid_argument("campaign: " + h.name + " is present (1) or not (0), got " + std::to_string(h.parameter));
+  }
   Campaign c;
   c.dynamics = truth.dynamics;
   c.fixed[plant::k_PP] = 0.0;  // the one coefficient a 1 g test cannot separate (its common part)
@@ -58,7 +62,11 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
   const double K1 = plant.coefficients[plant::K1];
   const OutputSource source = [&plant, K1](const Vec3& a) { return K1 * plant::settled_output_g(plant, a); };
   const std::vector<Reading> readings = simulate_static_test(source, K1, positions, design.errors, rng);
-  const ReadingBudget budget = reading_budget(plant.coefficients, positions, readings, design.errors);
+  // The readings' sigma as a lab states it: noise and set-angle error through the scale
+  // factor alone (nothing of the truth's nonlinearity or hidden effects).
+  plant::Coefficients scale_only;
+  scale_only[plant::K1] = K1;
+  const ReadingBudget budget = reading_budget(scale_only, positions, readings, design.errors);
   for (std::size_t i = 0; i < readings.size(); ++i)
     c.statics.push_back({positions[static_cast<std::size_t>(readings[i].position)].nominal_g, readings[i].output,
                          std::sqrt(budget.variance[i]), ""});

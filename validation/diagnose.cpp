@@ -48,7 +48,7 @@ std::vector<EffectModel> make_library() {
   {
     EffectModel e;
     e.name = "pendulum_geometry";
-    e.parameter = "fraction", e.unit = "1";
+    e.parameter = "fraction", e.unit = "1";  // a hypothesis: 1 = present; the fit says how much of it the data show
     e.physics = "vibropendulous coupling: the input axis turns with the pendulum, so vibration along IA and PA in "
                 "phase rectifies as -<a_PA theta>; zero for vibration along one axis only";
     e.linear = true, e.unit_value = 1;
@@ -62,8 +62,8 @@ std::vector<EffectModel> make_library() {
     e.name = "quadratic_cross_axis";
     e.parameter = "k_PP", e.unit = "1/g";
     e.physics = "k_PP a_PA^2 (and the common part of k_PP, k_OO, k2 with k0): invisible to any static test in 1 g, "
-                "so held at 0 by the identification; rectifies k_PP |w|^2 / 2 whatever the direction, frequency-"
-                "independent";
+                "so held at 0 by the identification; rectifies k_PP |w|^2 / 2 whatever the direction (its k2 part "
+                "through the loop, like k2; flat in frequency along PA and OA)";
     e.linear = true, e.unit_value = 1e-6;
     e.apply = [](double p, PlantConfig& c, vibration::SineVibration&, std::optional<double>&) {
       // The static test identified (k0 + p, k2 - p, 0, k_OO - p): give the part back.
@@ -205,21 +205,21 @@ struct Likelihood {
   double m2logl = 0, chi2 = 0;
 };
 struct Data {
-  Eigen::VectorXd measured, sigma2;
+  Eigen::VectorXd measured, sigma2;  // sigma2: the run's variance plus the simulation's own, (f_model pred_nominal)^2
   Eigen::MatrixXd Sigma;
-  double model_accuracy = 0;
 };
 
-Eigen::MatrixXd covariance(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
+// The model-accuracy part is fixed at the nominal prediction: were it taken at each effect's
+// prediction, an effect could lower chi^2 by inflating its predictions.
+Eigen::MatrixXd covariance(const Data& d, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
   const Eigen::MatrixXd Gi = rows(G, idx);
   Eigen::MatrixXd V = Gi * d.Sigma * Gi.transpose();
-  for (std::size_t i = 0; i < idx.size(); ++i)
-    V(i, i) += d.sigma2(idx[i]) + std::pow(d.model_accuracy * pred(idx[i]), 2);
+  for (std::size_t i = 0; i < idx.size(); ++i) V(i, i) += d.sigma2(idx[i]);
   return V;
 }
 
 Likelihood likelihood(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, pred, G, idx));
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, G, idx));
   const Eigen::VectorXd r = sub(d.measured, idx) - sub(pred, idx);
   Likelihood l;
   l.chi2 = r.dot(ldlt.solve(r));
@@ -231,7 +231,7 @@ Likelihood likelihood(const Data& d, const Eigen::VectorXd& pred, const Eigen::M
 // coefficients' correction estimated from the runs `from` (and the static test's prior).
 Eigen::VectorXd adjusted_residual(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G,
                                   const std::vector<int>& from, const std::vector<int>& at) {
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, pred, G, from));
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, G, from));
   const Eigen::VectorXd rf = sub(d.measured, from) - sub(pred, from);
   const Eigen::VectorXd dc = d.Sigma * rows(G, from).transpose() * ldlt.solve(rf);
   return sub(d.measured, at) - sub(pred, at) - rows(G, at) * dc;
@@ -273,7 +273,7 @@ class EffectFitter {
     std::vector<double> xs;
     if (e_.linear) {
       // A bracket from the fixed-covariance (nominal V) estimate, then a scan and a refinement.
-      const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, nominal_.pred, nominal_.G, idx));
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, nominal_.G, idx));
       const double du = e_.unit_value - e_.nominal;
       const Eigen::VectorXd s = sub(unit_.pred, idx) - sub(nominal_.pred, idx);
       const Eigen::VectorXd r = sub(d.measured, idx) - sub(nominal_.pred, idx);
@@ -396,34 +396,36 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   data.Sigma.resize(plant::kNumCoefficients, plant::kNumCoefficients);
   for (int i = 0; i < plant::kNumCoefficients; ++i)
     for (int j = 0; j < plant::kNumCoefficients; ++j) data.Sigma(i, j) = d.identified_uncertainty.covariance[i][j];
-  data.model_accuracy = s.model_accuracy;
 
   // 2. The nominal simulation: gap, significance, where.
   ResponseCache cache;
   const Table nominal = tabulate(plant, c.runs, nullptr, 0, cache);
+  for (int k = 0; k < n; ++k) data.sigma2(k) += std::pow(s.model_accuracy * nominal.pred(k), 2);
   std::vector<int> all(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) all[static_cast<std::size_t>(k)] = k;
-  const Eigen::MatrixXd V = covariance(data, nominal.pred, nominal.G, all);
+  const Eigen::MatrixXd V = covariance(data, nominal.G, all);
   const Eigen::LDLT<Eigen::MatrixXd> Vl(V);
   const Eigen::VectorXd r = data.measured - nominal.pred;
   const Eigen::MatrixXd Vinv = Vl.solve(Eigen::MatrixXd::Identity(n, n));
-  const Eigen::VectorXd u = Vinv * r;
-  d.chi2_nominal = r.dot(u);
+  d.chi2_nominal = r.dot(Vinv * r);
   const double chi2_sigma = chi2_as_sigma(d.chi2_nominal, n);
   d.runs.resize(static_cast<std::size_t>(n));
-  std::vector<std::pair<double, double>> la;  // log amplitude, log |adjusted gap| of significant runs
+  // Where: each run's gap that the static test's coefficient errors cannot take up (r - G dc*,
+  // dc* from all runs and the static prior), in units of the run's own sigma (measurement and
+  // simulation accuracy). The raw gap is dominated by the coefficient errors at several g
+  // and would point everywhere.
   const Eigen::VectorXd adj = adjusted_residual(data, nominal.pred, nominal.G, all, all);
   std::set<std::string> dirs;
   double f_lo = INFINITY, f_hi = 0, a_lo = INFINITY, a_hi = 0;
+  std::map<std::string, std::vector<std::pair<double, double>>> groups;  // (f, direction): (ln A, ln |adj|)
   for (int k = 0; k < n; ++k) {
     RunDiagnosis& rd = d.runs[static_cast<std::size_t>(k)];
     rd.predicted_g = nominal.pred(k);
     rd.sigma_predicted_g = std::sqrt(std::max(0.0, (nominal.G.row(k) * data.Sigma * nominal.G.row(k).transpose())(0, 0)));
     rd.gap_g = r(k);
     rd.sigma_g = std::sqrt(V(k, k));
-    // Standardised against all the other runs (the gap the shared coefficient errors cannot
-    // take up): u_k / sqrt((V^-1)_kk).
-    rd.z = u(k) / std::sqrt(Vinv(k, k));
+    rd.adjusted_gap_g = adj(k);
+    rd.z = adj(k) / std::sqrt(data.sigma2(k));
     d.max_abs_z = std::max(d.max_abs_z, std::abs(rd.z));
     if (std::abs(rd.z) >= s.significance_sigma) {
       ++d.significant_runs;
@@ -433,7 +435,8 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
       dirs.insert(dir);
       f_lo = std::min(f_lo, run.frequency_Hz), f_hi = std::max(f_hi, run.frequency_Hz);
       a_lo = std::min(a_lo, run.amplitude_g), a_hi = std::max(a_hi, run.amplitude_g);
-      if (adj(k) != 0) la.emplace_back(std::log(run.amplitude_g), std::log(std::abs(adj(k))));
+      groups[std::string(dir) + std::to_string(run.frequency_Hz)].emplace_back(std::log(run.amplitude_g),
+                                                                                 std::log(std::abs(adj(k))));
     }
   }
   d.gap_significant = d.significant_runs > 0 || chi2_sigma >= s.significance_sigma;
@@ -442,57 +445,75 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
     w.precision(3);
     w << "chi^2 " << d.chi2_nominal << " for " << n << " runs (" << chi2_sigma << " sigma); ";
     if (d.significant_runs > 0) {
-      w << d.significant_runs << " run(s) beyond " << s.significance_sigma << " sigma: " << f_lo << "-" << f_hi << " Hz, "
-        << a_lo << "-" << a_hi << " g, direction(s)";
+      w << d.significant_runs << " run(s) with a gap beyond " << s.significance_sigma
+        << " sigma that the coefficients cannot take up: " << f_lo << "-" << f_hi << " Hz, " << a_lo << "-" << a_hi
+        << " g, direction(s)";
       for (const auto& x : dirs) w << " " << x;
     } else {
       w << "no single run beyond " << s.significance_sigma << " sigma";
     }
     d.where = w.str();
-    if (la.size() >= 3 && a_hi > a_lo) {
+    // |gap| ~ A^p within each (direction, frequency): one intercept per group.
+    double sxy = 0, sxx = 0;
+    for (const auto& [key, pts] : groups) {
+      if (pts.size() < 2) continue;
       double mx = 0, my = 0;
-      for (auto [x, y] : la) mx += x, my += y;
-      mx /= static_cast<double>(la.size()), my /= static_cast<double>(la.size());
-      double sxy = 0, sxx = 0;
-      for (auto [x, y] : la) sxy += (x - mx) * (y - my), sxx += (x - mx) * (x - mx);
-      d.amplitude_power = sxx > 0 ? sxy / sxx : 0;
+      for (auto [x, y] : pts) mx += x, my += y;
+      mx /= static_cast<double>(pts.size()), my /= static_cast<double>(pts.size());
+      for (auto [x, y] : pts) sxy += (x - mx) * (y - my), sxx += (x - mx) * (x - mx);
     }
+    d.amplitude_power = sxx > 0 ? sxy / sxx : 0;
   }
 
-  // 3. Each effect: leave-one-frequency-out fits and the evidence on the held-out runs.
+  // 3. Each effect: fits on training runs and the evidence on the held-out ones. Folds: leave
+  // one amplitude out, so every frequency and direction stays in training (a resonance cannot
+  // be located from the other frequencies) and the held-out runs test the effect's scaling
+  // with amplitude, which tells most effects apart; with one amplitude, leave one frequency
+  // out; with neither, no cross-validation (said in d.folds).
+  std::set<double> amplitudes, frequencies;
+  for (const auto& run : c.runs) amplitudes.insert(run.amplitude_g), frequencies.insert(run.frequency_Hz);
+  const bool by_amplitude = amplitudes.size() >= 2, by_frequency = !by_amplitude && frequencies.size() >= 2;
+  d.folds = by_amplitude ? "leave one amplitude out" : by_frequency ? "leave one frequency out" : "none (in-sample: one amplitude, one frequency)";
+  const auto fold_key = [&](int k) {
+    const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
+    return by_amplitude ? run.amplitude_g : by_frequency ? run.frequency_Hz : 0.0;
+  };
   std::map<double, std::vector<int>> folds;
-  // Folds: leave one amplitude out. Every frequency and direction stays in the training set
-  // (a resonance cannot be located from the other frequencies), and the held-out runs test
-  // the effect's scaling with amplitude, which is what tells most effects apart.
-  const auto fold_key = [&](int k) { return c.runs[static_cast<std::size_t>(k)].amplitude_g; };
   for (int k = 0; k < n; ++k) folds[fold_key(k)].push_back(k);
+  const auto train_of = [&](double key) {
+    std::vector<int> train;
+    for (int k = 0; k < n; ++k)
+      if (fold_key(k) != key) train.push_back(k);
+    return train.empty() ? all : train;
+  };
   struct Scored {
     EffectFit fit;
     Eigen::VectorXd heldout;  // held-out adjusted residual per run
   };
   std::vector<Scored> scored;
   Eigen::VectorXd heldout_nominal = Eigen::VectorXd::Zero(n);
-  for (const auto& [f, test] : folds) {
-    std::vector<int> train;
-    for (int k = 0; k < n; ++k)
-      if (fold_key(k) != f) train.push_back(k);
-    if (train.empty()) train = all;
-    const Eigen::VectorXd a = adjusted_residual(data, nominal.pred, nominal.G, train, test);
+  for (const auto& [key, test] : folds) {
+    const Eigen::VectorXd a = adjusted_residual(data, nominal.pred, nominal.G, train_of(key), test);
     for (std::size_t i = 0; i < test.size(); ++i) heldout_nominal(test[i]) = a(static_cast<Eigen::Index>(i));
   }
+  // -2 ln p(test | train) = -2 ln L(all) + 2 ln L(train): the held-out runs given what the
+  // training runs say about the coefficients (the same conditioning as the shrinkage's).
+  const auto conditional = [&](const Table& t, const std::vector<int>& train) {
+    const Likelihood l_all = likelihood(data, t.pred, t.G, all), l_train = likelihood(data, t.pred, t.G, train);
+    return Likelihood{l_all.m2logl - l_train.m2logl, l_all.chi2 - l_train.chi2};
+  };
   for (const EffectModel& e : effect_library()) {
     const EffectFitter fitter(e, nominal, plant, c.runs, cache);
     Scored sc;
     sc.fit.name = e.name, sc.fit.parameter = e.parameter, sc.fit.unit = e.unit;
     sc.heldout = Eigen::VectorXd::Zero(n);
-    for (const auto& [f, test] : folds) {
-      std::vector<int> train;
-      for (int k = 0; k < n; ++k)
-        if (fold_key(k) != f) train.push_back(k);
-      if (train.empty()) train = all;
+    for (const auto& [key, test] : folds) {
+      const std::vector<int> train = train_of(key);
       const double p = fitter.fit(data, train).first;
       const Table t = fitter.at(p);
-      const Likelihood with = likelihood(data, t.pred, t.G, test), without = likelihood(data, nominal.pred, nominal.G, test);
+      const Likelihood with = train.size() == all.size() ? likelihood(data, t.pred, t.G, all) : conditional(t, train);
+      const Likelihood without =
+          train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all) : conditional(nominal, train);
       sc.fit.evidence += without.m2logl - with.m2logl;
       sc.fit.heldout_chi2 += with.chi2;
       const Eigen::VectorXd a = adjusted_residual(data, t.pred, t.G, train, test);
@@ -500,6 +521,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
     }
     const auto [p, sp] = fitter.fit(data, all);
     sc.fit.value = p, sc.fit.sigma = sp;
+    sc.fit.at_bound = !std::isfinite(sp);
     scored.push_back(std::move(sc));
   }
   std::sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
@@ -509,7 +531,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   const Scored& best = scored.front();
   double ss_b = 0, ss_a = 0, zs_b = 0, zs_a = 0;
   for (int k = 0; k < n; ++k) {
-    const double sk2 = data.sigma2(k) + std::pow(s.model_accuracy * nominal.pred(k), 2);
+    const double sk2 = data.sigma2(k);
     ss_b += heldout_nominal(k) * heldout_nominal(k), ss_a += best.heldout(k) * best.heldout(k);
     zs_b += heldout_nominal(k) * heldout_nominal(k) / sk2, zs_a += best.heldout(k) * best.heldout(k) / sk2;
     d.runs[static_cast<std::size_t>(k)].heldout_after_g = best.heldout(k);
@@ -534,7 +556,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
     const EffectModel* e = find_effect(best.fit.name);
     const double p = best.fit.value;
     const Table t = tabulate(plant, c.runs, e, p, cache);
-    const Eigen::LDLT<Eigen::MatrixXd> vl(covariance(data, t.pred, t.G, all));
+    const Eigen::LDLT<Eigen::MatrixXd> vl(covariance(data, t.G, all));
     const Eigen::VectorXd dc = data.Sigma * t.G.transpose() * vl.solve(data.measured - t.pred);
     PlantConfig corrected = plant;
     for (int i = 0; i < plant::kNumCoefficients; ++i) corrected.coefficients[i] += dc(i);

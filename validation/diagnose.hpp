@@ -87,12 +87,15 @@ struct EffectFit {
   std::string name, parameter, unit;
   double value = 0, sigma = 0;   // fitted on all runs
   double evidence = 0;           // held-out chi^2 reduction, summed over folds
-  double heldout_chi2 = 0;       // held-out chi^2 with the effect, summed over folds
+  double heldout_chi2 = 0;       // held-out chi^2 with the effect (given the training runs), summed over folds
+  bool at_bound = false;         // the fit ended on the edge of its range (no curvature: no sigma)
 };
 
 struct RunDiagnosis {
   double predicted_g = 0, sigma_predicted_g = 0;  // nominal simulation
-  double gap_g = 0, sigma_g = 0, z = 0;           // measured - predicted; sigma from V's diagonal
+  double gap_g = 0, sigma_g = 0;                  // measured - predicted; sigma from V's diagonal
+  double adjusted_gap_g = 0;  // the gap the static test's coefficient errors cannot take up (all runs)
+  double z = 0;               // adjusted_gap_g over the run's own sigma (measurement, simulation accuracy)
   double heldout_before_g = 0;                    // the gap the coefficient errors cannot take up (nominal), held out
   double heldout_after_g = 0;                     // the same with the chosen effect, fitted without this run's fold
 };
@@ -110,6 +113,7 @@ struct Diagnosis {
   std::string where;
   double amplitude_power = 0;
   std::vector<EffectFit> effects;  // best first (evidence)
+  std::string folds;               // the cross-validation used
   bool explained = false;
   std::string verdict;             // "no significant gap", "explained by <name>", "not explained by any known effect"
   double rms_before_g = 0, rms_after_g = 0;          // held-out, over all runs
