@@ -542,7 +542,8 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   if (!d.gap_significant) {
     d.verdict = "no significant gap";
   } else if (best.fit.evidence > s.significance_sigma * s.significance_sigma &&
-             best.fit.heldout_chi2 / n <= s.explained_chi2_per_run) {
+             (best.fit.heldout_chi2 / n <= s.explained_chi2_per_run ||
+              d.rms_after_g <= (1 - s.explained_shrinkage) * d.rms_before_g)) {
     d.explained = true;
     d.verdict = "explained by " + best.fit.name;
   } else {

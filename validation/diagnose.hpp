@@ -79,7 +79,12 @@ double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, cons
 struct DiagnoseSettings {
   double model_accuracy = 0.002;      // relative accuracy of the simulation (f_model)
   double significance_sigma = 5.0;    // a run's gap is significant beyond this many sigma
-  double explained_chi2_per_run = 2.0;  // held-out chi^2 per run at most this to call a gap explained
+  // A gap is explained by the best effect when its evidence exceeds significance_sigma^2 and
+  // either its held-out chi^2 per run is at most explained_chi2_per_run or it removes at least
+  // explained_shrinkage of the held-out gap rms (a large effect leaves the first-order
+  // simulation's own error, which chi^2 alone would call unexplained).
+  double explained_chi2_per_run = 2.0;
+  double explained_shrinkage = 0.9;
   int resimulate_runs = 12;             // runs (largest gaps first) re-simulated on the ODE; 0: none
 };
 
