@@ -823,8 +823,16 @@ void read_campaign(Table t, Case& c) {
     if (!n->is_boolean()) t.fail(n, "raw_series", "expected true or false");
     s.raw_series = n->as_boolean()->get();
   }
+  d.raw_noise_sigma_g = t.non_negative("raw_noise_sigma_ug", d.raw_noise_sigma_g * 1e6) * 1e-6;
+  d.raw_record_s = t.non_negative("raw_record_s", d.raw_record_s);
+  const double rate = t.non_negative("raw_sample_rate_Hz", 2000.0);
+  if (s.raw_series) {
+    if (!(rate > 0)) t.fail(t.raw().get("raw_sample_rate_Hz"), "raw_sample_rate_Hz", "must be positive");
+    if (!(d.raw_record_s > 0)) t.fail(t.raw().get("raw_record_s"), "raw_record_s", "must be positive");
+    d.raw_sample_rate_Hz = rate;
+  }
   t.check_unknown({"name", "hidden", "frequencies_Hz", "amplitudes_g", "directions", "orientations_g", "run_sigma_ug",
-                   "positions_per_series", "raw_series"});
+                   "positions_per_series", "raw_series", "raw_sample_rate_Hz", "raw_noise_sigma_ug", "raw_record_s"});
   c.campaign = s;
 }
 

@@ -121,14 +121,22 @@ void run_campaign(const CampaignOptions& o, std::ostream& out) {
   if (c.physical) throw InputError(c.path + ": campaign takes a plant built from coefficients");
   if (o.seed) c.seed = *o.seed;
   const CampaignSpec& spec = *c.campaign;
-  if (spec.raw_series)
-    throw InputError(c.path + ": [campaign] raw_series: writing raw records is not implemented yet (summaries only)");
   const auto start = std::chrono::steady_clock::now();
   validation::Campaign camp = validation::simulate_campaign(c.plant, spec.hidden, spec.design, c.seed, 0);
   camp.name = spec.name;
   LabManifest m;
   m.name = spec.name, m.output_unit = c.output_unit, m.g_m_per_s2 = c.g_m_per_s2;
-  write_campaign(o.out_dir, camp, m);
+  std::vector<RawSeriesRef> refs;
+  for (std::size_t k = 0; k < camp.raw.size(); ++k) {
+    const validation::RawRecord& rec = camp.raw[k];
+    const std::string file = "records/" + camp.runs[k].id + ".csv";
+    std::string text = fmt::format("# {} raw record: time in s, output in {}; at rest for t < 0\ntime_s,output_{}\n",
+                                   camp.runs[k].id, c.output_unit, c.output_unit);
+    for (std::size_t i = 0; i < rec.t_s.size(); ++i) text += fmt::format("{:.9g},{:.12g}\n", rec.t_s[i], rec.output[i]);
+    write_atomic(o.out_dir + "/" + file, text);
+    refs.push_back({file, rec.rest_from_s, rec.rest_to_s, rec.on_from_s, rec.on_to_s});
+  }
+  write_campaign(o.out_dir, camp, m, refs);
   json key = result_record("campaign", c);
   key["hidden"] = json::array();
   for (const auto& h : spec.hidden) key["hidden"].push_back({{"name", h.name}, {"parameter", h.parameter}});
@@ -138,9 +146,10 @@ void run_campaign(const CampaignOptions& o, std::ostream& out) {
   write_atomic(key_path, key.dump(2) + "\n");
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   out << fmt::format("vrelab {} ({}) campaign {}  [seed {}]\n", kProgramVersion, kGitDescribe, c.path, c.seed);
-  out << fmt::format("Wrote {} static readings and {} shaker runs to {} (lab data format, docs/data-format.md); the answer "
-                     "key to {} ({:.1f} s wall)\n",
-                     camp.statics.size(), camp.runs.size(), o.out_dir, key_path, wall);
+  out << fmt::format("Wrote {} static readings and {} shaker runs ({}) to {} (lab data format, docs/data-format.md); the "
+                     "answer key to {} ({:.1f} s wall)\n",
+                     camp.statics.size(), camp.runs.size(), refs.empty() ? "summaries" : "raw records in records/", o.out_dir,
+                     key_path, wall);
 }
 
 void run_diagnose(const DiagnoseOptions& o, std::ostream& out) {

@@ -286,7 +286,16 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       rectification::SeriesWindows win;
       win.baseline_from_s = *rf, win.baseline_to_s = *rt, win.on_from_s = *of, win.on_to_s = *ot;
       win.frequency_Hz = r.frequency_Hz, win.K1 = K1;
-      win.blocks = 8;
+      // Batch means over whole periods: up to 8 blocks of equal whole numbers of periods (the
+      // vibration window shortened to a multiple of the blocks).
+      const long periods = static_cast<long>(std::floor((*ot - *of) * r.frequency_Hz + 1e-9));
+      if (periods < 2) {
+        c.skipped.push_back(fmt::format("{}: the vibration window holds {} whole period(s) of {:g} Hz; at least 2 are needed",
+                                        label, periods, r.frequency_Hz));
+        continue;
+      }
+      win.blocks = static_cast<int>(std::min<long>(8, periods));
+      win.on_to_s = *of + static_cast<double>(periods / win.blocks * win.blocks) / r.frequency_Hz;
       const std::string spath = (fs::path(dir) / file).string();
       try {
         win.validate();

@@ -84,6 +84,8 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
         }
   std::vector<double> noise(c.runs.size());
   for (double& x : noise) x = n01(rng);
+  const bool raw = design.raw_sample_rate_Hz > 0;
+  if (raw) c.raw.resize(c.runs.size());
   std::atomic<std::size_t> next{0};
   std::vector<std::string> failures(c.runs.size());
   auto worker = [&] {
@@ -106,8 +108,30 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
       if (!harmonics.empty()) motion = std::make_shared<vibration::HarmonicDistortion>(tone, harmonics);
       else motion = tone;
       try {
-        const rectification::ShakeResult s = rectification::shake_sine(plant, r.orientation_g, commanded, {}, {}, motion.get());
-        r.measured_g = s.measured_g + r.sigma_g * noise[k];
+        if (raw) {
+          rectification::ShakeSettings ss;
+          ss.readout.sample_rate_Hz = std::max(design.raw_sample_rate_Hz, 20 * r.frequency_Hz);
+          ss.readout.noise_sigma_g = design.raw_noise_sigma_g;
+          ss.readout.seed = seed * 1000003u + k;
+          ss.min_measure_s = design.raw_record_s;
+          ss.blocks = 8;
+          RawRecord& rec = c.raw[k];
+          const rectification::ShakeResult s = rectification::shake_sine(
+              plant, r.orientation_g, commanded, ss,
+              [&rec](double t, const Vec3&, double u) {
+                rec.t_s.push_back(t);
+                rec.output.push_back(u);
+              },
+              motion.get());
+          // Windows half a sample clear of the samples they hold ([from, to), as SeriesMeasurer).
+          const double dt = 1 / s.sample_rate_Hz;
+          rec.rest_from_s = rec.t_s.front() - dt / 2, rec.rest_to_s = -dt / 2;
+          rec.on_from_s = s.settle_s - dt / 2, rec.on_to_s = rec.t_s.back();  // [from, to): the last sample out
+          r.measured_g = s.measured_g, r.sigma_g = s.sigma_g;
+        } else {
+          const rectification::ShakeResult s = rectification::shake_sine(plant, r.orientation_g, commanded, {}, {}, motion.get());
+          r.measured_g = s.measured_g + r.sigma_g * noise[k];
+        }
       } catch (const std::exception& e) {
         failures[k] = e.what();
       }

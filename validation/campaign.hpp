@@ -33,6 +33,11 @@ struct CampaignDesign {
   std::vector<double> frequencies_Hz, amplitudes_g;
   std::vector<Vec3> directions, orientations_g;
   double run_sigma_g = 0.3e-6;
+  // Raw records instead of summaries (raw_sample_rate_Hz > 0): each run read by a readout at
+  // that rate (raised to at least 20 samples per period) with this noise per sample, a record
+  // at rest then at least raw_record_s under vibration; Campaign::raw holds them and each
+  // run's measured_g / sigma_g is the batch-means measurement of its own record.
+  double raw_sample_rate_Hz = 0, raw_noise_sigma_g = 20e-6, raw_record_s = 1.0;
 };
 
 // The default design (docs/data-format.md): 7 frequencies 10 Hz - 1.5 kHz x 1, 2, 4 g x

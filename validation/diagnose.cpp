@@ -49,8 +49,10 @@ std::vector<EffectModel> make_library() {
     EffectModel e;
     e.name = "pendulum_geometry";
     e.parameter = "fraction", e.unit = "1";  // a hypothesis: 1 = present; the fit says how much of it the data show
+    e.lower = -0.5, e.upper = 1.5;
     e.physics = "vibropendulous coupling: the input axis turns with the pendulum, so vibration along IA and PA in "
-                "phase rectifies as -<a_PA theta>; zero for vibration along one axis only";
+                "phase rectifies as -<a_PA theta>; with a static a_IA also -a_IA <theta^2> / 4, which alone looks like "
+                "the pickoff nonlinearity";
     e.linear = true, e.unit_value = 1;
     e.apply = [](double p, PlantConfig& c, vibration::SineVibration&, std::optional<double>&) {
       if (p != 0) c.effects.push_back(std::make_shared<plant::PendulumGeometry>());
@@ -76,6 +78,7 @@ std::vector<EffectModel> make_library() {
     EffectModel e;
     e.name = "nonlinearity_at_input";
     e.parameter = "fraction", e.unit = "1";
+    e.lower = -0.5, e.upper = 1.5;  // a hypothesis: 0 (in the loop) or 1 (at the input)
     e.physics = "the input-axis nonlinearity (k1', k2, k3, k4) acts on the mechanical input, not in the torquer: it "
                 "sees the vibration itself, not the rebalance current, so it stays flat with frequency where the "
                 "loop-placed one peaks near the crossover and falls above it";
@@ -281,7 +284,11 @@ class EffectFitter {
       const double u0 = info > 0 ? s.dot(ldlt.solve(r)) / info : 0.0;
       const double su = info > 0 ? 1 / std::sqrt(info) : 1.0;
       const double half = 3 * std::abs(u0) + 20 * su;
-      for (int k = 0; k <= 60; ++k) xs.push_back(e_.nominal + du * (u0 - half + 2 * half * k / 60.0));
+      double lo = e_.nominal + du * (u0 - half), hi = e_.nominal + du * (u0 + half);
+      if (lo > hi) std::swap(lo, hi);
+      lo = std::clamp(lo, e_.lower, e_.upper), hi = std::clamp(hi, e_.lower, e_.upper);
+      if (!(hi > lo)) lo = e_.lower, hi = e_.upper;  // the estimate lies outside the physical range
+      for (int k = 0; k <= 60; ++k) xs.push_back(lo + (hi - lo) * k / 60.0);
     } else {
       xs = e_.grid;
     }

@@ -15,6 +15,7 @@
 // vector r has covariance V = diag(sigma_run^2 + (f_model pred)^2) + G Sigma G^T (G: the
 // prediction's gradient in the coefficients, Sigma their covariance from the static test,
 // f_model the simulation's own relative accuracy). Fits and chi^2 use V.
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -48,8 +49,16 @@ struct RunRecord {
   vibration::SineVibration vibration() const;
 };
 
+// A run's raw record (the virtual lab's, when asked for): time (s) and output (output units),
+// the rest at t < 0 then the vibration, with the windows a lab would measure over.
+struct RawRecord {
+  std::vector<double> t_s, output;
+  double rest_from_s = 0, rest_to_s = 0, on_from_s = 0, on_to_s = 0;
+};
+
 struct Campaign {
   std::string name;
+  std::vector<RawRecord> raw;  // one per run when the runs were recorded raw; else empty
   plant::Dynamics dynamics;  // nominal
   FixedSet fixed{};          // coefficients the identification holds
   std::vector<StaticRecord> statics;
@@ -66,6 +75,7 @@ struct EffectModel {
   bool changes_dynamics = false;  // the loop's linear response depends on the parameter
   std::vector<double> grid;     // values tried (nonlinear effects)
   double unit_value = 1;        // the parameter value used for the signature (linear effects)
+  double lower = -INFINITY, upper = INFINITY;  // physical range of the fit (hypotheses: [-0.5, 1.5])
   // Applies parameter p to the nominal plant and to the vibration (sensor axes).
   std::function<void(double p, plant::PlantConfig&, vibration::SineVibration&, std::optional<double>& range_g)> apply;
 };
