@@ -9,32 +9,17 @@
 
 #include <nlohmann/json.hpp>
 
+#include "support/files.hpp"
 #include "app/case_file.hpp"
 #include "app/commands.hpp"
 
 using namespace vrelab::app;
 namespace fs = std::filesystem;
+using vrelab::test::read_file;
+using vrelab::test::TempDir;
 using nlohmann::json;
 
 namespace {
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() / ("vrelab-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                                        "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
 
 // A copy of a shipped case with one regex replacement applied.
 fs::path edited_case(const TempDir& d, const std::string& name, const std::string& pattern, const std::string& with) {

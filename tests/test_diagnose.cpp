@@ -14,6 +14,8 @@
 
 #include <fmt/format.h>
 
+#include "support/files.hpp"
+#include "support/random_coefficients.hpp"
 #include "app/case_file.hpp"
 #include "app/commands.hpp"
 #include "app/lab_data.hpp"
@@ -26,15 +28,14 @@
 using namespace vrelab;
 using namespace vrelab::validation;
 namespace fs = std::filesystem;
+using vrelab::test::read_file;
+using vrelab::test::TempDir;
 
 namespace {
 
 plant::PlantConfig truth() {
   plant::PlantConfig p;
-  auto& c = p.coefficients;
-  c[plant::K1] = 1.25, c[plant::k0] = 1.5e-3, c[plant::k1_asym] = 2e-5, c[plant::k2] = 1.5e-5, c[plant::k3] = 1e-6;
-  c[plant::k4] = 2e-7, c[plant::delta_OA] = 1e-4, c[plant::delta_PA] = -5e-5, c[plant::k_IP] = 8e-6;
-  c[plant::k_IO] = -5e-6, c[plant::k_PO] = 3e-6;
+  p.coefficients = test::paper_like();
   return p;
 }
 
@@ -46,17 +47,6 @@ CampaignDesign small_design() {
   d.directions = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0).normalized()};
   return d;
 }
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() / ("vrelab-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                                        "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
 
 }  // namespace
 

@@ -14,6 +14,7 @@
 #include <Eigen/Cholesky>
 #include <nlohmann/json.hpp>
 
+#include "support/files.hpp"
 #include "app/case_file.hpp"
 #include "app/commands.hpp"
 #include "app/report.hpp"
@@ -25,36 +26,14 @@
 using namespace vrelab;
 using namespace vrelab::plant;
 using namespace vrelab::validation;
+using vrelab::test::paper_like;
 namespace fs = std::filesystem;
+using vrelab::test::read_file;
+using vrelab::test::TempDir;
 using nlohmann::json;
 constexpr double kArcsec = std::numbers::pi / (180 * 3600);
 
 namespace {
-
-std::string read_file(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    path = fs::temp_directory_path() / ("vrelab-test-" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
-                                        "-" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
-
-Coefficients paper_like() {
-  Coefficients c;
-  c[K1] = 1.25, c[k0] = 1.5e-3, c[k1_asym] = 2e-5, c[k2] = 1.5e-5, c[k3] = 1e-6, c[k4] = 2e-7;
-  c[delta_OA] = 1e-4, c[delta_PA] = -5e-5, c[k_IP] = 8e-6, c[k_IO] = -5e-6, c[k_PO] = 3e-6;
-  return c;
-}
 
 using Cov = std::array<CoefArray, kNumCoefficients>;
 

@@ -7,22 +7,17 @@
 #include <numbers>
 #include <random>
 
+#include "support/random_coefficients.hpp"
 #include "plant/model1.hpp"
 #include "validation/static_test.hpp"
 
 using namespace vrelab;
 using namespace vrelab::plant;
 using namespace vrelab::validation;
+using vrelab::test::paper_like;
 constexpr double kArcsec = std::numbers::pi / (180 * 3600);
 
 namespace {
-
-Coefficients paper_like() {
-  Coefficients c;
-  c[K1] = 1.25, c[k0] = 1.5e-3, c[k1_asym] = 2e-5, c[k2] = 1.5e-5, c[k3] = 1e-6, c[k4] = 2e-7;
-  c[delta_OA] = 1e-4, c[delta_PA] = -5e-5, c[k_IP] = 8e-6, c[k_IO] = -5e-6, c[k_PO] = 3e-6;
-  return c;
-}
 
 StaticTestErrors paper_errors() {
   StaticTestErrors e;
