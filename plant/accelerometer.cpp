@@ -185,6 +185,7 @@ double Accelerometer::solve_z(double i) const {
 double Accelerometer::readout(double i, const Vec3& a) const {
   double out = i + cross(Location::output, a);
   if (has_out_ia_) out += f_ia(Location::output, solve_z(i));
+  for (const auto& e : config_.effects) out = e->readout(out);
   return out;
 }
 
@@ -219,6 +220,7 @@ void Accelerometer::rhs(double t, const double* x, double* dx) const {
 
   double out = i + cross(Location::output, a);
   if (has_out_ia_) out += f_ia(Location::output, z);
+  for (const auto& e : config_.effects) out = e->readout(out);
   if (d.antialias_Hz > 0) {
     const double wa = 2 * kPi * d.antialias_Hz;
     dx[kAA1] = x[kAA2];

@@ -14,7 +14,8 @@
 //   theta'' = -2 zeta w_p theta' - w_p^2 theta + b (s1 - tau(i) + effects' extra input)
 //   u = G * pickoff(theta);  y = lead(u);  i = y + w_i * integral(y)   (PI + phase lead)
 //   tau(i) = m_in(m_il^-1(i))                                   torquer with the loop terms
-//   U/K1 = i + F_output(m_il^-1(i)) + C_output(a)               readout
+//   U/K1 = R(i + F_output(m_il^-1(i)) + C_output(a))            readout (R: the effects'
+//                                                               readout hooks; identity without)
 // where F_X(z) = sum over the IA terms (k0, k1_asym, k2, k3, k4) placed at X of k f(z),
 // C_X the cross terms (delta_*, k_IP..k_OO) placed at X, m_in(z) = z + F_input(z) and
 // m_il(z) = z + F_input(z) + F_loop(z). With the integrator theta = 0 at rest, so

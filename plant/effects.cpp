@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <utility>
 
 namespace vrelab::plant {
 
@@ -16,6 +17,18 @@ CurrentSaturation::CurrentSaturation(double limit_g) : limit_g_(limit_g) {
 }
 
 double CurrentSaturation::current(double i) const { return std::clamp(i, -limit_g_, limit_g_); }
+
+OutputPolynomial::OutputPolynomial(std::string name, const std::array<double, 7>& c) : name_(std::move(name)), c_(c) {
+  if (c[0] != 0 || c[1] != 0) throw std::invalid_argument(name_ + ": the readout polynomial starts at u^2");
+  for (double x : c)
+    if (!std::isfinite(x)) throw std::invalid_argument(name_ + ": readout coefficients must be finite");
+}
+
+double OutputPolynomial::readout(double u) const {
+  double s = 0;  // Horner on c_6 u^6 + ... + c_2 u^2
+  for (int n = 6; n >= 2; --n) s = (s + c_[static_cast<std::size_t>(n)]) * u;
+  return u + s * u;
+}
 
 double PendulumGeometry::extra_input_g(double theta, double, double s1, const Vec3& a) const {
   return s1 * (std::cos(theta) - 1) - a[PA] * std::sin(theta);

@@ -5,8 +5,9 @@
 // places: the mechanical input (the acceleration the pendulum feels), the pickoff, the
 // torquer current, and the pendulum's torque balance; it may own states. Adding an effect is
 // a new class here and a line in the case reader. Each hook's default is the identity, so
-// an effect overrides only where it acts. None of the shipped effects changes the static
-// response inside the range: the static identification cannot see them.
+// an effect overrides only where it acts. Only OutputPolynomial changes the static response
+// inside the range (the static identification absorbs part of it); the others vanish at rest.
+#include <array>
 #include <complex>
 #include <memory>
 #include <string>
@@ -29,6 +30,8 @@ class Effect {
   virtual Vec3 input(const Vec3& a_g, const double* /*s*/, double* /*ds*/) const { return a_g; }
   virtual double pickoff(double theta_rad) const { return theta_rad; }
   virtual double current(double i_g) const { return i_g; }
+  // The readout: the normalised output U/K1 (g) as read, before the anti-alias filter.
+  virtual double readout(double u_g) const { return u_g; }
   // Extra unbalanced input on the pendulum, in g (the plant multiplies by b = P g / J):
   // s1 is the input-axis drive, a_g the acceleration the pendulum feels.
   virtual double extra_input_g(double /*theta_rad*/, double /*omega_rad_per_s*/, double /*s1_g*/,
@@ -70,6 +73,24 @@ class CurrentSaturation final : public Effect {
 
  private:
   double limit_g_;
+};
+
+// A polynomial on the readout: U/K1 = u -> u + sum_n c_n u^n, n = 2..6 (u in g, c_n in
+// 1/g^(n-1)). One mechanism for two effects of validation/diagnose.hpp's library: the
+// instrument's terms of higher order than model (1) identifies (k5 u^5, k6 u^6: they act at
+// rest too, and in the loop they would rectify alike, the averaged torque balance making
+// loop and output equivalent), and the nonlinearity of the data acquisition that records
+// the shaker runs (q2 u^2; a lab reads its static test with another instrument).
+class OutputPolynomial final : public Effect {
+ public:
+  OutputPolynomial(std::string name, const std::array<double, 7>& c);  // c[n] multiplies u^n; c[0], c[1] must be 0
+  std::string name() const override { return name_; }
+  double readout(double u) const override;
+  const std::array<double, 7>& coefficients() const { return c_; }
+
+ private:
+  std::string name_;
+  std::array<double, 7> c_;
 };
 
 // A second mechanical mode (flexure or mount resonance) between the case and the pendulum

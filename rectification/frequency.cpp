@@ -107,6 +107,24 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
   out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * std::norm(theta) / 2;
   if (geometry)
     out.pendulum_geometry_g = dc_gain * (-0.5 * std::real(F[PA] * std::conj(theta)) - a[IA] * std::norm(theta) / 4);
+  // A readout polynomial: the period average of R over the output's oscillation, by the
+  // trapezoidal rule on 32 points (exact for a trigonometric polynomial of degree < 32).
+  // U: the output's oscillation, the current plus the output-placed cross terms' linear part
+  // (their gradient at the static orientation, on what the pendulum's base feels).
+  Coefficients cross_out;
+  cross_out[K1] = 1;
+  for (int c = delta_OA; c < kNumCoefficients; ++c)
+    if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
+  const Vec3 slope = plant::output_gradient(cross_out, a) - Vec3::UnitX();
+  std::complex<double> U = current + slope[IA] * F[IA] + slope[PA] * F[PA] + slope[OA] * F[OA];
+  const double u0 = plant::output_g(config.coefficients, a);
+  for (const auto& e : config.effects) {
+    if (!dynamic_cast<const OutputPolynomial*>(e.get())) continue;
+    constexpr int kN = 32;
+    double mean = 0;
+    for (int k = 0; k < kN; ++k) mean += e->readout(u0 + std::real(U * std::polar(1.0, 2 * std::numbers::pi * k / kN)));
+    out.readout_g += mean / kN - e->readout(u0);
+  }
   out.loop_dc_gain = dc_gain;
   return out;
 }

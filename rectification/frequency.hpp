@@ -12,7 +12,9 @@
 //  - pickoff nonlinearity p2: (w_p^2 / b) p2 |Theta|^2 / 2, Theta = sum_j G_j(jw) W_j the
 //    pendulum angle (<theta> = -p2 <theta^2> and the hinge stiffness turns it into torque);
 //  - pendulum geometry: -Re(W_PA conj(Theta)) / 2 - a_IA |Theta|^2 / 4 (vibropendulous);
-//  - clipping at [range]: of the current's amplitude |I|.
+//  - clipping at [range]: of the current's amplitude |I|;
+//  - a polynomial on the readout R(u) (plant::OutputPolynomial): <R(u0 + Re(U e^{jwt}))> -
+//    R(u0), u0 the static output of (1), U = I + the output-placed cross terms' linear part.
 // H and G come from the linearisation of the plant with every nonlinear part removed. What
 // rectifies before the loop (input terms, the torquer, the pendulum geometry) reaches the
 // output with the loop's DC gain: 1 with the integrator, L0/(1 + L0) without (L0 = b G/w_p^2).
@@ -32,10 +34,11 @@ struct FrequencyPrediction {
   Eq3Terms terms;                         // the terms of (1), at this frequency
   double pickoff_g = 0.0;                 // effect: pickoff nonlinearity
   double pendulum_geometry_g = 0.0;       // effect: vibropendulous coupling
+  double readout_g = 0.0;                 // effect: a polynomial on the readout
   std::complex<double> current_amplitude_g;  // I
   std::complex<double> angle_amplitude_rad;  // Theta
   double loop_dc_gain = 1.0;  // from a disturbance before the loop to the output; 1 with the integrator
-  double total_g() const { return terms.total_g() + pickoff_g + pendulum_geometry_g; }
+  double total_g() const { return terms.total_g() + pickoff_g + pendulum_geometry_g + readout_g; }
 };
 
 FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,

@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <array>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -62,6 +64,17 @@ TEST(FrequencyDependentEq3, MatchesTheOdeForEachMechanismFrom1HzTo5kHz) {
     c.effects.push_back(std::make_shared<PendulumGeometry>());
     ms.push_back({"pendulum geometry", c, Vec3(2, 1.5, 0)});
   }
+  {
+    auto c = base();  // terms beyond (1): k5 u^5 + k6 u^6 on the readout
+    c.effects.push_back(std::make_shared<OutputPolynomial>("higher_order", std::array<double, 7>{0, 0, 0, 0, 0, 3e-6, 1e-6}));
+    ms.push_back({"k5, k6 on the readout", c, Vec3(3, 0, 0)});
+  }
+  {
+    auto c = base();  // a quadratic readout, with a misalignment at the output in its way
+    c.coefficients[delta_OA] = 2e-2;  // (a_PA), large enough to matter above the loop
+    c.effects.push_back(std::make_shared<OutputPolynomial>("readout", std::array<double, 7>{0, 0, 2e-5, 0, 0, 0, 0}));
+    ms.push_back({"q2 on the readout", c, Vec3(2, 1.5, 0)});
+  }
   for (const auto& m : ms) {
     for (double f : {1.0, 30.0, 200.0, 500.0, 1000.0, 5000.0}) {
       vibration::SineVibration v;
@@ -72,6 +85,23 @@ TEST(FrequencyDependentEq3, MatchesTheOdeForEachMechanismFrom1HzTo5kHz) {
       EXPECT_NEAR(measured, predicted, 0.01 * std::abs(predicted) + 1e-12) << m.name << " at " << f << " Hz";
     }
   }
+}
+
+// At rest a readout polynomial R acts on model (1)'s output: U/K1 = R(model (1) / K1), the
+// static test sees it (checked against the closed form at a few orientations).
+TEST(FrequencyDependentEq3, ReadoutPolynomialActsOnTheStaticOutputToo) {
+  PlantConfig c;
+  c.coefficients[K1] = 1.25, c.coefficients[k2] = 1.5e-5, c.coefficients[k_IP] = 5e-6;
+  const std::array<double, 7> poly{0, 0, 1e-5, 2e-6, 0, 1e-7, 3e-8};
+  c.effects.push_back(std::make_shared<OutputPolynomial>("higher_order", poly));
+  for (const Vec3& a : {Vec3(1, 0, 0), Vec3(-0.6, 0.8, 0), Vec3(0.3, 0.2, -0.9)}) {
+    const double u = output_g(c.coefficients, a);
+    double r = u;
+    for (int n = 2; n <= 6; ++n) r += poly[static_cast<std::size_t>(n)] * std::pow(u, n);
+    // settled_output_g solves the rest state by Newton to ~1e-15 relative.
+    EXPECT_NEAR(settled_output_g(c, a), r, 1e-13) << a.transpose();
+  }
+  EXPECT_THROW(OutputPolynomial("x", std::array<double, 7>{0, 1e-3, 0, 0, 0, 0, 0}), std::invalid_argument);
 }
 
 TEST(FrequencyDependentEq3, IsEq3AtLowFrequencyAndFallsAboveTheLoop) {
