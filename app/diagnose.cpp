@@ -73,6 +73,7 @@ json diagnosis_json(const validation::Diagnosis& d, const validation::Campaign& 
            {{"runs", d.resimulated_runs},
             {"rms_without_effect_g", d.resimulated_rms_before_g},
             {"rms_with_effect_g", d.resimulated_rms_after_g},
+            {"failures", d.resimulation_failures},
             {"what", "measured - ODE plant (coefficients corrected by all runs under the chosen effect), runs with the "
                      "largest gaps"}}},
           {"identified", coefficients_json(d.identified)},
@@ -108,7 +109,12 @@ validation::HiddenEffect draw_effect(const std::string& name, std::mt19937_64& r
   if (name == "servo_dynamics") return {name, sign(rng) ? log_uniform(rng, 0.6, 0.85) : log_uniform(rng, 1.15, 1.6)};
   if (name == "mechanical_mode") return {name, log_uniform(rng, 300, 1200)};
   if (name == "shaker_transverse_motion") return {name, s * log_uniform(rng, 0.02, 0.1)};
+  if (name == "servo_phase_margin") return {name, s * log_uniform(rng, 4, 20)};
+  if (name == "higher_order_k5") return {name, s * log_uniform(rng, 5e-8, 5e-7)};
+  if (name == "higher_order_k6") return {name, s * log_uniform(rng, 1e-8, 6e-8)};
+  if (name == "readout_nonlinearity") return {name, s * log_uniform(rng, 1e-5, 4e-5)};
   if (name == "shaker_harmonic_distortion") return {name, log_uniform(rng, 0.1, 0.3)};
+  if (name == "fixture_rocking") return {name, s * log_uniform(rng, 0.2e-6, 1e-6)};
   throw std::invalid_argument("blind: no parameter range for " + name);
 }
 
@@ -183,6 +189,7 @@ void run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
                        "with it\n",
                        d.resimulated_runs, d.resimulated_rms_before_g * 1e6, d.effects.front().name,
                        d.resimulated_rms_after_g * 1e6);
+  for (const auto& f : d.resimulation_failures) out << "  re-simulation failed: " << f << "\n";
   json j = {{"program", program_record()}, {"command", "diagnose"}, {"data", o.dir}, {"campaign", c.name}};
   j["nominal_dynamics"] = {{"pendulum_frequency_Hz", c.dynamics.pendulum_frequency_Hz},
                            {"pendulum_damping_ratio", c.dynamics.pendulum_damping_ratio},
@@ -244,6 +251,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
     std::vector<validation::HiddenEffect> hidden;
     validation::Diagnosis d;
     std::string error;
+    double simulate_s = 0, wall_s = 0;  // the campaign's simulation; with its diagnosis
   };
   std::vector<Case1> cases(static_cast<std::size_t>(o.n));
   std::vector<std::string> library;
@@ -257,7 +265,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
       k.category = "clean";
     } else if (slot == 2) {
       k.category = "out_of_library";
-      k.hidden.push_back(draw_effect("shaker_harmonic_distortion", rng));
+      k.hidden.push_back(draw_effect(i / 10 % 2 == 0 ? "shaker_harmonic_distortion" : "fixture_rocking", rng));
     } else if (slot == 3) {
       k.category = "two";
       std::vector<std::string> pick = library;
@@ -274,14 +282,17 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   auto worker = [&] {
     for (int i = next++; i < o.n; i = next++) {
       Case1& k = cases[static_cast<std::size_t>(i)];
+      const auto t0 = std::chrono::steady_clock::now();
       try {
         std::mt19937_64 rng(k.seed + 17);
         const plant::PlantConfig truth = random_truth(rng);
         const validation::Campaign camp = validation::simulate_campaign(truth, k.hidden, validation::default_design(), k.seed, 1);
+        k.simulate_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         k.d = validation::diagnose(camp);  // the key (k.hidden) is not passed
       } catch (const std::exception& e) {
         k.error = e.what();
       }
+      k.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       std::lock_guard<std::mutex> g(lock);
       ++done;
       out << fmt::format("\r  {}/{} campaigns", done.load(), o.n) << std::flush;
@@ -334,7 +345,8 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
     }
     json h = json::array();
     for (const auto& x : k.hidden) h.push_back({{"name", x.name}, {"parameter", x.parameter}});
-    json row = {{"index", k.index}, {"seed", k.seed}, {"category", k.category}, {"hidden", h}, {"called", called}};
+    json row = {{"index", k.index}, {"seed", k.seed},        {"category", k.category}, {"hidden", h},
+                {"called", called}, {"simulate_s", k.simulate_s}, {"wall_s", k.wall_s}};
     if (k.error.empty()) {
       row["top"] = top;
       row["top_parameter"] = k.d.effects.front().value;

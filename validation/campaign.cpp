@@ -26,11 +26,13 @@ CampaignDesign default_design() {
   d.frequencies_Hz = {10, 40, 100, 200, 400, 800, 1500};
   d.amplitudes_g = {1, 2, 4};
   d.directions = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 0).normalized()};
-  d.orientations_g = {Vec3(1, 0, 1).normalized()};
+  d.orientations_g = {Vec3(1, 0, 1).normalized(), Vec3(-1, 0, 1).normalized()};  // a_IA = +-0.71 g
   return d;
 }
 
-bool is_out_of_library(const std::string& name) { return name == "shaker_harmonic_distortion"; }
+bool is_out_of_library(const std::string& name) {
+  return name == "shaker_harmonic_distortion" || name == "fixture_rocking";
+}
 
 Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
                            const CampaignDesign& design, std::uint64_t seed, int threads) {
@@ -47,20 +49,21 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n01;
 
-  // The truth plant with its hidden effects (those that live in the plant).
-  plant::PlantConfig plant = truth;
+  // The truth plant with its hidden effects (those that live in the plant); the static test
+  // reads it without those that live in the shaker runs' data acquisition.
+  plant::PlantConfig plant = truth, static_plant = truth;
   for (const auto& h : hidden) {
     if (is_out_of_library(h.name)) continue;
+    const EffectModel& e = *find_effect(h.name);
     vibration::SineVibration dummy;
-    std::optional<double> range;
-    find_effect(h.name)->apply(h.parameter, plant, dummy, range);
-    if (range) plant.effects.push_back(std::make_shared<plant::CurrentSaturation>(*range));
+    e.apply(h.parameter, plant, dummy);
+    if (!e.shaker_runs_only) e.apply(h.parameter, static_plant, dummy);
   }
 
   // Static test: the plant settled in each position.
   const std::vector<Position> positions = equally_spaced_positions(design.positions_per_series);
   const double K1 = plant.coefficients[plant::K1];
-  const OutputSource source = [&plant, K1](const Vec3& a) { return K1 * plant::settled_output_g(plant, a); };
+  const OutputSource source = [&static_plant, K1](const Vec3& a) { return K1 * plant::settled_output_g(static_plant, a); };
   const std::vector<Reading> readings = simulate_static_test(source, K1, positions, design.errors, rng);
   // The readings' sigma as a lab states it: noise and set-angle error through the scale
   // factor alone (nothing of the truth's nonlinearity or hidden effects).
@@ -94,19 +97,32 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
       const vibration::SineVibration commanded = r.vibration();
       vibration::SineVibration table = commanded;
       std::vector<vibration::Harmonic> harmonics;
+      double rocking_rad_per_g = 0;
       for (const auto& h : hidden) {
-        if (is_out_of_library(h.name)) {
-          harmonics.push_back({2, h.parameter, 0.0});
-          continue;
-        }
+        if (h.name == "shaker_harmonic_distortion") harmonics.push_back({2, h.parameter, 0.0});
+        if (h.name == "fixture_rocking") rocking_rad_per_g = h.parameter;
+        if (is_out_of_library(h.name)) continue;
         plant::PlantConfig unused = truth;
-        std::optional<double> range;
-        find_effect(h.name)->apply(h.parameter, unused, table, range);  // the shaker's own motion
+        find_effect(h.name)->apply(h.parameter, unused, table);  // the shaker's own motion
       }
       std::shared_ptr<const vibration::Excitation> motion;
       auto tone = std::make_shared<vibration::SineExcitation>(table);
       if (!harmonics.empty()) motion = std::make_shared<vibration::HarmonicDistortion>(tone, harmonics);
       else motion = tone;
+      if (rocking_rad_per_g != 0) {
+        // The fixture rocks about OA in phase with the table, by rocking_rad_per_g per g of
+        // commanded amplitude, the sensor 30 mm from the axis along IA: gravity and the table's
+        // motion turn with it, and the lever arm adds a tangential acceleration along PA
+        // (~ f^2) and a centripetal one along -IA (rectified: ~ f^2 alpha^2).
+        vibration::RockingSpec rs;
+        rs.axis = Vec3::UnitZ();
+        rs.amplitude_rad = std::abs(rocking_rad_per_g) * r.amplitude_g;
+        rs.phase_rad = rocking_rad_per_g < 0 ? std::numbers::pi : 0.0;
+        rs.static_gravity_g = r.orientation_g;
+        rs.lever_arm_m = Vec3(0.03, 0, 0);
+        rs.g_m_per_s2 = 9.80665;
+        motion = std::make_shared<vibration::Rocking>(motion, tone, rs);
+      }
       try {
         if (raw) {
           rectification::ShakeSettings ss;

@@ -4,7 +4,9 @@
 //
 // Takes: the truth plant (coefficients, dynamics), the hidden effects (names of
 //        validation/diagnose.hpp's library with their parameter, or the out-of-library
-//        "shaker_harmonic_distortion" with its 2nd-harmonic ratio), the campaign design (the
+//        "shaker_harmonic_distortion" with its 2nd-harmonic ratio and "fixture_rocking" with
+//        its rocking in rad per g of table amplitude, about OA, the sensor 30 mm along IA
+//        from the axis), the campaign design (the
 //        static positions and errors; the shaker runs: frequencies x amplitudes x directions
 //        x static orientations; each run's measurement sigma), a seed.
 // Gives: a Campaign as a lab would hand it over: static readings (the ODE plant settled in
@@ -41,7 +43,8 @@ struct CampaignDesign {
 };
 
 // The default design (docs/data-format.md): 7 frequencies 10 Hz - 1.5 kHz x 1, 2, 4 g x
-// IA, PA, OA, IA+PA x one static orientation; 3 x 12 static positions, twice each.
+// IA, PA, OA, IA+PA x two static orientations with opposite a_IA (+-0.71 g, OA up: the
+// terms odd in a_IA change sign, the even ones do not); 3 x 12 static positions, twice each.
 CampaignDesign default_design();
 
 // Out-of-library effects the virtual lab can hide (diagnose must call them unexplained).

@@ -75,9 +75,16 @@ struct EffectModel {
   bool changes_dynamics = false;  // the loop's linear response depends on the parameter
   std::vector<double> grid;     // values tried (nonlinear effects)
   double unit_value = 1;        // the parameter value used for the signature (linear effects)
-  double lower = -INFINITY, upper = INFINITY;  // physical range of the fit (hypotheses: [-0.5, 1.5])
+  // The physical range of the fit: hypotheses [-0.5, 1.5]; other linear effects
+  // nominal +- 100 |unit_value - nominal| (set by effect_library()).
+  double lower = -INFINITY, upper = INFINITY;
+  // Acts at rest too (linear effects only): the static test took up part of it into the
+  // identified coefficients; diagnose gives that part back (docs/diagnose.md).
+  bool acts_at_rest = false;
+  // Lives in the shaker runs' data acquisition only: a lab reads its static test apart.
+  bool shaker_runs_only = false;
   // Applies parameter p to the nominal plant and to the vibration (sensor axes).
-  std::function<void(double p, plant::PlantConfig&, vibration::SineVibration&, std::optional<double>& range_g)> apply;
+  std::function<void(double p, plant::PlantConfig&, vibration::SineVibration&)> apply;
 };
 const std::vector<EffectModel>& effect_library();
 const EffectModel* find_effect(const std::string& name);
@@ -135,8 +142,10 @@ struct Diagnosis {
   double rms_before_sigma = 0, rms_after_sigma = 0;  // the same in units of each run's sigma
   // The confirmation on the ODE plant (the runs with the largest gaps; coefficients corrected
   // by all runs under the chosen effect): rms of measured - ODE without and with the effect.
+  // Only when the gap is explained; runs whose simulation failed are listed (id: why) and left out.
   int resimulated_runs = 0;
   double resimulated_rms_before_g = 0, resimulated_rms_after_g = 0;
+  std::vector<std::string> resimulation_failures;
 };
 
 Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {});
