@@ -54,8 +54,16 @@ json diagnosis_json(const validation::Diagnosis& d, const validation::Campaign& 
                     {"heldout_before_g", x.heldout_before_g},
                     {"heldout_after_g", x.heldout_after_g}});
   }
+  json pairs = json::array();
+  for (const auto& p : d.pairs)
+    pairs.push_back({{"names", {p.a, p.b}},
+                     {"parameters", {p.pa, p.pb}},
+                     {"evidence", p.evidence},
+                     {"heldout_chi2", p.heldout_chi2}});
   return {{"gap_significant", d.gap_significant},
           {"verdict", d.verdict},
+          {"chosen", d.chosen},
+          {"pairs", pairs},
           {"explained", d.explained},
           {"where", d.where},
           {"significant_runs", d.significant_runs},
@@ -181,13 +189,16 @@ void run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
   for (const auto& e : d.effects)
     out << fmt::format("  {:<26}{:>16.5g}{:>12.3g}{:>12.1f}{:>14.1f}  {} ({})\n", e.name, e.value, e.sigma, e.evidence,
                        e.heldout_chi2, e.parameter, e.unit);
+  for (const auto& p : d.pairs)
+    out << fmt::format("  pair {:<40}{:>12.5g},{:<12.5g}{:>12.1f}{:>14.1f}\n", p.a + " + " + p.b, p.pa, p.pb, p.evidence,
+                       p.heldout_chi2);
   out << fmt::format("Held-out gap rms: {:.4g} ug ({:.3g} sigma) before, {:.4g} ug ({:.3g} sigma) after {} ({:.1f} s wall)\n",
-                     d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, d.effects.front().name,
+                     d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, d.chosen,
                      wall);
   if (d.resimulated_runs > 0)
     out << fmt::format("Re-simulated on the ODE plant ({} runs with the largest gaps): rms {:.4g} ug without {}, {:.4g} ug "
                        "with it\n",
-                       d.resimulated_runs, d.resimulated_rms_before_g * 1e6, d.effects.front().name,
+                       d.resimulated_runs, d.resimulated_rms_before_g * 1e6, d.chosen,
                        d.resimulated_rms_after_g * 1e6);
   for (const auto& f : d.resimulation_failures) out << "  re-simulation failed: " << f << "\n";
   json j = {{"program", program_record()}, {"command", "diagnose"}, {"data", o.dir}, {"campaign", c.name}};
@@ -217,19 +228,28 @@ void run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
       rows.push_back({e.name, e.parameter + " (" + e.unit + ")", fmt::format("{:.5g}", e.value), fmt::format("{:.3g}", e.sigma),
                       fmt::format("{:.1f}", e.evidence), fmt::format("{:.1f}", e.heldout_chi2)});
     rep.table(rows);
+    if (!d.pairs.empty()) {
+      rep.paragraph("No one effect explains the gap; the pairs of the three best, fitted together (additive to first "
+                    "order), a pair chosen only when its evidence beats the best single effect's by 25:");
+      std::vector<std::vector<std::string>> prow = {{"pair", "parameters", "evidence", "held-out chi2"}};
+      for (const auto& p : d.pairs)
+        prow.push_back({p.a + " + " + p.b, fmt::format("{:.5g}, {:.5g}", p.pa, p.pb), fmt::format("{:.1f}", p.evidence),
+                        fmt::format("{:.1f}", p.heldout_chi2)});
+      rep.table(prow);
+    }
     rep.paragraph("Verdict: " + d.verdict + ".");
     rep.heading("3. How far it shrinks");
     rep.paragraph(fmt::format(
         "On the held-out runs (each amplitude predicted from the others), the gap the static test's coefficient errors "
         "cannot take up has rms {:.4g} ug ({:.3g} sigma) with the nominal simulation and {:.4g} ug ({:.3g} sigma) with {} "
         "added: {:.0f} % removed.",
-        d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, d.effects.front().name,
+        d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, d.chosen,
         d.rms_before_g > 0 ? 100 * (1 - d.rms_after_g / d.rms_before_g) : 0.0));
     if (d.resimulated_runs > 0)
       rep.paragraph(fmt::format(
           "Confirmed on the ODE plant: the {} runs with the largest gaps re-simulated with the coefficients corrected by "
           "all runs under {} and the effect added leave rms {:.4g} ug; without the effect, {:.4g} ug.",
-          d.resimulated_runs, d.effects.front().name, d.resimulated_rms_after_g * 1e6, d.resimulated_rms_before_g * 1e6));
+          d.resimulated_runs, d.chosen, d.resimulated_rms_after_g * 1e6, d.resimulated_rms_before_g * 1e6));
     write_atomic(o.report_dir + "/diagnosis.json", j.dump(2) + "\n");
     const std::string why = run_plot_script("diagnose.py", o.report_dir);
     rep.figure("gap_map", "The gap per run, standardised against all the others (z), over frequency and amplitude, per direction.",
@@ -306,7 +326,8 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   // Scores against the keys.
-  int single = 0, single_right = 0, single_explained = 0, clean = 0, false_alarms = 0, ool = 0, ool_unexplained = 0, two = 0, two_hit = 0;
+  int single = 0, single_right = 0, single_explained = 0, clean = 0, false_alarms = 0, ool = 0, ool_unexplained = 0, two = 0,
+      two_hit = 0, two_both = 0;
   std::vector<double> shrink;
   std::map<std::string, std::map<std::string, int>> confusion;
   json rows = json::array();
@@ -314,7 +335,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   for (const Case1& k : cases) {
     const std::string truth = k.category == "single" ? k.hidden[0].name : k.category;
     std::string called = "error";
-    if (k.error.empty()) called = !k.d.gap_significant ? "clean" : k.d.explained ? k.d.effects.front().name : "unexplained";
+    if (k.error.empty()) called = !k.d.gap_significant ? "clean" : k.d.explained ? k.d.chosen : "unexplained";
     ++confusion[truth][called];
     const std::string top = k.error.empty() ? k.d.effects.front().name : "";
     if (k.category == "single") {
@@ -341,7 +362,10 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
                                     k.hidden[0].name, k.hidden[0].parameter, called));
     } else {
       ++two;
-      two_hit += called == k.hidden[0].name || called == k.hidden[1].name;
+      const std::string& a = k.hidden[0].name;
+      const std::string& b = k.hidden[1].name;
+      two_hit += called == a || called == b;
+      two_both += called == a + " + " + b || called == b + " + " + a;
     }
     json h = json::array();
     for (const auto& x : k.hidden) h.push_back({{"name", x.name}, {"parameter", x.parameter}});
@@ -373,6 +397,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
                  {"unexplained_recognition", ool ? static_cast<double>(ool_unexplained) / ool : 0.0},
                  {"out_of_library_campaigns", ool},
                  {"two_effect_explained_by_one_of_them", two ? static_cast<double>(two_hit) / two : 0.0},
+                 {"two_effect_explained_by_both", two ? static_cast<double>(two_both) / two : 0.0},
                  {"two_effect_campaigns", two},
                  {"median_shrinkage", median_shrink},
                  {"wrong", wrong},
@@ -381,6 +406,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   write_atomic(o.out_dir + "/scores.json", scores.dump(2) + "\n");
   std::vector<std::string> called_names = {"clean"};
   for (const auto& n : library) called_names.push_back(n);
+  called_names.push_back("two_effects");  // any "A + B" verdict
   called_names.push_back("unexplained");
   std::string csv = "# rows: the hidden truth; columns: what diagnose called it (without the key)\ntruth";
   for (const auto& n : called_names) csv += "," + n;
@@ -391,7 +417,13 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   truths.push_back("two");
   for (const auto& t : truths) {
     csv += t;
-    for (const auto& n : called_names) csv += fmt::format(",{}", confusion.count(t) && confusion[t].count(n) ? confusion[t][n] : 0);
+    for (const auto& n : called_names) {
+      int count = 0;
+      if (confusion.count(t))
+        for (const auto& [called, k] : confusion[t])
+          if (called == n || (n == "two_effects" && called.find(" + ") != std::string::npos)) count += k;
+      csv += fmt::format(",{}", count);
+    }
     csv += "\n";
   }
   write_atomic(o.out_dir + "/confusion.csv", csv);
@@ -402,7 +434,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   out << fmt::format("  hidden effect ranked first whatever the verdict: {}/{}\n", single_explained, single);
   out << fmt::format("  false alarms on clean campaigns: {}/{}\n", false_alarms, clean);
   out << fmt::format("  out-of-library called unexplained: {}/{}\n", ool_unexplained, ool);
-  out << fmt::format("  two effects, explained by one of them: {}/{}\n", two_hit, two);
+  out << fmt::format("  two effects: explained by both (a pair) {}/{}, by one of them {}/{}\n", two_both, two, two_hit, two);
   out << fmt::format("  median held-out shrinkage of the gap rms: {:.0f} %\n", 100 * median_shrink);
   for (const auto& w : wrong) out << "  wrong: " << w << "\n";
   const std::string why = run_plot_script("confusion.py", o.out_dir);

@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <numbers>
 #include <cmath>
+#include <functional>
 #include <map>
+#include <tuple>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -611,15 +613,13 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
     const Likelihood l_all = likelihood(data, t.pred, t.G, all), l_train = likelihood(data, t.pred, t.G, train);
     return Likelihood{l_all.m2logl - l_train.m2logl, l_all.chi2 - l_train.chi2};
   };
-  for (const EffectModel& e : effect_library()) {
-    const EffectFitter fitter(e, nominal, plant, c.runs, cache, absorbed);
-    Scored sc;
-    sc.fit.name = e.name, sc.fit.parameter = e.parameter, sc.fit.unit = e.unit;
+  // Scores a candidate: fitted on each fold's training runs (fit_on gives its table there),
+  // judged on the fold's held-out runs.
+  const auto score = [&](const std::function<Table(const std::vector<int>&)>& fit_on, Scored& sc) {
     sc.heldout = Eigen::VectorXd::Zero(n);
     for (const auto& [key, test] : folds) {
       const std::vector<int> train = train_of(key);
-      const double p = fitter.fit(data, train).first;
-      const Table t = fitter.at(p);
+      const Table t = fit_on(train);
       const Likelihood with = train.size() == all.size() ? likelihood(data, t.pred, t.G, all) : conditional(t, train);
       const Likelihood without =
           train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all) : conditional(nominal, train);
@@ -628,6 +628,13 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
       const Eigen::VectorXd a = adjusted_residual(data, t.pred, t.G, train, test);
       for (std::size_t i = 0; i < test.size(); ++i) sc.heldout(test[i]) = a(static_cast<Eigen::Index>(i));
     }
+  };
+  std::map<std::string, std::unique_ptr<EffectFitter>> fitters;
+  for (const EffectModel& e : effect_library()) {
+    const EffectFitter& fitter = *(fitters[e.name] = std::make_unique<EffectFitter>(e, nominal, plant, c.runs, cache, absorbed));
+    Scored sc;
+    sc.fit.name = e.name, sc.fit.parameter = e.parameter, sc.fit.unit = e.unit;
+    score([&](const std::vector<int>& train) { return fitter.at(fitter.fit(data, train).first); }, sc);
     const auto [p, sp] = fitter.fit(data, all);
     sc.fit.value = p, sc.fit.sigma = sp;
     sc.fit.at_bound = !std::isfinite(sp);
@@ -636,25 +643,84 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   std::sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
   for (const auto& sc : scored) d.effects.push_back(sc.fit);
 
-  // 4. The verdict and the held-out shrinkage of the chosen effect.
-  const Scored& best = scored.front();
-  double ss_b = 0, ss_a = 0, zs_b = 0, zs_a = 0;
+  // 4. The verdict and the held-out shrinkage of the chosen effect(s).
+  const auto explains = [&](const Scored& sc, double rms_after) {
+    return sc.fit.evidence > s.significance_sigma * s.significance_sigma &&
+           (sc.fit.heldout_chi2 / n <= s.explained_chi2_per_run || rms_after <= (1 - s.explained_shrinkage) * d.rms_before_g);
+  };
+  const auto rms = [&](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / n); };
+  const Scored* best = &scored.front();
+  double ss_b = 0, zs_b = 0;
   for (int k = 0; k < n; ++k) {
-    const double sk2 = data.sigma2(k);
-    ss_b += heldout_nominal(k) * heldout_nominal(k), ss_a += best.heldout(k) * best.heldout(k);
-    zs_b += heldout_nominal(k) * heldout_nominal(k) / sk2, zs_a += best.heldout(k) * best.heldout(k) / sk2;
-    d.runs[static_cast<std::size_t>(k)].heldout_after_g = best.heldout(k);
+    ss_b += heldout_nominal(k) * heldout_nominal(k), zs_b += heldout_nominal(k) * heldout_nominal(k) / data.sigma2(k);
     d.runs[static_cast<std::size_t>(k)].heldout_before_g = heldout_nominal(k);
   }
-  d.rms_before_g = std::sqrt(ss_b / n), d.rms_after_g = std::sqrt(ss_a / n);
-  d.rms_before_sigma = std::sqrt(zs_b / n), d.rms_after_sigma = std::sqrt(zs_a / n);
+  d.rms_before_g = std::sqrt(ss_b / n), d.rms_before_sigma = std::sqrt(zs_b / n);
+  std::vector<std::pair<const EffectModel*, double>> chosen = {{find_effect(best->fit.name), best->fit.value}};
+  // Two effects at once, when no one effect explains a significant gap: the best effect A with
+  // a second B, additive to first order (T = T_A(pA) + T_B(pB) - T_0). The candidates for B
+  // are ranked by how much they lower -2 ln L of what A leaves (A fitted on all runs); the two
+  // best are fitted together with A by alternating one-parameter fits, each on the data less
+  // the other's part, and scored on the held-out runs like a single effect. A pair is chosen
+  // only when its evidence beats A's by significance_sigma^2 and it explains the gap.
+  Scored pair_best;
+  if (d.gap_significant && !explains(*best, rms(best->heldout)) && s.try_pairs) {
+    const auto fit_pair = [&](const EffectFitter& A, const EffectFitter& B, double pB, const std::vector<int>& idx) {
+      double pA = A.fit(data, idx).first;
+      for (int round = 0; round < 3; ++round) {
+        Data db = data;
+        db.measured -= A.at(pA).pred - nominal.pred;
+        pB = B.fit(db, idx).first;
+        Data da = data;
+        da.measured -= B.at(pB).pred - nominal.pred;
+        pA = A.fit(da, idx).first;
+      }
+      const Table ta = A.at(pA), tb = B.at(pB);
+      return std::make_tuple(pA, pB, Table{ta.pred + tb.pred - nominal.pred, ta.G + tb.G - nominal.G});
+    };
+    const EffectModel& ea = *find_effect(best->fit.name);
+    const EffectFitter& A = *fitters.at(ea.name);
+    Data rest = data;  // what A leaves
+    rest.measured -= A.at(best->fit.value).pred - nominal.pred;
+    const double l_rest = likelihood(rest, nominal.pred, nominal.G, all).m2logl;
+    std::vector<std::pair<double, const EffectModel*>> second;
+    for (const EffectModel& eb : effect_library()) {
+      if (eb.name == ea.name) continue;
+      const EffectFitter& B = *fitters.at(eb.name);
+      const Table tb = B.at(B.fit(rest, all).first);
+      second.emplace_back(l_rest - likelihood(rest, tb.pred, tb.G, all).m2logl, &eb);
+    }
+    std::sort(second.begin(), second.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+    for (std::size_t j = 0; j < std::min<std::size_t>(2, second.size()); ++j) {
+      const EffectModel& eb = *second[j].second;
+      const EffectFitter& B = *fitters.at(eb.name);
+      Scored sc;
+      sc.fit.name = ea.name + " + " + eb.name;
+      score([&](const std::vector<int>& train) { return std::get<2>(fit_pair(A, B, eb.nominal, train)); }, sc);
+      const auto [pa, pb, t] = fit_pair(A, B, eb.nominal, all);
+      d.pairs.push_back(PairFit{ea.name, eb.name, pa, pb, sc.fit.evidence, sc.fit.heldout_chi2});
+      if (pair_best.fit.name.empty() || sc.fit.evidence > pair_best.fit.evidence) pair_best = sc;
+    }
+    std::sort(d.pairs.begin(), d.pairs.end(), [](const PairFit& a, const PairFit& b) { return a.evidence > b.evidence; });
+    if (!pair_best.fit.name.empty() &&
+        pair_best.fit.evidence > best->fit.evidence + s.significance_sigma * s.significance_sigma &&
+        explains(pair_best, rms(pair_best.heldout))) {
+      best = &pair_best;
+      chosen = {{find_effect(d.pairs.front().a), d.pairs.front().pa}, {find_effect(d.pairs.front().b), d.pairs.front().pb}};
+    }
+  }
+  double ss_a = 0, zs_a = 0;
+  for (int k = 0; k < n; ++k) {
+    ss_a += best->heldout(k) * best->heldout(k), zs_a += best->heldout(k) * best->heldout(k) / data.sigma2(k);
+    d.runs[static_cast<std::size_t>(k)].heldout_after_g = best->heldout(k);
+  }
+  d.rms_after_g = std::sqrt(ss_a / n), d.rms_after_sigma = std::sqrt(zs_a / n);
+  d.chosen = best->fit.name;
   if (!d.gap_significant) {
     d.verdict = "no significant gap";
-  } else if (best.fit.evidence > s.significance_sigma * s.significance_sigma &&
-             (best.fit.heldout_chi2 / n <= s.explained_chi2_per_run ||
-              d.rms_after_g <= (1 - s.explained_shrinkage) * d.rms_before_g)) {
+  } else if (explains(*best, d.rms_after_g)) {
     d.explained = true;
-    d.verdict = "explained by " + best.fit.name;
+    d.verdict = "explained by " + best->fit.name;
   } else {
     d.verdict = "not explained by any known effect";
   }
@@ -663,17 +729,25 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   // coefficients corrected by all runs (under the chosen effect) and the effect added, and
   // without it.
   if (s.resimulate_runs > 0 && d.explained) {
-    const EffectModel* e = find_effect(best.fit.name);
-    const double p = best.fit.value;
-    const Table t = tabulate(plant, c.runs, e, p, cache, absorbed);
+    // The chosen effect(s) applied to a plant and a table motion; less what the static test
+    // took up of those that act at rest.
+    const auto apply_chosen = [&](PlantConfig& cfg, vibration::SineVibration& v, bool give_back) {
+      for (const auto& [e, p] : chosen) {
+        e->apply(p, cfg, v);
+        if (give_back && e->acts_at_rest)
+          for (int i = 0; i < plant::kNumCoefficients; ++i)
+            cfg.coefficients[i] -= (p - e->nominal) / (e->unit_value - e->nominal) * absorbed.at(e->name)[i];
+      }
+    };
+    Table t = tabulate(plant, c.runs, chosen[0].first, chosen[0].second, cache, absorbed);
+    for (std::size_t q = 1; q < chosen.size(); ++q) {
+      const Table u = tabulate(plant, c.runs, chosen[q].first, chosen[q].second, cache, absorbed);
+      t.pred += u.pred - nominal.pred, t.G += u.G - nominal.G;
+    }
     const Eigen::LDLT<Eigen::MatrixXd> vl(covariance(data, t.G, all));
     const Eigen::VectorXd dc = data.Sigma * t.G.transpose() * vl.solve(data.measured - t.pred);
     PlantConfig corrected = plant;
     for (int i = 0; i < plant::kNumCoefficients; ++i) corrected.coefficients[i] += dc(i);
-    PlantConfig corrected_under_effect = corrected;  // less what the static test took up of the effect
-    if (e->acts_at_rest)
-      for (int i = 0; i < plant::kNumCoefficients; ++i)
-        corrected_under_effect.coefficients[i] -= (p - e->nominal) / (e->unit_value - e->nominal) * absorbed.at(e->name)[i];
     std::vector<int> order = all;
     std::sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(r(a)) > std::abs(r(b)); });
     order.resize(std::min<std::size_t>(order.size(), static_cast<std::size_t>(s.resimulate_runs)));
@@ -682,9 +756,9 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
     for (int k : order) {
       const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
       const vibration::SineVibration commanded = run.vibration();
-      PlantConfig with = corrected_under_effect;
+      PlantConfig with = corrected;
       vibration::SineVibration table = commanded;
-      e->apply(p, with, table);
+      apply_chosen(with, table, true);
       const vibration::SineExcitation motion(table);
       try {
         const double ode_with = rectification::shake_sine(with, run.orientation_g, commanded, {}, {}, &motion).measured_g;

@@ -103,6 +103,7 @@ struct DiagnoseSettings {
   double explained_chi2_per_run = 2.0;
   double explained_shrinkage = 0.9;
   int resimulate_runs = 12;             // runs (largest gaps first) re-simulated on the ODE; 0: none
+  bool try_pairs = true;                // two effects at once when no one effect explains the gap
 };
 
 struct EffectFit {
@@ -111,6 +112,13 @@ struct EffectFit {
   double evidence = 0;           // held-out chi^2 reduction, summed over folds
   double heldout_chi2 = 0;       // held-out chi^2 with the effect (given the training runs), summed over folds
   bool at_bound = false;         // the fit ended on the edge of its range (no curvature: no sigma)
+};
+
+// Two effects fitted together (additive to first order), when no one effect explains the gap.
+struct PairFit {
+  std::string a, b;
+  double pa = 0, pb = 0;         // their parameters, fitted on all runs
+  double evidence = 0, heldout_chi2 = 0;
 };
 
 struct RunDiagnosis {
@@ -135,9 +143,11 @@ struct Diagnosis {
   std::string where;
   double amplitude_power = 0;
   std::vector<EffectFit> effects;  // best first (evidence)
+  std::vector<PairFit> pairs;      // tried when no one effect explains a significant gap; best first
+  std::string chosen;              // the best effect, or "A + B" when a pair explains the gap
   std::string folds;               // the cross-validation used
   bool explained = false;
-  std::string verdict;             // "no significant gap", "explained by <name>", "not explained by any known effect"
+  std::string verdict;             // "no significant gap", "explained by <name>" (or "<A> + <B>"), "not explained by any known effect"
   double rms_before_g = 0, rms_after_g = 0;          // held-out, over all runs
   double rms_before_sigma = 0, rms_after_sigma = 0;  // the same in units of each run's sigma
   // The confirmation on the ODE plant (the runs with the largest gaps; coefficients corrected
