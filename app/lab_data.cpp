@@ -22,15 +22,38 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::vector<std::string> split(const std::string& line) {
+// One CSV line into cells, trimmed of blanks. A cell may be quoted ("a, b"; "" is a quote
+// inside), as spreadsheets write them; an unclosed quote is std::invalid_argument naming `where`.
+std::vector<std::string> split(const std::string& line, const std::string& where) {
   std::vector<std::string> out;
-  std::string cell;
-  std::istringstream s(line);
-  while (std::getline(s, cell, ',')) {
-    const auto a = cell.find_first_not_of(" \t\r"), b = cell.find_last_not_of(" \t\r");
-    out.push_back(a == std::string::npos ? std::string() : cell.substr(a, b - a + 1));
+  std::size_t i = 0;
+  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  while (true) {
+    while (i < line.size() && blank(line[i])) ++i;
+    std::string cell;
+    if (i < line.size() && line[i] == '"') {
+      for (++i;; ++i) {
+        if (i >= line.size()) throw std::invalid_argument(where + ": a quoted cell is not closed");
+        if (line[i] == '"') {
+          if (i + 1 < line.size() && line[i + 1] == '"') cell += '"', ++i;
+          else break;
+        } else {
+          cell += line[i];
+        }
+      }
+      ++i;
+      while (i < line.size() && blank(line[i])) ++i;
+      if (i < line.size() && line[i] != ',') throw std::invalid_argument(where + ": text after a quoted cell");
+    } else {
+      const std::size_t end = std::min(line.find(',', i), line.size());
+      cell = line.substr(i, end - i);
+      while (!cell.empty() && blank(cell.back())) cell.pop_back();
+      i = end;
+    }
+    out.push_back(std::move(cell));
+    if (i >= line.size()) break;
+    ++i;  // the comma
   }
-  if (!line.empty() && line.back() == ',') out.emplace_back();
   return out;
 }
 
@@ -53,7 +76,12 @@ Csv read_csv(const std::string& path) {
   while (std::getline(in, line)) {
     ++n;
     if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    std::vector<std::string> cells = split(line);
+    std::vector<std::string> cells;
+    try {
+      cells = split(line, path + ":" + std::to_string(n));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(e.what());
+    }
     if (!header) {
       for (std::size_t i = 0; i < cells.size(); ++i) csv.column[cells[i]] = i;
       header = true;
@@ -310,7 +338,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
         while (std::getline(in, line)) {
           ++ln;
           if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
-          const auto cells = split(line);
+          const auto cells = split(line, spath + ":" + std::to_string(ln));
           if (!header) {
             header = true;
             bool found_t = false, found_u = false;

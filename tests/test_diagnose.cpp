@@ -250,6 +250,31 @@ TEST(LabData, BadRunsAreSkippedWithFileAndLineAndBadFilesStop) {
   }
 }
 
+// Spreadsheets quote cells: "a, b" is one cell, "" a quote inside; an unclosed quote stops
+// the reading with file and line.
+TEST(LabData, QuotedCsvCellsAreRead) {
+  TempDir t;
+  const std::string dir = (t.path / "c").string();
+  fs::copy(std::string(VRELAB_CASES_DIR) + "/lab-example", dir);
+  const Campaign plain = app::read_campaign(dir);
+  std::string text = read_file(dir + "/runs.csv");
+  text = std::regex_replace(text, std::regex("id,frequency_Hz,"), "\"id\", \"frequency_Hz\",");
+  text = std::regex_replace(text, std::regex("\nia-100Hz-2g,100,"), "\n\"ia-100Hz-2g, \"\"quoted\"\"\" ,\"100\",");
+  std::ofstream(dir + "/runs.csv") << text;
+  const Campaign quoted = app::read_campaign(dir);
+  ASSERT_EQ(quoted.runs.size(), plain.runs.size());
+  EXPECT_EQ(quoted.runs[1].id, "ia-100Hz-2g, \"quoted\"");
+  EXPECT_EQ(quoted.runs[1].frequency_Hz, 100.0);
+  EXPECT_EQ(quoted.runs[1].measured_g, plain.runs[1].measured_g);
+  std::ofstream(dir + "/runs.csv") << text << "\"unclosed,10,2,1,0,0,0.7071,0,0.7071,1,0.3\n";
+  try {
+    app::read_campaign(dir);
+    ADD_FAILURE() << "accepted an unclosed quote";
+  } catch (const app::InputError& e) {
+    EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(R"(runs\.csv:\d+: a quoted cell is not closed)"))) << e.what();
+  }
+}
+
 TEST(LabData, RawRecordIsMeasuredAsTheSummaryWouldBe) {
   // A synthetic record: 0.88 mA at rest, then a 50 Hz sine of 1 mA with a 25 ug (x K1) offset.
   TempDir t;
