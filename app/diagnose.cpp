@@ -54,6 +54,8 @@ json diagnosis_json(const validation::Diagnosis& d, const validation::Campaign& 
                     {"heldout_before_g", x.heldout_before_g},
                     {"heldout_after_g", x.heldout_after_g}});
   }
+  json rms_z = json::object();
+  for (const auto& [dir, z] : d.rms_z_by_direction) rms_z[dir] = z;
   json pairs = json::array();
   for (const auto& p : d.pairs)
     pairs.push_back({{"names", {p.a, p.b}},
@@ -69,6 +71,10 @@ json diagnosis_json(const validation::Diagnosis& d, const validation::Campaign& 
           {"significant_runs", d.significant_runs},
           {"chi2_nominal", d.chi2_nominal},
           {"amplitude_power", d.amplitude_power},
+          {"frequency_power", d.frequency_power},
+          {"peak", d.peak},
+          {"rms_z_by_direction", rms_z},
+          {"odd_in_a_IA_fraction", std::isfinite(d.odd_in_a_IA_fraction) ? json(d.odd_in_a_IA_fraction) : json(nullptr)},
           {"effects", effects},
           {"shrinkage",
            {{"rms_before_g", d.rms_before_g},
@@ -220,7 +226,7 @@ void run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
                               c.statics.size(), c.runs.size(), c.skipped.size()));
     if (!c.skipped.empty()) rep.list(c.skipped);
     rep.heading("1. Where the gap lies");
-    rep.paragraph(d.where + fmt::format(". |gap| scales as amplitude^{:.2f} over the significant runs.", d.amplitude_power));
+    rep.paragraph(d.where + ".");
     rep.heading("2. Which effect");
     std::vector<std::vector<std::string>> rows = {{"effect", "parameter", "value", "sigma", "evidence (held-out -2 ln L)",
                                                    "held-out chi2"}};

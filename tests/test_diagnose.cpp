@@ -119,6 +119,9 @@ TEST(Diagnose, HiddenK5IsFittedWithWhatTheStaticTestTookUpGivenBack) {
   // Tolerance: 3 fitted sigma plus the first-order simulation's 0.2 %.
   EXPECT_NEAR(d.effects.front().value, 2e-7, 3 * d.effects.front().sigma + 0.002 * 2e-7);
   EXPECT_LT(d.effects.front().sigma, 0.01 * 2e-7);  // the fit resolves 1 %: the check above is sharp
+  // Where: k5 rectifies 5 a0^3 |I|^2 + (15/8) a0 |I|^4, odd in the static a_IA; the runs at
+  // a_IA = +-0.71 g say so (noise and the coefficients' share leave a few per cent).
+  EXPECT_GT(d.odd_in_a_IA_fraction, 0.9) << d.where;
 }
 
 // The shaker runs' data acquisition reads u + q2 u^2; the static test (another instrument)
@@ -131,6 +134,8 @@ TEST(Diagnose, ReadoutNonlinearityOfTheShakerRunsIsFound) {
   EXPECT_TRUE(d.explained) << d.verdict;
   ASSERT_EQ(d.effects.front().name, "readout_nonlinearity");
   EXPECT_NEAR(d.effects.front().value, 2e-5, 3 * d.effects.front().sigma + 0.002 * 2e-5);
+  // q2 |U|^2 / 2 does not depend on the sign of the static a_IA: the gap is even in it.
+  EXPECT_LT(d.odd_in_a_IA_fraction, 0.2) << d.where;
 }
 
 // Two effects hidden at once, both linear (additive to first order): no one effect explains

@@ -407,6 +407,14 @@ class EffectFitter {
   mutable std::map<double, Table> extra_;
 };
 
+std::string fmt_peak(const RunRecord& run, const std::string& dir, const std::string& orient, double z) {
+  std::ostringstream o;
+  o.precision(3);
+  o << run.id << " (" << run.frequency_Hz << " Hz, " << run.amplitude_g << " g along " << dir << ", static " << orient
+    << ", z = " << z << ")";
+  return o.str();
+}
+
 // chi^2 with n degrees of freedom as a normal deviate (Wilson-Hilferty).
 double chi2_as_sigma(double chi2, int n) {
   const double v = 2.0 / (9.0 * n);
@@ -526,32 +534,76 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   // simulation accuracy). The raw gap is dominated by the coefficient errors at several g
   // and would point everywhere.
   const Eigen::VectorXd adj = adjusted_residual(data, nominal.pred, nominal.G, all, all);
+  const auto vec_name = [](const Vec3& v) {
+    char b[64];
+    std::snprintf(b, sizeof b, "[%.2g, %.2g, %.2g]", v[0], v[1], v[2]);
+    return std::string(b);
+  };
   std::set<std::string> dirs;
   double f_lo = INFINITY, f_hi = 0, a_lo = INFINITY, a_hi = 0;
-  std::map<std::string, std::vector<std::pair<double, double>>> groups;  // (f, direction): (ln A, ln |adj|)
+  // ln |adj| against ln A within each (direction, frequency, orientation), and against ln f
+  // within each (direction, amplitude, orientation): one intercept per group.
+  std::map<std::string, std::vector<std::pair<double, double>>> over_amplitude, over_frequency;
+  std::map<std::string, std::pair<double, int>> z2_by_direction;
   for (int k = 0; k < n; ++k) {
     RunDiagnosis& rd = d.runs[static_cast<std::size_t>(k)];
+    const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
     rd.predicted_g = nominal.pred(k);
     rd.sigma_predicted_g = std::sqrt(std::max(0.0, (nominal.G.row(k) * data.Sigma * nominal.G.row(k).transpose())(0, 0)));
     rd.gap_g = r(k);
     rd.sigma_g = std::sqrt(V(k, k));
     rd.adjusted_gap_g = adj(k);
     rd.z = adj(k) / std::sqrt(data.sigma2(k));
-    d.max_abs_z = std::max(d.max_abs_z, std::abs(rd.z));
+    const std::string dir = vec_name(run.direction), orient = vec_name(run.orientation_g);
+    z2_by_direction[dir].first += rd.z * rd.z, ++z2_by_direction[dir].second;
+    if (std::abs(rd.z) > d.max_abs_z) {
+      d.max_abs_z = std::abs(rd.z);
+      d.peak = fmt_peak(run, dir, orient, rd.z);
+    }
     if (std::abs(rd.z) >= s.significance_sigma) {
       ++d.significant_runs;
-      const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
-      char dir[64];
-      std::snprintf(dir, sizeof dir, "[%.2g, %.2g, %.2g]", run.direction[0], run.direction[1], run.direction[2]);
       dirs.insert(dir);
       f_lo = std::min(f_lo, run.frequency_Hz), f_hi = std::max(f_hi, run.frequency_Hz);
       a_lo = std::min(a_lo, run.amplitude_g), a_hi = std::max(a_hi, run.amplitude_g);
-      groups[std::string(dir) + std::to_string(run.frequency_Hz)].emplace_back(std::log(run.amplitude_g),
-                                                                                 std::log(std::abs(adj(k))));
+      const double y = std::log(std::abs(adj(k)));
+      over_amplitude[dir + orient + std::to_string(run.frequency_Hz)].emplace_back(std::log(run.amplitude_g), y);
+      over_frequency[dir + orient + std::to_string(run.amplitude_g)].emplace_back(std::log(run.frequency_Hz), y);
     }
+  }
+  for (const auto& [dir, z2] : z2_by_direction) d.rms_z_by_direction.emplace_back(dir, std::sqrt(z2.first / z2.second));
+  // Odd or even in the static a_IA: runs alike but for the sign of a_IA, where either is
+  // significant; the share of the pairs' gap power in (z1 - z2) / 2.
+  {
+    double odd = 0, even = 0;
+    for (int k = 0; k < n; ++k)
+      for (int j = k + 1; j < n; ++j) {
+        const RunRecord &a = c.runs[static_cast<std::size_t>(k)], &b = c.runs[static_cast<std::size_t>(j)];
+        const Vec3 mirrored(-a.orientation_g[0], a.orientation_g[1], a.orientation_g[2]);
+        if (a.frequency_Hz != b.frequency_Hz || a.amplitude_g != b.amplitude_g || (a.direction - b.direction).norm() > 1e-6 ||
+            (mirrored - b.orientation_g).norm() > 1e-3 || std::abs(a.orientation_g[0]) < 0.1)
+          continue;
+        const double za = d.runs[static_cast<std::size_t>(k)].z, zb = d.runs[static_cast<std::size_t>(j)].z;
+        if (std::max(std::abs(za), std::abs(zb)) < s.significance_sigma) continue;
+        odd += std::pow((za - zb) / 2, 2), even += std::pow((za + zb) / 2, 2);
+      }
+    d.odd_in_a_IA_fraction = odd + even > 0 ? odd / (odd + even) : NAN;
   }
   d.gap_significant = d.significant_runs > 0 || chi2_sigma >= s.significance_sigma;
   {
+    // The slope of ln |gap| within groups, pooled.
+    const auto pooled_slope = [](const std::map<std::string, std::vector<std::pair<double, double>>>& groups) {
+      double sxy = 0, sxx = 0;
+      for (const auto& [key, pts] : groups) {
+        if (pts.size() < 2) continue;
+        double mx = 0, my = 0;
+        for (auto [x, y] : pts) mx += x, my += y;
+        mx /= static_cast<double>(pts.size()), my /= static_cast<double>(pts.size());
+        for (auto [x, y] : pts) sxy += (x - mx) * (y - my), sxx += (x - mx) * (x - mx);
+      }
+      return sxx > 0 ? sxy / sxx : 0.0;
+    };
+    d.amplitude_power = pooled_slope(over_amplitude);
+    d.frequency_power = pooled_slope(over_frequency);
     std::ostringstream w;
     w.precision(3);
     w << "chi^2 " << d.chi2_nominal << " for " << n << " runs (" << chi2_sigma << " sigma); ";
@@ -560,20 +612,15 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
         << " sigma that the coefficients cannot take up: " << f_lo << "-" << f_hi << " Hz, " << a_lo << "-" << a_hi
         << " g, direction(s)";
       for (const auto& x : dirs) w << " " << x;
+      w << "; largest at " << d.peak << "; |gap| ~ amplitude^" << d.amplitude_power << ", ~ frequency^"
+        << d.frequency_power << " (pooled within groups); rms z by direction:";
+      for (const auto& [dir, z] : d.rms_z_by_direction) w << " " << dir << " " << z;
+      if (std::isfinite(d.odd_in_a_IA_fraction))
+        w << "; share of the gap odd in the static a_IA: " << d.odd_in_a_IA_fraction;
     } else {
       w << "no single run beyond " << s.significance_sigma << " sigma";
     }
     d.where = w.str();
-    // |gap| ~ A^p within each (direction, frequency): one intercept per group.
-    double sxy = 0, sxx = 0;
-    for (const auto& [key, pts] : groups) {
-      if (pts.size() < 2) continue;
-      double mx = 0, my = 0;
-      for (auto [x, y] : pts) mx += x, my += y;
-      mx /= static_cast<double>(pts.size()), my /= static_cast<double>(pts.size());
-      for (auto [x, y] : pts) sxy += (x - mx) * (y - my), sxx += (x - mx) * (x - mx);
-    }
-    d.amplitude_power = sxx > 0 ? sxy / sxx : 0;
   }
 
   // 3. Each effect: fits on training runs and the evidence on the held-out ones. Folds: leave

@@ -140,8 +140,13 @@ struct Diagnosis {
   double max_abs_z = 0;
   // Where: the significant runs' span, and the gap's scaling with amplitude (power p of
   // |gap| ~ A^p, least squares on the significant runs; 0 when fewer than 3).
-  std::string where;
-  double amplitude_power = 0;
+  // Also: the run with the largest |z| (peak), the power q of |gap| ~ f^q pooled within
+  // (direction, amplitude, orientation) groups, the rms z per direction, and the share of the
+  // gap odd in the static a_IA (runs alike but for its sign; NaN without such pairs).
+  std::string where, peak;
+  double amplitude_power = 0, frequency_power = 0;
+  std::vector<std::pair<std::string, double>> rms_z_by_direction;
+  double odd_in_a_IA_fraction = NAN;
   std::vector<EffectFit> effects;  // best first (evidence)
   std::vector<PairFit> pairs;      // tried when no one effect explains a significant gap; best first
   std::string chosen;              // the best effect, or "A + B" when a pair explains the gap
