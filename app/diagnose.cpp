@@ -235,8 +235,10 @@ void run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
                       fmt::format("{:.1f}", e.evidence), fmt::format("{:.1f}", e.heldout_chi2)});
     rep.table(rows);
     if (!d.pairs.empty()) {
-      rep.paragraph("No one effect explains the gap; the pairs of the three best, fitted together (additive to first "
-                    "order), a pair chosen only when its evidence beats the best single effect's by 25:");
+      rep.paragraph(fmt::format("No one effect explains the gap; the best with the two most promising seconds (ranked on "
+                                "each fold's training runs), fitted together (additive to first order), a pair chosen "
+                                "only when its evidence beats the best single effect's by {:.0f}:",
+                                std::pow(validation::DiagnoseSettings{}.significance_sigma, 2)));
       std::vector<std::vector<std::string>> prow = {{"pair", "parameters", "evidence", "held-out chi2"}};
       for (const auto& p : d.pairs)
         prow.push_back({p.a + " + " + p.b, fmt::format("{:.5g}, {:.5g}", p.pa, p.pb), fmt::format("{:.1f}", p.evidence),

@@ -83,6 +83,27 @@ TEST(EffectLibrary, EachEffectsPredictionMatchesTheOdeWithThatEffect) {
   }
 }
 
+// What a static test takes up of k5: on a circle through IA, a^5 = cos^5 phi =
+// -(5/16) a + (5/4) a^3 + cos(5 phi)/16, and cos 5 phi is orthogonal to every term of model (1)
+// on 12 equally spaced positions (harmonics 0-4 and the even ones of |a_IA|); so, per unit of
+// k5 and to first order, K1 loses 5/16 of itself and k3 gains 5/4. Equal weights; the settled
+// outputs carry ~1e-13 of error against a 1e-8 signal: bound 1e-4 relative. (The polynomial
+// acts on the whole output: with a bias k0 it also gives k4 5 k0, so the instrument here is
+// linear.)
+TEST(EffectLibrary, TheStaticTestTakesUpK5AsItsProjectionOnModel1) {
+  plant::PlantConfig p;
+  p.coefficients[plant::K1] = 1.25;
+  const std::vector<Position> positions = equally_spaced_positions(12);
+  const std::vector<double> weights(positions.size(), 1.0);
+  FixedSet fixed{};
+  fixed[plant::k_PP] = 0.0;
+  const plant::Coefficients t = taken_up_by_static_test(*find_effect("higher_order_k5"), p, positions, weights, fixed);
+  const double K1 = p.coefficients[plant::K1];
+  EXPECT_NEAR(t[plant::K1], -5.0 / 16 * K1, 1e-4 * 5.0 / 16 * K1);
+  EXPECT_NEAR(t[plant::k3], 5.0 / 4, 1e-4 * 5.0 / 4);
+  for (int i : {plant::k0, plant::k2, plant::k4, plant::k_IP, plant::k_IO}) EXPECT_NEAR(t[i], 0.0, 1e-4) << i;
+}
+
 TEST(Diagnose, CleanCampaignHasNoSignificantGap) {
   const Campaign c = simulate_campaign(truth(), {}, small_design(), 31, 2);
   const Diagnosis d = diagnose(c);
@@ -106,8 +127,8 @@ TEST(Diagnose, HiddenPickoffNonlinearityIsFoundFittedAndRemoved) {
   EXPECT_NEAR(d.amplitude_power, 2.0, 0.3);
 }
 
-// k5 acts at rest too: in +-1 g the static test folds it into K1 and k3 (10/16 and 5/16 of
-// it). diagnose gives that part back (the prior's mean); here the coefficients' freedom within
+// k5 acts at rest too: in +-1 g the static test folds it into K1 and k3 (-5/16 and +5/4 of
+// it, the test above). diagnose gives that part back (the prior's mean); here the coefficients' freedom within
 // the static test's covariance would take it up anyway: without the give-back the fit moved
 // by 4e-5 relative (measured by disabling it), far inside the tolerance. The truth is 2e-7 /g^4.
 TEST(Diagnose, HiddenK5IsFittedWithWhatTheStaticTestTookUpGivenBack) {
@@ -125,8 +146,8 @@ TEST(Diagnose, HiddenK5IsFittedWithWhatTheStaticTestTookUpGivenBack) {
 }
 
 // The shaker runs' data acquisition reads u + q2 u^2; the static test (another instrument)
-// does not. Along IA it is the shape of a k2 error, so only the static test's k2 and the
-// runs' two orientations bound it: q2 = 2e-5 /g is found and fitted.
+// does not. Along IA it is the shape of a k2 error (both even in a_IA), so only the static
+// test's k2 bounds it: q2 = 2e-5 /g is found and fitted.
 TEST(Diagnose, ReadoutNonlinearityOfTheShakerRunsIsFound) {
   const Campaign c = simulate_campaign(truth(), {{"readout_nonlinearity", 2e-5}}, small_design(), 35, 2);
   const Diagnosis d = diagnose(c);

@@ -227,8 +227,8 @@ class ResponseCache {
   std::map<std::pair<std::string, double>, rectification::LoopResponse> cache_;
 };
 
-// What the static test took up of an effect that acts at rest, per unit of (p - nominal) /
-// (unit_value - nominal): subtracted from the identified coefficients under the effect.
+// What the static test took up of an effect that acts at rest, per unit of (p - nominal)
+// (taken_up_by_static_test): subtracted from the identified coefficients under the effect.
 using Absorbed = std::map<std::string, Coefficients>;
 
 Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const EffectModel* e, double p,
@@ -247,8 +247,7 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
       Coefficients z = nominal.coefficients;
       for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] = cfg.coefficients[i] - nominal.coefficients[i];
       if (e && e->acts_at_rest) {
-        const double u = (p - e->nominal) / (e->unit_value - e->nominal);
-        for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] -= u * absorbed.at(e->name)[i];
+        for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] -= (p - e->nominal) * absorbed.at(e->name)[i];
       }
       return z;
     }();
@@ -338,9 +337,13 @@ class EffectFitter {
   }
   // Maximum likelihood over the runs `idx`; sigma from the curvature of -2 log L.
   std::pair<double, double> fit(const Data& d, const std::vector<int>& idx) const {
-    auto L = [&](double p) {
-      const Table t = at(p);
-      return likelihood(d, t.pred, t.G, idx).m2logl;
+    auto L = [&](double p) {  // a value the plant refuses (a servo the design cannot build) is no fit
+      try {
+        const Table t = at(p);
+        return likelihood(d, t.pred, t.G, idx).m2logl;
+      } catch (const std::invalid_argument&) {
+        return static_cast<double>(INFINITY);
+      }
     };
     std::vector<double> xs;
     if (e_.linear) {
@@ -360,6 +363,7 @@ class EffectFitter {
       for (int k = 0; k <= 60; ++k) xs.push_back(lo + (hi - lo) * k / 60.0);
     } else {
       xs = values_;
+      if (xs.empty()) return {e_.nominal, INFINITY};
     }
     std::vector<double> ls;
     for (double x : xs) ls.push_back(L(x));
@@ -444,6 +448,27 @@ const EffectModel* find_effect(const std::string& name) {
   return nullptr;
 }
 
+Coefficients taken_up_by_static_test(const EffectModel& e, const PlantConfig& plant, const std::vector<Position>& positions,
+                                     const std::vector<double>& weights, const FixedSet& fixed) {
+  if (!e.linear) throw std::logic_error("diagnose: " + e.name + " acts at rest but is not linear");
+  PlantConfig with = plant;
+  vibration::SineVibration unused;
+  e.apply(e.unit_value, with, unused);
+  // Least squares is linear in the readings: the difference of the fits to the plant's
+  // settled readings with and without the effect.
+  std::vector<Reading> base, moved;
+  const double K1 = plant.coefficients[plant::K1];
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    base.push_back({static_cast<int>(i), K1 * plant::settled_output_g(plant, positions[i].nominal_g)});
+    moved.push_back({static_cast<int>(i), K1 * plant::settled_output_g(with, positions[i].nominal_g)});
+  }
+  const Coefficients b = least_squares(positions, base, weights, fixed).estimate.value;
+  const Coefficients m = least_squares(positions, moved, weights, fixed).estimate.value;
+  Coefficients diff;
+  for (int i = 0; i < plant::kNumCoefficients; ++i) diff[i] = (m[i] - b[i]) / (e.unit_value - e.nominal);
+  return diff;
+}
+
 double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const EffectModel* e, double p) {
   PlantConfig cfg = nominal;
   vibration::SineVibration v = r.vibration();
@@ -497,24 +522,8 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   // change the effect (at its unit value) makes to the readings, at the campaign's own
   // positions and weights (least squares is linear in the readings: the difference of two fits).
   Absorbed absorbed;
-  for (const EffectModel& e : effect_library()) {
-    if (!e.acts_at_rest) continue;
-    if (!e.linear) throw std::logic_error("diagnose: " + e.name + " acts at rest but is not linear");
-    PlantConfig with = plant;
-    vibration::SineVibration unused;
-    e.apply(e.unit_value, with, unused);
-    std::vector<Reading> base = readings, moved = readings;
-    for (std::size_t i = 0; i < readings.size(); ++i) {
-      const Vec3 a = positions[i].nominal_g;
-      base[i].output = plant.coefficients[plant::K1] * plant::settled_output_g(plant, a);
-      moved[i].output = plant.coefficients[plant::K1] * plant::settled_output_g(with, a);
-    }
-    const Coefficients b = least_squares(positions, base, weights, c.fixed).estimate.value;
-    const Coefficients m = least_squares(positions, moved, weights, c.fixed).estimate.value;
-    Coefficients diff;
-    for (int i = 0; i < plant::kNumCoefficients; ++i) diff[i] = m[i] - b[i];
-    absorbed[e.name] = diff;
-  }
+  for (const EffectModel& e : effect_library())
+    if (e.acts_at_rest) absorbed[e.name] = taken_up_by_static_test(e, plant, positions, weights, c.fixed);
 
   // 2. The nominal simulation: gap, significance, where.
   ResponseCache cache;
@@ -706,14 +715,15 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   std::vector<std::pair<const EffectModel*, double>> chosen = {{find_effect(best->fit.name), best->fit.value}};
   // Two effects at once, when no one effect explains a significant gap: the best effect A with
   // a second B, additive to first order (T = T_A(pA) + T_B(pB) - T_0). The candidates for B
-  // are ranked by how much they lower -2 ln L of what A leaves (A fitted on all runs); the two
-  // best are fitted together with A by alternating one-parameter fits, each on the data less
-  // the other's part, and scored on the held-out runs like a single effect. A pair is chosen
-  // only when its evidence beats A's by significance_sigma^2 and it explains the gap.
+  // are ranked by how much they lower -2 ln L of what A leaves, on the training runs of each
+  // fold (so the held-out runs do not choose them); the best and the next are fitted together
+  // with A by alternating one-parameter fits, each on the data less the other's part, and
+  // scored on the held-out runs like a single effect. A pair is chosen only when its evidence
+  // beats A's by significance_sigma^2 and it explains the gap.
   Scored pair_best;
   if (d.gap_significant && !explains(*best, rms(best->heldout)) && s.try_pairs) {
     const auto fit_pair = [&](const EffectFitter& A, const EffectFitter& B, double pB, const std::vector<int>& idx) {
-      double pA = A.fit(data, idx).first;
+      double pA = A.fit(data, idx).first;  // (pB: B's nominal, the start)
       for (int round = 0; round < 3; ++round) {
         Data db = data;
         db.measured -= A.at(pA).pred - nominal.pred;
@@ -727,33 +737,48 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
     };
     const EffectModel& ea = *find_effect(best->fit.name);
     const EffectFitter& A = *fitters.at(ea.name);
-    Data rest = data;  // what A leaves
-    rest.measured -= A.at(best->fit.value).pred - nominal.pred;
-    const double l_rest = likelihood(rest, nominal.pred, nominal.G, all).m2logl;
-    std::vector<std::pair<double, const EffectModel*>> second;
-    for (const EffectModel& eb : effect_library()) {
-      if (eb.name == ea.name) continue;
-      const EffectFitter& B = *fitters.at(eb.name);
-      const Table tb = B.at(B.fit(rest, all).first);
-      second.emplace_back(l_rest - likelihood(rest, tb.pred, tb.G, all).m2logl, &eb);
-    }
-    std::sort(second.begin(), second.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
-    for (std::size_t j = 0; j < std::min<std::size_t>(2, second.size()); ++j) {
-      const EffectModel& eb = *second[j].second;
-      const EffectFitter& B = *fitters.at(eb.name);
+    // The seconds ranked on the runs `idx` alone (each fold's training runs when scored): each
+    // other effect fitted to what A (fitted on idx) leaves, by the drop of -2 ln L.
+    std::map<std::vector<int>, std::vector<const EffectModel*>> ranked;
+    const auto seconds = [&](const std::vector<int>& idx) -> const std::vector<const EffectModel*>& {
+      auto it = ranked.find(idx);
+      if (it != ranked.end()) return it->second;
+      Data rest = data;
+      rest.measured -= A.at(A.fit(data, idx).first).pred - nominal.pred;
+      const double l_rest = likelihood(rest, nominal.pred, nominal.G, idx).m2logl;
+      std::vector<std::pair<double, const EffectModel*>> drop;
+      for (const EffectModel& eb : effect_library()) {
+        if (eb.name == ea.name) continue;
+        const EffectFitter& B = *fitters.at(eb.name);
+        const Table tb = B.at(B.fit(rest, idx).first);
+        drop.emplace_back(l_rest - likelihood(rest, tb.pred, tb.G, idx).m2logl, &eb);
+      }
+      std::stable_sort(drop.begin(), drop.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+      std::vector<const EffectModel*> v;
+      for (const auto& x : drop) v.push_back(x.second);
+      return ranked.emplace(idx, v).first->second;
+    };
+    PairFit chosen_pair;
+    for (std::size_t j = 0; j < std::min<std::size_t>(2, effect_library().size() - 1); ++j) {
+      // Candidate j: A with the j-th best second, that second chosen on each fold's training runs.
       Scored sc;
+      score([&](const std::vector<int>& train) {
+        const EffectModel& eb = *seconds(train)[j];
+        return std::get<2>(fit_pair(A, *fitters.at(eb.name), eb.nominal, train));
+      }, sc);
+      const EffectModel& eb = *seconds(all)[j];
       sc.fit.name = ea.name + " + " + eb.name;
-      score([&](const std::vector<int>& train) { return std::get<2>(fit_pair(A, B, eb.nominal, train)); }, sc);
-      const auto [pa, pb, t] = fit_pair(A, B, eb.nominal, all);
-      d.pairs.push_back(PairFit{ea.name, eb.name, pa, pb, sc.fit.evidence, sc.fit.heldout_chi2});
-      if (pair_best.fit.name.empty() || sc.fit.evidence > pair_best.fit.evidence) pair_best = sc;
+      const auto [pa, pb, t] = fit_pair(A, *fitters.at(eb.name), eb.nominal, all);
+      const PairFit pf{ea.name, eb.name, pa, pb, sc.fit.evidence, sc.fit.heldout_chi2};
+      d.pairs.push_back(pf);
+      if (pair_best.fit.name.empty() || sc.fit.evidence > pair_best.fit.evidence) pair_best = sc, chosen_pair = pf;
     }
-    std::sort(d.pairs.begin(), d.pairs.end(), [](const PairFit& a, const PairFit& b) { return a.evidence > b.evidence; });
+    std::stable_sort(d.pairs.begin(), d.pairs.end(), [](const PairFit& a, const PairFit& b) { return a.evidence > b.evidence; });
     if (!pair_best.fit.name.empty() &&
         pair_best.fit.evidence > best->fit.evidence + s.significance_sigma * s.significance_sigma &&
         explains(pair_best, rms(pair_best.heldout))) {
       best = &pair_best;
-      chosen = {{find_effect(d.pairs.front().a), d.pairs.front().pa}, {find_effect(d.pairs.front().b), d.pairs.front().pb}};
+      chosen = {{find_effect(chosen_pair.a), chosen_pair.pa}, {find_effect(chosen_pair.b), chosen_pair.pb}};
     }
   }
   double ss_a = 0, zs_a = 0;
@@ -783,7 +808,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
         e->apply(p, cfg, v);
         if (give_back && e->acts_at_rest)
           for (int i = 0; i < plant::kNumCoefficients; ++i)
-            cfg.coefficients[i] -= (p - e->nominal) / (e->unit_value - e->nominal) * absorbed.at(e->name)[i];
+            cfg.coefficients[i] -= (p - e->nominal) * absorbed.at(e->name)[i];
       }
     };
     Table t = tabulate(plant, c.runs, chosen[0].first, chosen[0].second, cache, absorbed);

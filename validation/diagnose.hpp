@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "plant/accelerometer.hpp"
+#include "validation/dividing_head.hpp"
 #include "validation/identification.hpp"
 #include "validation/uncertainty.hpp"
 #include "vibration/profile.hpp"
@@ -89,6 +90,12 @@ struct EffectModel {
 const std::vector<EffectModel>& effect_library();
 const EffectModel* find_effect(const std::string& name);
 
+// What a static test at `positions` (weights, held coefficients) takes up into the identified
+// coefficients of an effect that acts at rest, per unit of its parameter (linear effects).
+plant::Coefficients taken_up_by_static_test(const EffectModel& e, const plant::PlantConfig& plant,
+                                     const std::vector<Position>& positions, const std::vector<double>& weights,
+                                     const FixedSet& fixed);
+
 // The simulation's prediction of one run: eq. (3) through the plant's dynamics, with an
 // effect (name, parameter) applied when given. g.
 double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, const EffectModel* e = nullptr, double p = 0);
@@ -142,7 +149,8 @@ struct Diagnosis {
   // |gap| ~ A^p, least squares on the significant runs; 0 when fewer than 3).
   // Also: the run with the largest |z| (peak), the power q of |gap| ~ f^q pooled within
   // (direction, amplitude, orientation) groups, the rms z per direction, and the share of the
-  // gap odd in the static a_IA (runs alike but for its sign; NaN without such pairs).
+  // gap odd in the static a_IA (runs alike but for its sign, where either is significant;
+  // NaN without such pairs).
   std::string where, peak;
   double amplitude_power = 0, frequency_power = 0;
   std::vector<std::pair<std::string, double>> rms_z_by_direction;
