@@ -68,5 +68,14 @@ expect 2 'missing.toml: cannot open the case file' reproduce "$tmp/missing.toml"
 # diagnose: a folder without a manifest; a campaign folder that works.
 expect 2 'nowhere/manifest.toml: cannot open the manifest' diagnose "$tmp/nowhere"
 expect 0 'Verdict: explained by pickoff_nonlinearity' diagnose "$cases/lab-example"
+# ... and one whose raw record has a NaN sample: that run is skipped with file and line, the
+# others diagnosed.
+cp -r "$cases/lab-example" "$tmp/lab"
+awk 'BEGIN { print "time_s,output_mA"; for (k = 0; k <= 130; ++k) print -0.02 + 0.001 * k "," (k == 70 ? "nan" : "0.88") }' \
+  >"$tmp/lab/rec.csv"  # 1 kHz, 4 periods of 40 Hz under vibration; the NaN on line 72
+sed -i -e 's/^id,frequency_Hz,.*sigma_ug$/&,series,rest_from_s,rest_to_s,on_from_s,on_to_s/' \
+  -e 's/^\(ia-40Hz-4g,.*\)$/\1,rec.csv,-0.0155,-0.0045,0.0045,0.1045/' "$tmp/lab/runs.csv"
+expect 0 "skipped: .*rec.csv:72: a sample is not a finite number" diagnose "$tmp/lab"
+expect 0 'Verdict: explained by pickoff_nonlinearity' diagnose "$tmp/lab"
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]
