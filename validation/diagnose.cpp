@@ -335,6 +335,24 @@ class EffectFitter {
     if (it == extra_.end()) it = extra_.emplace(p, tabulate(plant_, runs_, &e_, p, cache_, absorbed_)).first;
     return it->second;
   }
+  // d pred / d p at p: exact for linear effects, central over +-h for the others (a value the
+  // plant refuses: one-sided).
+  Eigen::VectorXd slope(double p, double h) const {
+    if (e_.linear) return (unit_.pred - nominal_.pred) / (e_.unit_value - e_.nominal);
+    const auto pred_at = [&](double x) -> std::optional<Eigen::VectorXd> {
+      try {
+        return at(x).pred;
+      } catch (const std::invalid_argument&) {
+        return std::nullopt;
+      }
+    };
+    const auto up = pred_at(p + h), down = pred_at(p - h);
+    if (up && down) return (*up - *down) / (2 * h);
+    const Eigen::VectorXd mid = at(p).pred;
+    if (up) return (*up - mid) / h;
+    if (down) return (mid - *down) / h;
+    return Eigen::VectorXd::Zero(mid.size());
+  }
   // Maximum likelihood over the runs `idx`; sigma from the curvature of -2 log L.
   std::pair<double, double> fit(const Data& d, const std::vector<int>& idx) const {
     auto L = [&](double p) {  // a value the plant refuses (a servo the design cannot build) is no fit
@@ -665,32 +683,71 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   }
   // -2 ln p(test | train) = -2 ln L(all) + 2 ln L(train): the held-out runs given what the
   // training runs say about the coefficients (the same conditioning as the shrinkage's).
-  const auto conditional = [&](const Table& t, const std::vector<int>& train) {
-    const Likelihood l_all = likelihood(data, t.pred, t.G, all), l_train = likelihood(data, t.pred, t.G, train);
+  const auto conditional_on = [&](const Data& dd, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G,
+                                  const std::vector<int>& train) {
+    const Likelihood l_all = likelihood(dd, pred, G, all), l_train = likelihood(dd, pred, G, train);
     return Likelihood{l_all.m2logl - l_train.m2logl, l_all.chi2 - l_train.chi2};
   };
-  // Scores a candidate: fitted on each fold's training runs (fit_on gives its table there),
-  // judged on the fold's held-out runs.
-  const auto score = [&](const std::function<Table(const std::vector<int>&)>& fit_on, Scored& sc) {
+  const auto conditional = [&](const Table& t, const std::vector<int>& train) {
+    return conditional_on(data, t.pred, t.G, train);
+  };
+  // Scores a candidate on each fold: -2 ln p(held-out | training) and the held-out chi^2,
+  // with the coefficients and the candidate's parameters uncertain: the parameters, fitted on
+  // the training runs, enter like the coefficients, with their slopes S = d pred / d p as
+  // columns of G and their fitted variances beside Sigma. So an effect whose parameter the
+  // training runs pin only loosely (k6 from 1 and 2 g, extrapolated to 4 g) is judged with
+  // that looseness. (The training runs then count twice for the parameters, which makes the
+  // judgement a little strict.) fit_on(runs) fits the candidate on `runs`.
+  struct Fitted {
+    Table t;
+    Eigen::MatrixXd slopes;    // n x k; k = 0 when a parameter ended on a bound
+    Eigen::VectorXd variance;  // k
+  };
+  const auto score = [&](const std::function<Fitted(const std::vector<int>&)>& fit_on, Scored& sc) {
     sc.heldout = Eigen::VectorXd::Zero(n);
     for (const auto& [key, test] : folds) {
       const std::vector<int> train = train_of(key);
-      const Table t = fit_on(train);
-      const Likelihood with = train.size() == all.size() ? likelihood(data, t.pred, t.G, all) : conditional(t, train);
+      const Fitted f = fit_on(train);
+      Likelihood with;
+      if (train.size() == all.size()) {
+        with = likelihood(data, f.t.pred, f.t.G, all);
+      } else {
+        const Eigen::Index k = f.variance.size(), m = plant::kNumCoefficients;
+        Data da = data;
+        da.Sigma = Eigen::MatrixXd::Zero(m + k, m + k);
+        da.Sigma.topLeftCorner(m, m) = data.Sigma;
+        for (Eigen::Index j = 0; j < k; ++j) da.Sigma(m + j, m + j) = f.variance(j);
+        Eigen::MatrixXd Ga(n, m + k);
+        Ga << f.t.G, f.slopes;
+        with = conditional_on(da, f.t.pred, Ga, train);
+      }
       const Likelihood without =
           train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all) : conditional(nominal, train);
       sc.fit.evidence += without.m2logl - with.m2logl;
       sc.fit.heldout_chi2 += with.chi2;
-      const Eigen::VectorXd a = adjusted_residual(data, t.pred, t.G, train, test);
+      const Eigen::VectorXd a = adjusted_residual(data, f.t.pred, f.t.G, train, test);
       for (std::size_t i = 0; i < test.size(); ++i) sc.heldout(test[i]) = a(static_cast<Eigen::Index>(i));
     }
+  };
+  // A fitted effect with its slope (none at a bound).
+  const auto fitted_at = [&](const EffectFitter& fitter, double p, double sp) {
+    Fitted f{fitter.at(p), Eigen::MatrixXd(n, 0), Eigen::VectorXd(0)};
+    if (std::isfinite(sp) && sp > 0) {
+      f.slopes = fitter.slope(p, sp);
+      f.variance = Eigen::VectorXd::Constant(1, sp * sp);
+    }
+    return f;
+  };
+  const auto fitted_one = [&](const EffectFitter& fitter, const Data& dd, const std::vector<int>& runs) {
+    const auto [p, sp] = fitter.fit(dd, runs);
+    return fitted_at(fitter, p, sp);
   };
   std::map<std::string, std::unique_ptr<EffectFitter>> fitters;
   for (const EffectModel& e : effect_library()) {
     const EffectFitter& fitter = *(fitters[e.name] = std::make_unique<EffectFitter>(e, nominal, plant, c.runs, cache, absorbed));
     Scored sc;
     sc.fit.name = e.name, sc.fit.parameter = e.parameter, sc.fit.unit = e.unit;
-    score([&](const std::vector<int>& train) { return fitter.at(fitter.fit(data, train).first); }, sc);
+    score([&](const std::vector<int>& runs) { return fitted_one(fitter, data, runs); }, sc);
     const auto [p, sp] = fitter.fit(data, all);
     sc.fit.value = p, sc.fit.sigma = sp;
     sc.fit.at_bound = !std::isfinite(sp);
@@ -722,18 +779,26 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   // beats A's by significance_sigma^2 and it explains the gap.
   Scored pair_best;
   if (d.gap_significant && !explains(*best, rms(best->heldout)) && s.try_pairs) {
+    // (The two parameters' variances: each conditional on the other, their correlation left out.)
     const auto fit_pair = [&](const EffectFitter& A, const EffectFitter& B, double pB, const std::vector<int>& idx) {
       double pA = A.fit(data, idx).first;  // (pB: B's nominal, the start)
+      Fitted fa, fb;
       for (int round = 0; round < 3; ++round) {
         Data db = data;
         db.measured -= A.at(pA).pred - nominal.pred;
-        pB = B.fit(db, idx).first;
+        const auto [pb, sb] = B.fit(db, idx);
+        pB = pb;
         Data da = data;
         da.measured -= B.at(pB).pred - nominal.pred;
-        pA = A.fit(da, idx).first;
+        const auto [pa, sa] = A.fit(da, idx);
+        pA = pa;
+        if (round == 2) fa = fitted_at(A, pA, sa), fb = fitted_at(B, pB, sb);
       }
-      const Table ta = A.at(pA), tb = B.at(pB);
-      return std::make_tuple(pA, pB, Table{ta.pred + tb.pred - nominal.pred, ta.G + tb.G - nominal.G});
+      Fitted f{{fa.t.pred + fb.t.pred - nominal.pred, fa.t.G + fb.t.G - nominal.G}, Eigen::MatrixXd(n, fa.slopes.cols() + fb.slopes.cols()),
+               Eigen::VectorXd(fa.variance.size() + fb.variance.size())};
+      f.slopes << fa.slopes, fb.slopes;
+      f.variance << fa.variance, fb.variance;
+      return std::make_tuple(pA, pB, f);
     };
     const EffectModel& ea = *find_effect(best->fit.name);
     const EffectFitter& A = *fitters.at(ea.name);
