@@ -759,7 +759,8 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   // 4. The verdict and the held-out shrinkage of the chosen effect(s).
   const auto explains = [&](const Scored& sc, double rms_after) {
     return sc.fit.evidence > s.significance_sigma * s.significance_sigma &&
-           (sc.fit.heldout_chi2 / n <= s.explained_chi2_per_run || rms_after <= (1 - s.explained_shrinkage) * d.rms_before_g);
+           (chi2_as_sigma(sc.fit.heldout_chi2, n) < s.significance_sigma ||
+            rms_after <= (1 - s.explained_shrinkage) * d.rms_before_g);
   };
   const auto rms = [&](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / n); };
   const Scored* best = &scored.front();
@@ -839,9 +840,12 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
       if (pair_best.fit.name.empty() || sc.fit.evidence > pair_best.fit.evidence) pair_best = sc, chosen_pair = pf;
     }
     std::stable_sort(d.pairs.begin(), d.pairs.end(), [](const PairFit& a, const PairFit& b) { return a.evidence > b.evidence; });
+    // A pair is the more flexible model: it must also remove at least half of the held-out gap
+    // rms (a pair whose parameters the training runs leave loose can pass chi^2 without
+    // predicting anything).
     if (!pair_best.fit.name.empty() &&
         pair_best.fit.evidence > best->fit.evidence + s.significance_sigma * s.significance_sigma &&
-        explains(pair_best, rms(pair_best.heldout))) {
+        explains(pair_best, rms(pair_best.heldout)) && rms(pair_best.heldout) <= 0.5 * d.rms_before_g) {
       best = &pair_best;
       chosen = {{find_effect(chosen_pair.a), chosen_pair.pa}, {find_effect(chosen_pair.b), chosen_pair.pb}};
     }

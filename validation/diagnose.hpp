@@ -104,10 +104,10 @@ struct DiagnoseSettings {
   double model_accuracy = 0.002;      // relative accuracy of the simulation (f_model)
   double significance_sigma = 5.0;    // a run's gap is significant beyond this many sigma
   // A gap is explained by the best effect when its evidence exceeds significance_sigma^2 and
-  // either its held-out chi^2 per run is at most explained_chi2_per_run or it removes at least
+  // either its held-out chi^2, as a normal deviate, stays below significance_sigma (the test
+  // that found the gap no longer finds one on the held-out runs) or it removes at least
   // explained_shrinkage of the held-out gap rms (a large effect leaves the first-order
   // simulation's own error, which chi^2 alone would call unexplained).
-  double explained_chi2_per_run = 2.0;
   double explained_shrinkage = 0.9;
   int resimulate_runs = 12;             // runs (largest gaps first) re-simulated on the ODE; 0: none
   bool try_pairs = true;                // two effects at once when no one effect explains the gap
