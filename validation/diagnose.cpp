@@ -385,12 +385,11 @@ class EffectFitter {
     }
     std::vector<double> ls;
     for (double x : xs) ls.push_back(L(x));
-    const std::size_t b = static_cast<std::size_t>(std::min_element(ls.begin(), ls.end()) - ls.begin());
-    double best = xs[b], lbest = ls[b], sigma = INFINITY;
-    if (b > 0 && b + 1 < xs.size()) {
-      // Refinement in [x_{b-1}, x_{b+1}] by successive parabolic interpolation (safeguarded by
-      // golden steps): where the prediction is near linear in p across a grid step, -2 ln L is
-      // near quadratic and a step or two lands on the minimum. Then the curvature there.
+    // Refinement in [x_{b-1}, x_{b+1}] by successive parabolic interpolation (safeguarded by
+    // golden steps): where the prediction is near linear in p across a grid step, -2 ln L is
+    // near quadratic and a step or two lands on the minimum.
+    const auto refine = [&](std::size_t b) {
+      double best = xs[b], lbest = ls[b];
       double lo = xs[b - 1], hi = xs[b + 1], flo = ls[b - 1], fhi = ls[b + 1];
       const double tol = 1e-4 * (hi - lo);
       for (int it = 0; it < 12; ++it) {
@@ -409,7 +408,24 @@ class EffectFitter {
           else hi = x, fhi = fx;
         }
       }
-      const double h = 0.25 * (xs[b + 1] - xs[b - 1]);
+      return std::make_pair(best, lbest);
+    };
+    // The grid's interior local minima, best first: the three best are refined (a narrow valley
+    // between grid points, such as a resonance's, can refine below a broader one that looked
+    // better on the grid).
+    std::vector<std::size_t> minima;
+    for (std::size_t k = 1; k + 1 < xs.size(); ++k)
+      if (ls[k] <= ls[k - 1] && ls[k] <= ls[k + 1]) minima.push_back(k);
+    std::sort(minima.begin(), minima.end(), [&](std::size_t a, std::size_t b) { return ls[a] < ls[b]; });
+    const std::size_t g = static_cast<std::size_t>(std::min_element(ls.begin(), ls.end()) - ls.begin());
+    double best = xs[g], lbest = ls[g], sigma = INFINITY;
+    std::size_t at = g;
+    for (std::size_t m = 0; m < std::min<std::size_t>(3, minima.size()); ++m) {
+      const auto [x, l] = refine(minima[m]);
+      if (l < lbest || minima[m] == g) best = x, lbest = l, at = minima[m];
+    }
+    if (at > 0 && at + 1 < xs.size()) {  // the curvature at the minimum
+      const double h = 0.25 * (xs[at + 1] - xs[at - 1]);
       const double curv = (L(best + h) - 2 * lbest + L(best - h)) / (h * h);  // d2(-2 log L)/dp2
       if (curv > 0) sigma = std::sqrt(2 / curv);
     }
