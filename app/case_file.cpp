@@ -799,7 +799,7 @@ void read_campaign(Table t, Case& c) {
       if (!validation::find_effect(h.name) && !validation::is_out_of_library(h.name)) {
         std::string names;
         for (const auto& m : validation::effect_library()) names += " " + m.name;
-        t.fail(&x, "hidden", "unknown effect '" + h.name + "'; known:" + names + " shaker_harmonic_distortion fixture_rocking");
+        t.fail(&x, "hidden", "unknown effect '" + h.name + "'; known:" + names + " readout_clipping shaker_third_harmonic");
       }
       const toml::node* p = e->get("parameter");
       if (!p || !p->is_number()) t.fail(&x, "hidden", "each hidden effect needs a numeric parameter");

@@ -129,6 +129,10 @@ validation::HiddenEffect draw_effect(const std::string& name, std::mt19937_64& r
   if (name == "readout_nonlinearity") return {name, s * log_uniform(rng, 1e-5, 4e-5)};
   if (name == "shaker_harmonic_distortion") return {name, log_uniform(rng, 0.1, 0.3)};
   if (name == "fixture_rocking") return {name, s * log_uniform(rng, 0.2e-6, 1e-6)};
+  // Outside the library: the DAQ's full scale just below the 4 g IA runs' peak output
+  // (4.71 g), and a 3rd harmonic (the library's distortion is the 2nd).
+  if (name == "readout_clipping") return {name, log_uniform(rng, 4.2, 4.7)};
+  if (name == "shaker_third_harmonic") return {name, log_uniform(rng, 0.1, 0.3)};
   throw std::invalid_argument("blind: no parameter range for " + name);
 }
 
@@ -293,7 +297,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
       k.category = "clean";
     } else if (slot == 2) {
       k.category = "out_of_library";
-      k.hidden.push_back(draw_effect(i / 10 % 2 == 0 ? "shaker_harmonic_distortion" : "fixture_rocking", rng));
+      k.hidden.push_back(draw_effect(i / 10 % 2 == 0 ? "shaker_third_harmonic" : "readout_clipping", rng));
     } else if (slot == 3) {
       k.category = "two";
       std::vector<std::string> pick = library;

@@ -30,6 +30,12 @@ double OutputPolynomial::readout(double u) const {
   return u + s * u;
 }
 
+ReadoutClipping::ReadoutClipping(double full_scale_g) : full_scale_g_(full_scale_g) {
+  if (!(full_scale_g > 0) || !std::isfinite(full_scale_g)) throw std::invalid_argument("readout clipping full_scale_g must be positive");
+}
+
+double ReadoutClipping::readout(double u) const { return std::clamp(u, -full_scale_g_, full_scale_g_); }
+
 double PendulumGeometry::extra_input_g(double theta, double, double s1, const Vec3& a) const {
   return s1 * (std::cos(theta) - 1) - a[PA] * std::sin(theta);
 }

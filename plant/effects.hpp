@@ -93,6 +93,20 @@ class OutputPolynomial final : public Effect {
   std::array<double, 7> c_;
 };
 
+// The data acquisition's range: the readout clips at +-full_scale_g (in g of input). A DAQ
+// set too close to a run's peak output clips one side more than the other when the sensor
+// has a static a_IA, and the mean shifts (validation/campaign.hpp's effect outside the
+// diagnosis's library: a lab sees it in the raw record).
+class ReadoutClipping final : public Effect {
+ public:
+  explicit ReadoutClipping(double full_scale_g);
+  std::string name() const override { return "readout_clipping"; }
+  double readout(double u) const override;
+
+ private:
+  double full_scale_g_;
+};
+
 // A second mechanical mode (flexure or mount resonance) between the case and the pendulum
 // along the chosen axes: base-excited oscillator, transmissibility
 // (w^2 + 2 z w s) / (s^2 + 2 z w s + w^2), static gain 1.

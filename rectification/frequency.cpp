@@ -1,5 +1,7 @@
 #include "rectification/frequency.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -126,6 +128,167 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
     out.readout_g += mean / kN - e->readout(u0);
   }
   out.loop_dc_gain = dc_gain;
+  return out;
+}
+
+bool PeriodicInput::single_tone() const {
+  return mean_g.isZero(0.0) && tones.size() == 1 && tones.front().first == 1;
+}
+
+PeriodicInput periodic_input(const vibration::SineVibration& v) {
+  vibration::validate(v);
+  PeriodicInput p;
+  p.frequency_Hz = v.frequency_Hz;
+  Eigen::Vector3cd w;
+  for (int i = 0; i < 3; ++i) w[i] = std::polar(v.amplitude_g[i], v.phase_rad[i]);
+  p.tones.push_back({1, w});
+  return p;
+}
+
+PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz) {
+  if (!(frequency_Hz > 0)) throw std::invalid_argument("periodic_input: frequency_Hz must be positive");
+  constexpr int kN = 64, kMaxHarmonic = 16;
+  std::array<Vec3, kN> a;
+  for (int k = 0; k < kN; ++k) a[static_cast<std::size_t>(k)] = e.acceleration_g(k / (kN * frequency_Hz));
+  // Parts below the sampling's rounding (1e-12 of the largest sample) are noise, not motion.
+  double peak = 0;
+  for (const Vec3& x : a) peak = std::max(peak, x.cwiseAbs().maxCoeff());
+  const double floor_g = 1e-12 * peak;
+  PeriodicInput p;
+  p.frequency_Hz = frequency_Hz;
+  for (const Vec3& x : a) p.mean_g += x / kN;
+  for (int i = 0; i < 3; ++i)
+    if (std::abs(p.mean_g[i]) <= floor_g) p.mean_g[i] = 0.0;
+  for (int h = 1; h <= kMaxHarmonic; ++h) {
+    // X_h = sum_k a_k e^{-j 2 pi h k / N}; for a_k = Im(W e^{j 2 pi h k / N}), X_h = N W / (2j).
+    Eigen::Vector3cd x = Eigen::Vector3cd::Zero();
+    for (int k = 0; k < kN; ++k) x += a[static_cast<std::size_t>(k)].cast<std::complex<double>>() * std::polar(1.0, -2 * std::numbers::pi * h * k / kN);
+    Eigen::Vector3cd w = std::complex<double>(0, 2.0 / kN) * x;
+    for (int i = 0; i < 3; ++i)
+      if (std::abs(w[i]) <= floor_g) w[i] = 0.0;
+    if (!w.isZero(0.0)) p.tones.push_back({h, w});
+  }
+  return p;
+}
+
+namespace {
+
+// The eq. (3) term a coefficient's rectification belongs to (-1: none; the misalignments
+// respond to the input's mean only).
+int term_of(int c) {
+  switch (c) {
+    case k1_asym: return t_k1_asym;
+    case k2: return t_k2;
+    case k3: return t_k3;
+    case k4: return t_k4;
+    case k_IP: return t_k_IP;
+    case k_IO: return t_k_IO;
+    case k_PO: return t_k_PO;
+    case k_PP: return t_k_PP;
+    case k_OO: return t_k_OO;
+    default: return -1;
+  }
+}
+
+}  // namespace
+
+FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3& a, const PeriodicInput& in,
+                                           const ResponseAt& response, bool allow_closed_form) {
+  if (!(in.frequency_Hz > 0)) throw std::invalid_argument("periodic_rectification: frequency_Hz must be positive");
+  if (allow_closed_form && in.single_tone()) {
+    vibration::SineVibration v;
+    v.frequency_Hz = in.frequency_Hz;
+    const Eigen::Vector3cd& w = in.tones.front().second;
+    for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(w[i]), v.phase_rad[i] = std::arg(w[i]);
+    return sine_rectification_at_frequency(config, a, v, std::nullopt, response(in.frequency_Hz));
+  }
+  double p2 = 0.0;
+  bool geometry = false;
+  for (const auto& e : config.effects) {
+    if (const auto* p = dynamic_cast<const PickoffNonlinearity*>(e.get())) p2 += p->p2_per_rad();
+    if (dynamic_cast<const PendulumGeometry*>(e.get())) geometry = true;
+  }
+  // Per harmonic: what the pendulum's base feels F, the rebalance current I, the angle Theta,
+  // and the output's oscillation U (the current plus the output-placed cross terms' slope).
+  Coefficients cross_out;
+  cross_out[K1] = 1;
+  for (int c = delta_OA; c < kNumCoefficients; ++c)
+    if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
+  const Vec3 slope = plant::output_gradient(cross_out, a) - Vec3::UnitX();
+  struct Harmonic {
+    int h;
+    Eigen::Vector3cd F;
+    std::complex<double> I, Theta, U;
+  };
+  std::vector<Harmonic> hs;
+  double dc_gain = 1.0;
+  for (const auto& [h, W] : in.tones) {
+    const LoopResponse& r = response(h * in.frequency_Hz);
+    dc_gain = r.dc_gain;
+    Harmonic x{h, Eigen::Vector3cd::Zero(), 0.0, 0.0, 0.0};
+    for (int j = 0; j < 3; ++j) {
+      const auto sj = static_cast<std::size_t>(j);
+      x.F[j] = r.mechanical[sj] * W[j];
+      x.I += r.current[sj] * W[j];
+      x.Theta += r.angle_rad[sj] * W[j];
+    }
+    x.U = x.I + slope[IA] * x.F[IA] + slope[PA] * x.F[PA] + slope[OA] * x.F[OA];
+    hs.push_back(x);
+  }
+  FrequencyPrediction out;
+  out.loop_dc_gain = dc_gain;
+  if (!hs.empty() && hs.front().h == 1) out.current_amplitude_g = hs.front().I, out.angle_amplitude_rad = hs.front().Theta;
+
+  // One period on kM points: the felt acceleration (about the static point moved by the
+  // input's mean) and the current's oscillation; each coefficient's basis function averaged
+  // at its place, less its static value.
+  int h_max = 1;
+  for (const Harmonic& x : hs) h_max = std::max(h_max, x.h);
+  const int kM = std::max(64, 6 * h_max + 1);  // exact for degree-6 trigonometric polynomials
+  const Vec3 a_mean = a + in.mean_g;
+  std::array<double, kNumCoefficients> at_input{}, in_loop{};
+  const plant::Basis b0 = plant::basis(a);
+  double readout_mean = 0, u0 = plant::output_g(config.coefficients, a);
+  const double u_mean = u0 + in.mean_g[IA] + slope.dot(in.mean_g);
+  for (int k = 0; k < kM; ++k) {
+    const double phi = 2 * std::numbers::pi * k / kM;
+    Vec3 felt = a_mean;
+    double current = 0, u = u_mean;
+    for (const Harmonic& x : hs) {
+      const std::complex<double> e = std::polar(1.0, x.h * phi);
+      for (int i = 0; i < 3; ++i) felt[i] += std::imag(x.F[i] * e);
+      current += std::imag(x.I * e);
+      u += std::imag(x.U * e);
+    }
+    const plant::Basis bf = plant::basis(felt);
+    Vec3 loop = felt;
+    loop[IA] = a_mean[IA] + current;
+    const plant::Basis bl = plant::basis(loop);
+    for (int c = 0; c < kNumCoefficients; ++c) at_input[c] += bf[c] / kM, in_loop[c] += bl[c] / kM;
+    for (const auto& e : config.effects)
+      if (dynamic_cast<const OutputPolynomial*>(e.get())) readout_mean += (e->readout(u) - u) / kM;
+  }
+  for (int c = k1_asym; c < kNumCoefficients; ++c) {
+    if (config.coefficients[c] == 0) continue;
+    const bool filtered = c <= k4 && config.location[c] != Location::input;
+    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
+    const double g = gain * config.coefficients[c] * ((filtered ? in_loop[c] : at_input[c]) - b0[c]);
+    const int t = term_of(c);
+    if (t >= 0) out.terms.g[t] += g;
+    else out.input_mean_g += g;
+  }
+  out.input_mean_g += in.mean_g[IA];
+  for (const auto& e : config.effects)
+    if (dynamic_cast<const OutputPolynomial*>(e.get())) readout_mean -= e->readout(u0) - u0;
+  out.readout_g = readout_mean;
+  // Effects beyond (1): quadratic in the angle, so harmonics add (their cross products
+  // average out over a period).
+  const Dynamics& d = config.dynamics;
+  const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+  double theta2 = 0, pa_theta = 0;  // <theta^2>, <f_PA theta>
+  for (const Harmonic& x : hs) theta2 += std::norm(x.Theta) / 2, pa_theta += std::real(x.F[PA] * std::conj(x.Theta)) / 2;
+  out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * theta2;
+  if (geometry) out.pendulum_geometry_g = dc_gain * (-pa_theta - a_mean[IA] * theta2 / 2);
   return out;
 }
 

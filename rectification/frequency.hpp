@@ -23,9 +23,15 @@
 // see the vibration through the mode's transmissibility (what the pendulum's base feels).
 #include <array>
 #include <complex>
+#include <functional>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Dense>
 
 #include "plant/accelerometer.hpp"
 #include "rectification/eq3.hpp"
+#include "vibration/excitation.hpp"
 #include "vibration/profile.hpp"
 
 namespace vrelab::rectification {
@@ -38,7 +44,11 @@ struct FrequencyPrediction {
   std::complex<double> current_amplitude_g;  // I
   std::complex<double> angle_amplitude_rad;  // Theta
   double loop_dc_gain = 1.0;  // from a disturbance before the loop to the output; 1 with the integrator
-  double total_g() const { return terms.total_g() + pickoff_g + pendulum_geometry_g + readout_g; }
+  // A periodic input's mean (periodic_rectification): the output's first-order response to it,
+  // a_IA's mean plus the misalignments' share of the other axes' means. Not a rectification
+  // of the sensor but the measured error contains it (e.g. a rocking fixture's centripetal part).
+  double input_mean_g = 0.0;
+  double total_g() const { return terms.total_g() + pickoff_g + pendulum_geometry_g + readout_g + input_mean_g; }
 };
 
 FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
@@ -63,5 +73,35 @@ LoopResponse loop_response(const plant::PlantConfig& plant, double frequency_Hz)
 FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
                                                     const vibration::SineVibration& v, std::optional<double> range_limit_g,
                                                     const LoopResponse& response);
+
+// A periodic vibration of fundamental frequency f (a distorted sine, a rocking fixture's motion):
+//   a(t) = mean_g + sum_h Im(W_h e^{j h 2 pi f t}),  sensor axes, g,
+// the sine convention of vibration::SineVibration (W = amplitude e^{j phase}).
+struct PeriodicInput {
+  double frequency_Hz = 0;
+  Vec3 mean_g = Vec3::Zero();
+  std::vector<std::pair<int, Eigen::Vector3cd>> tones;  // (h >= 1, W_h)
+  bool single_tone() const;  // one tone at h = 1 and no mean
+};
+PeriodicInput periodic_input(const vibration::SineVibration& v);  // exact
+// One period of `e` (which must repeat with 1 / frequency_Hz) sampled on 64 points and
+// resolved into its mean and harmonics h <= 16 (exact for content up to h = 31 when none lies
+// beyond; each harmonic's phase as e has it from t = 0); parts at the sampling's rounding,
+// 1e-12 of the largest sample, are dropped.
+PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz);
+
+// The vibration error for a periodic input: every harmonic through the plant's linear
+// response at its own frequency (`response(h f)`, loop_response or a cache of it), then
+// each term of (1) at its place and each effect averaged over one period by the trapezoid
+// rule on max(64, 6 h_max + 1) points (exact for the polynomial terms and the readout
+// polynomial, of degree <= 6; the |a_IA| of k1' converges as 1 / points^2). Cross-harmonic products are what a distorted tone adds: e.g.
+// <a^3> = -(3/4) h2 sin(phi2) w^3 for w (sin t + h2 sin(2t + phi2)). The
+// input's mean adds its first-order output (input_mean_g). With allow_closed_form, a single
+// tone without mean goes to sine_rectification_at_frequency (the same number, faster).
+// Clipping is not modelled here.
+using ResponseAt = std::function<const LoopResponse&(double frequency_Hz)>;
+FrequencyPrediction periodic_rectification(const plant::PlantConfig& plant, const Vec3& a_static_g,
+                                           const PeriodicInput& input, const ResponseAt& response,
+                                           bool allow_closed_form = true);
 
 }  // namespace vrelab::rectification

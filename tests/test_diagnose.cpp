@@ -61,7 +61,8 @@ TEST(EffectLibrary, EachEffectsPredictionMatchesTheOdeWithThatEffect) {
   } cases[] = {{"pickoff_nonlinearity", 20},  {"pendulum_geometry", 1},   {"quadratic_cross_axis", 2e-6},
                {"nonlinearity_at_input", 1},  {"servo_dynamics", 0.7},    {"mechanical_mode", 700},
                {"shaker_transverse_motion", 0.05}, {"servo_phase_margin", -15},  {"higher_order_k5", 3e-8},
-               {"higher_order_k6", 3e-9},         {"readout_nonlinearity", 2e-6}};
+               {"higher_order_k6", 3e-9},         {"readout_nonlinearity", 2e-6},
+               {"shaker_harmonic_distortion", 0.2}, {"fixture_rocking", -1e-6}};
   for (const auto& c : cases) {
     const EffectModel* e = find_effect(c.name);
     ASSERT_NE(e, nullptr) << c.name;
@@ -69,10 +70,9 @@ TEST(EffectLibrary, EachEffectsPredictionMatchesTheOdeWithThatEffect) {
       RunRecord r;
       r.frequency_Hz = f, r.amplitude_g = 4, r.direction = Vec3(1, 1, 0).normalized(), r.orientation_g = Vec3(1, 0, 1).normalized();
       plant::PlantConfig p = truth();
-      vibration::SineVibration table = r.vibration();
+      TableMotion table = table_motion(r);
       e->apply(c.p, p, table);
-      const vibration::SineExcitation motion(table);
-      const double ode = rectification::shake_sine(p, r.orientation_g, r.vibration(), {}, {}, &motion).measured_g;
+      const double ode = rectification::shake_sine(p, r.orientation_g, r.vibration(), {}, {}, table.excitation().get()).measured_g;
       const double pred = predict_run_g(truth(), r, e, c.p);
       EXPECT_NEAR(pred, ode, 0.01 * std::abs(pred) + 0.05e-6) << c.name << " at " << f << " Hz";
       // And the effect is not nothing there (the test could not fail otherwise).
@@ -192,8 +192,41 @@ TEST(Diagnose, ServoDynamicsAreTellApartFromAResonance) {
   EXPECT_NEAR(d.effects.front().value, 1.3, 0.02);
 }
 
+// The shaker's 2nd harmonic (20 %): mostly (1 + h^2) on the quadratic terms, which the
+// loop filters at f and 2f. Before the periodic model it was taken for servo_dynamics (a
+// crossover moved) in blind campaigns. Tolerance: 3 fitted sigma plus 1 % (the grid fit's
+// refinement and the first-order model).
+TEST(Diagnose, HiddenHarmonicDistortionIsFoundAndFitted) {
+  const Campaign c = simulate_campaign(truth(), {{"shaker_harmonic_distortion", 0.2}}, small_design(), 37, 2);
+  const Diagnosis d = diagnose(c);
+  ASSERT_TRUE(d.gap_significant) << d.where;
+  EXPECT_TRUE(d.explained) << d.verdict;
+  ASSERT_EQ(d.effects.front().name, "shaker_harmonic_distortion");
+  EXPECT_NEAR(d.effects.front().value, 0.2, 3 * d.effects.front().sigma + 0.01 * 0.2);
+}
+
+// The fixture rocks (-6e-7 rad/g, antiphase): along PA the table's motion turned by the
+// rocking has an IA component alpha a_PA whose mean is a first-order output, flat in
+// frequency; along IA the lever arm's tangential PA acceleration (~ f^2) meets k_IP.
+TEST(Diagnose, HiddenFixtureRockingIsFoundAndFitted) {
+  const Campaign c = simulate_campaign(truth(), {{"fixture_rocking", -6e-7}}, small_design(), 38, 2);
+  const Diagnosis d = diagnose(c);
+  ASSERT_TRUE(d.gap_significant) << d.where;
+  EXPECT_TRUE(d.explained) << d.verdict;
+  ASSERT_EQ(d.effects.front().name, "fixture_rocking");
+  EXPECT_NEAR(d.effects.front().value, -6e-7, 3 * d.effects.front().sigma + 0.01 * 6e-7);
+  // The held-out gap in sigma falls from 7.5 to 2.2 (seed 38; bound 0.4x). In ug it falls
+  // only from 2.8 to 1.0: the rms is led by the 4 g IA runs, where coefficients corrected on
+  // the 1 and 2 g runs (this design's folds leave one amplitude out) miss by several ug
+  // within their own sigma.
+  EXPECT_LT(d.rms_after_sigma, 0.4 * d.rms_before_sigma);
+}
+
+// Outside the library: the shaker runs' DAQ clips at 4.6 g, below the 4 g IA runs' peak
+// output (4.71 g at a_IA = 0.71 g); the mean shifts by up to mg, odd in a_IA, in those runs
+// only. No library effect has that threshold.
 TEST(Diagnose, AnEffectOutsideTheLibraryIsNotExplained) {
-  const Campaign c = simulate_campaign(truth(), {{"shaker_harmonic_distortion", 0.3}}, small_design(), 41, 2);
+  const Campaign c = simulate_campaign(truth(), {{"readout_clipping", 4.6}}, small_design(), 41, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
   EXPECT_FALSE(d.explained) << d.verdict;

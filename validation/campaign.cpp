@@ -30,9 +30,7 @@ CampaignDesign default_design() {
   return d;
 }
 
-bool is_out_of_library(const std::string& name) {
-  return name == "shaker_harmonic_distortion" || name == "fixture_rocking";
-}
+bool is_out_of_library(const std::string& name) { return name == "readout_clipping" || name == "shaker_third_harmonic"; }
 
 Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
                            const CampaignDesign& design, std::uint64_t seed, int threads) {
@@ -42,6 +40,10 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
     // These two are hypotheses (present or not), not scalable: the truth takes 0 or 1.
     if ((h.name == "pendulum_geometry" || h.name == "nonlinearity_at_input") && h.parameter != 0 && h.parameter != 1)
       throw std::invalid_argument("campaign: " + h.name + " is present (1) or not (0), got " + std::to_string(h.parameter));
+    if ((h.name == "shaker_harmonic_distortion" || h.name == "shaker_third_harmonic") && !(h.parameter >= 0 && h.parameter < 1))
+      throw std::invalid_argument("campaign: " + h.name + " is a harmonic's ratio to the fundamental, in [0, 1), got " + std::to_string(h.parameter));
+    if (h.name == "readout_clipping" && !(h.parameter > 0))
+      throw std::invalid_argument("campaign: readout_clipping is the DAQ's full scale in g, > 0, got " + std::to_string(h.parameter));
   }
   Campaign c;
   c.dynamics = truth.dynamics;
@@ -53,9 +55,13 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
   // reads it without those that live in the shaker runs' data acquisition.
   plant::PlantConfig plant = truth, static_plant = truth;
   for (const auto& h : hidden) {
-    if (is_out_of_library(h.name)) continue;
+    if (h.name == "shaker_third_harmonic") continue;  // the table's motion, below
+    if (h.name == "readout_clipping") {  // the shaker runs' DAQ; the static test is read apart
+      plant.effects.push_back(std::make_shared<plant::ReadoutClipping>(h.parameter));
+      continue;
+    }
     const EffectModel& e = *find_effect(h.name);
-    vibration::SineVibration dummy;
+    TableMotion dummy;
     e.apply(h.parameter, plant, dummy);
     if (!e.shaker_runs_only) e.apply(h.parameter, static_plant, dummy);
   }
@@ -95,34 +101,14 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
     for (std::size_t k = next++; k < c.runs.size(); k = next++) {
       RunRecord& r = c.runs[k];
       const vibration::SineVibration commanded = r.vibration();
-      vibration::SineVibration table = commanded;
-      std::vector<vibration::Harmonic> harmonics;
-      double rocking_rad_per_g = 0;
+      TableMotion table = table_motion(r);
       for (const auto& h : hidden) {
-        if (h.name == "shaker_harmonic_distortion") harmonics.push_back({2, h.parameter, 0.0});
-        if (h.name == "fixture_rocking") rocking_rad_per_g = h.parameter;
+        if (h.name == "shaker_third_harmonic") table.harmonics.push_back({3, h.parameter, 0.0});
         if (is_out_of_library(h.name)) continue;
         plant::PlantConfig unused = truth;
         find_effect(h.name)->apply(h.parameter, unused, table);  // the shaker's own motion
       }
-      std::shared_ptr<const vibration::Excitation> motion;
-      auto tone = std::make_shared<vibration::SineExcitation>(table);
-      if (!harmonics.empty()) motion = std::make_shared<vibration::HarmonicDistortion>(tone, harmonics);
-      else motion = tone;
-      if (rocking_rad_per_g != 0) {
-        // The fixture rocks about OA in phase with the table, by rocking_rad_per_g per g of
-        // commanded amplitude, the sensor 30 mm from the axis along IA: gravity and the table's
-        // motion turn with it, and the lever arm adds a tangential acceleration along PA
-        // (~ f^2) and a centripetal one along -IA (rectified: ~ f^2 alpha^2).
-        vibration::RockingSpec rs;
-        rs.axis = Vec3::UnitZ();
-        rs.amplitude_rad = std::abs(rocking_rad_per_g) * r.amplitude_g;
-        rs.phase_rad = rocking_rad_per_g < 0 ? std::numbers::pi : 0.0;
-        rs.static_gravity_g = r.orientation_g;
-        rs.lever_arm_m = Vec3(0.03, 0, 0);
-        rs.g_m_per_s2 = 9.80665;
-        motion = std::make_shared<vibration::Rocking>(motion, tone, rs);
-      }
+      const std::shared_ptr<const vibration::Excitation> motion = table.excitation();
       try {
         if (raw) {
           rectification::ShakeSettings ss;

@@ -4,9 +4,8 @@
 //
 // Takes: the truth plant (coefficients, dynamics), the hidden effects (names of
 //        validation/diagnose.hpp's library with their parameter, or the out-of-library
-//        "shaker_harmonic_distortion" with its 2nd-harmonic ratio and "fixture_rocking" with
-//        its rocking in rad per g of table amplitude, about OA, the sensor 30 mm along IA
-//        from the axis), the campaign design (the
+//        "readout_clipping" with the shaker runs' DAQ full scale in g and
+//        "shaker_third_harmonic" with the table's 3rd-harmonic ratio), the campaign design (the
 //        static positions and errors; the shaker runs: frequencies x amplitudes x directions
 //        x static orientations; each run's measurement sigma), a seed.
 // Gives: a Campaign as a lab would hand it over: static readings (the ODE plant settled in

@@ -43,7 +43,7 @@ std::vector<EffectModel> make_library() {
                 "growing with the pendulum's angle amplitude (quadratic in amplitude, rising towards the pendulum's "
                 "and the loop's resonances)";
     e.linear = true, e.unit_value = 10;
-    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&) {
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
       if (p != 0) c.effects.push_back(std::make_shared<plant::PickoffNonlinearity>(p));
     };
     lib.push_back(e);
@@ -57,7 +57,7 @@ std::vector<EffectModel> make_library() {
                 "phase rectifies as -<a_PA theta>; with a static a_IA also -a_IA <theta^2> / 4, which alone looks like "
                 "the pickoff nonlinearity";
     e.linear = true, e.unit_value = 1;
-    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&) {
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
       if (p != 0) c.effects.push_back(std::make_shared<plant::PendulumGeometry>());
     };
     lib.push_back(e);
@@ -70,7 +70,7 @@ std::vector<EffectModel> make_library() {
                 "so held at 0 by the identification; rectifies k_PP |w|^2 / 2 whatever the direction (its k2 part "
                 "through the loop, like k2; flat in frequency along PA and OA)";
     e.linear = true, e.unit_value = 1e-6;
-    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&) {
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
       // The static test identified (k0 + p, k2 - p, 0, k_OO - p): give the part back.
       c.coefficients[plant::k0] -= p;
       for (int i : {plant::k2, plant::k_PP, plant::k_OO}) c.coefficients[i] += p;
@@ -86,7 +86,7 @@ std::vector<EffectModel> make_library() {
                 "sees the vibration itself, not the rebalance current, so it stays flat with frequency where the "
                 "loop-placed one peaks near the crossover and falls above it";
     e.linear = true, e.unit_value = 1;
-    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&) {
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
       if (p >= 0.5)
         for (int i : {plant::k1_asym, plant::k2, plant::k3, plant::k4}) c.location[i] = plant::Location::input;
     };
@@ -101,7 +101,7 @@ std::vector<EffectModel> make_library() {
                 "the loop-placed terms' rectification, moves in frequency; no effect at low frequency";
     e.nominal = 1;
     e.grid = geometric(0.5, 2.0, 41);
-    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&) {
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
       c.dynamics.loop_bandwidth_Hz *= p;
     };
     lib.push_back(e);
@@ -116,7 +116,7 @@ std::vector<EffectModel> make_library() {
                 "there, grows as the margin falls; no effect at low frequency or far above the crossover";
     e.nominal = 0;
     for (int k = -8; k <= 8; ++k) e.grid.push_back(4.0 * k);  // -32 .. +32 deg (the plant takes 10 .. 85)
-    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&) {
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
       c.dynamics.phase_margin_deg = std::clamp(c.dynamics.phase_margin_deg + p, 10.0, 85.0);
     };
     lib.push_back(e);
@@ -130,7 +130,7 @@ std::vector<EffectModel> make_library() {
                 "that reaches the pendulum near its frequency: a resonance in the gap over frequency, along IA";
     e.nominal = 0;  // 0: no mode
     e.grid = geometric(100, 5000, 41);
-    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&) {
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
       if (p > 0) c.effects.push_back(std::make_shared<plant::MechanicalMode>(p, 0.05, Vec3(1, 0, 0)));
     };
     lib.push_back(e);
@@ -144,8 +144,9 @@ std::vector<EffectModel> make_library() {
                 "rectify, growing with frequency";
     e.linear = false;
     e.grid = {-0.2, -0.15, -0.1, -0.07, -0.05, -0.03, -0.02, -0.01, -0.005, 0, 0.005, 0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2};
-    e.apply = [](double p, PlantConfig&, vibration::SineVibration& v) {
+    e.apply = [](double p, PlantConfig&, TableMotion& m) {
       if (p == 0) return;
+      vibration::SineVibration& v = m.sine;
       const double r = p * v.frequency_Hz / 1000;
       Vec3 a;  // signed, in-phase amplitudes (phase 0 or 180 deg)
       for (int i = 0; i < 3; ++i) a[i] = v.amplitude_g[i] * std::cos(v.phase_rad[i]);
@@ -165,7 +166,7 @@ std::vector<EffectModel> make_library() {
                          "test; under vibration it rectifies (5/16) |I|^6 + ..., as amplitude^6, along IA";
     e.linear = true, e.unit_value = n == 5 ? 1e-8 : 1e-9;
     e.acts_at_rest = true;
-    e.apply = [n, name = e.name](double p, PlantConfig& c, vibration::SineVibration&) {
+    e.apply = [n, name = e.name](double p, PlantConfig& c, TableMotion&) {
       std::array<double, 7> poly{};
       poly[static_cast<std::size_t>(n)] = p;
       if (p != 0) c.effects.push_back(std::make_shared<plant::OutputPolynomial>(name, poly));
@@ -181,9 +182,40 @@ std::vector<EffectModel> make_library() {
                 "it. It rectifies q2 |U|^2 / 2: the shape of a loop-placed k2 error, along IA only";
     e.linear = true, e.unit_value = 1e-6;
     e.shaker_runs_only = true;
-    e.apply = [](double p, PlantConfig& c, vibration::SineVibration&) {
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
       if (p != 0) c.effects.push_back(std::make_shared<plant::OutputPolynomial>("readout_nonlinearity", std::array<double, 7>{0, 0, p, 0, 0, 0, 0}));
     };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "shaker_harmonic_distortion";
+    e.parameter = "second_harmonic_ratio", e.unit = "1";
+    e.physics = "the table's motion carries a 2nd harmonic, ratio h of the fundamental on every axis, as "
+                "w (sin t + h sin 2t): the quadratic terms see (1 + h^2) w^2 / 2, the cubic and quartic ones "
+                "cross products of the two tones, each tone through the loop at its own frequency; grows as "
+                "h^2 in the quadratic terms, along every direction the instrument is nonlinear in";
+    e.nominal = 0;
+    e.grid = {0};
+    for (double h : geometric(0.01, 0.5, 22)) e.grid.push_back(h);
+    e.apply = [](double p, PlantConfig&, TableMotion& m) {
+      if (p > 0) m.harmonics.push_back({2, p, 0.0});
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "fixture_rocking";
+    e.parameter = "rocking_rad_per_g", e.unit = "rad/g";
+    e.physics = "the fixture rocks about OA in phase with the table, by the parameter per g of amplitude, the "
+                "sensor 30 mm from the axis along IA: a tangential acceleration along PA growing as f^2, "
+                "rectified with the IA motion through k_IP and by itself through k_PP, the centripetal "
+                "acceleration (-r <alpha'^2>, along -IA, as f^2 alpha^2) and gravity turning with the fixture";
+    e.nominal = 0;
+    e.grid = {0};
+    for (double x : geometric(0.03e-6, 5e-6, 12)) e.grid.push_back(x), e.grid.push_back(-x);
+    std::sort(e.grid.begin(), e.grid.end());
+    e.apply = [](double p, PlantConfig&, TableMotion& m) { m.rocking_rad_per_g = p; };
     lib.push_back(e);
   }
   for (EffectModel& e : lib)
@@ -194,6 +226,12 @@ std::vector<EffectModel> make_library() {
   return lib;
 }
 
+
+// The table's motion as the prediction takes it: a pure sine exactly, else one period of
+// the excitation resolved into harmonics.
+rectification::PeriodicInput periodic_input(const TableMotion& m, double frequency_Hz) {
+  return m.pure_sine() ? rectification::periodic_input(m.sine) : rectification::periodic_input(*m.excitation(), frequency_Hz);
+}
 
 Eigen::VectorXd sub(const Eigen::VectorXd& v, const std::vector<int>& idx) {
   Eigen::VectorXd s(idx.size());
@@ -239,9 +277,10 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
   for (int k = 0; k < n; ++k) {
     const RunRecord& r = runs[static_cast<std::size_t>(k)];
     PlantConfig cfg = nominal;
-    vibration::SineVibration v = r.vibration();
-    if (e) e->apply(p, cfg, v);
-    const rectification::LoopResponse& h = cache.get(cfg, key, r.frequency_Hz);
+    TableMotion m = table_motion(r);
+    if (e) e->apply(p, cfg, m);
+    const rectification::PeriodicInput input = periodic_input(m, r.frequency_Hz);
+    const rectification::ResponseAt h = [&](double f) -> const rectification::LoopResponse& { return cache.get(cfg, key, f); };
     // Coefficients as identified, then the effect's own change of them (if any) on top.
     const Coefficients shift = [&] {
       Coefficients z = nominal.coefficients;
@@ -254,7 +293,7 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
     const auto f = [&](const Coefficients& co) {
       PlantConfig q = cfg;
       for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
-      return rectification::sine_rectification_at_frequency(q, r.orientation_g, v, std::nullopt, h).total_g();
+      return rectification::periodic_rectification(q, r.orientation_g, input, h).total_g();
     };
     const CoefArray g = prediction_gradient(f, nominal.coefficients);
     for (int i = 0; i < plant::kNumCoefficients; ++i) t.G(k, i) = g[i];
@@ -461,6 +500,33 @@ double chi2_as_sigma(double chi2, int n) {
 
 }  // namespace
 
+TableMotion table_motion(const RunRecord& r) {
+  TableMotion m;
+  m.sine = r.vibration();
+  m.commanded_amplitude_g = r.amplitude_g;
+  m.static_gravity_g = r.orientation_g;
+  return m;
+}
+
+std::shared_ptr<const vibration::Excitation> TableMotion::excitation() const {
+  auto tone = std::make_shared<vibration::SineExcitation>(sine);
+  std::shared_ptr<const vibration::Excitation> motion = tone;
+  if (!harmonics.empty()) motion = std::make_shared<vibration::HarmonicDistortion>(tone, harmonics);
+  if (rocking_rad_per_g != 0) {
+    // Gravity and the table's motion turn with the fixture; the lever arm adds a tangential
+    // acceleration along PA (~ f^2) and a centripetal one along -IA (~ f^2 alpha^2).
+    vibration::RockingSpec rs;
+    rs.axis = Vec3::UnitZ();
+    rs.amplitude_rad = std::abs(rocking_rad_per_g) * commanded_amplitude_g;
+    rs.phase_rad = rocking_rad_per_g < 0 ? std::numbers::pi : 0.0;
+    rs.static_gravity_g = static_gravity_g;
+    rs.lever_arm_m = Vec3(kRockingLeverArm_m, 0, 0);
+    rs.g_m_per_s2 = 9.80665;
+    motion = std::make_shared<vibration::Rocking>(motion, tone, rs);
+  }
+  return motion;
+}
+
 vibration::SineVibration RunRecord::vibration() const {
   vibration::SineVibration v;
   for (int i = 0; i < 3; ++i) {
@@ -486,7 +552,7 @@ Coefficients taken_up_by_static_test(const EffectModel& e, const PlantConfig& pl
                                      const std::vector<double>& weights, const FixedSet& fixed) {
   if (!e.linear) throw std::logic_error("diagnose: " + e.name + " acts at rest but is not linear");
   PlantConfig with = plant;
-  vibration::SineVibration unused;
+  TableMotion unused;
   e.apply(e.unit_value, with, unused);
   // Least squares is linear in the readings: the difference of the fits to the plant's
   // settled readings with and without the effect.
@@ -505,9 +571,15 @@ Coefficients taken_up_by_static_test(const EffectModel& e, const PlantConfig& pl
 
 double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const EffectModel* e, double p) {
   PlantConfig cfg = nominal;
-  vibration::SineVibration v = r.vibration();
-  if (e) e->apply(p, cfg, v);
-  return rectification::sine_rectification_at_frequency(cfg, r.orientation_g, v).total_g();
+  TableMotion m = table_motion(r);
+  if (e) e->apply(p, cfg, m);
+  std::map<double, rectification::LoopResponse> responses;
+  const rectification::ResponseAt h = [&](double f) -> const rectification::LoopResponse& {
+    auto it = responses.find(f);
+    if (it == responses.end()) it = responses.emplace(f, rectification::loop_response(cfg, f)).first;
+    return it->second;
+  };
+  return rectification::periodic_rectification(cfg, r.orientation_g, periodic_input(m, r.frequency_Hz), h).total_g();
 }
 
 Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
@@ -888,7 +960,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   if (s.resimulate_runs > 0 && d.explained) {
     // The chosen effect(s) applied to a plant and a table motion; less what the static test
     // took up of those that act at rest.
-    const auto apply_chosen = [&](PlantConfig& cfg, vibration::SineVibration& v, bool give_back) {
+    const auto apply_chosen = [&](PlantConfig& cfg, TableMotion& v, bool give_back) {
       for (const auto& [e, p] : chosen) {
         e->apply(p, cfg, v);
         if (give_back && e->acts_at_rest)
@@ -914,11 +986,10 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
       const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
       const vibration::SineVibration commanded = run.vibration();
       PlantConfig with = corrected;
-      vibration::SineVibration table = commanded;
+      TableMotion table = table_motion(run);
       apply_chosen(with, table, true);
-      const vibration::SineExcitation motion(table);
       try {
-        const double ode_with = rectification::shake_sine(with, run.orientation_g, commanded, {}, {}, &motion).measured_g;
+        const double ode_with = rectification::shake_sine(with, run.orientation_g, commanded, {}, {}, table.excitation().get()).measured_g;
         const double ode_without = rectification::shake_sine(corrected, run.orientation_g, commanded).measured_g;
         sb += std::pow(run.measured_g - ode_without, 2), sa += std::pow(run.measured_g - ode_with, 2);
         ++done;

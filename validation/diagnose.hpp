@@ -18,6 +18,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,6 +27,7 @@
 #include "validation/dividing_head.hpp"
 #include "validation/identification.hpp"
 #include "validation/uncertainty.hpp"
+#include "vibration/decorators.hpp"
 #include "vibration/profile.hpp"
 
 namespace vrelab::validation {
@@ -67,6 +69,24 @@ struct Campaign {
   std::vector<std::string> skipped;  // runs the reader could not use, each with why
 };
 
+// The table's motion in one run as the simulation models it, in sensor axes: the sine the
+// shaker makes (the commanded one, with any transverse part), its harmonic distortion, and the
+// fixture's rocking. The effects that live in the shaker set these.
+struct TableMotion {
+  vibration::SineVibration sine;
+  std::vector<vibration::Harmonic> harmonics;  // vibration/decorators.hpp's HarmonicDistortion
+  // Rocking of the fixture about OA, rad per g of commanded amplitude, in phase with the
+  // table (negative: in antiphase); the sensor 30 mm from the axis along IA.
+  double rocking_rad_per_g = 0;
+  double commanded_amplitude_g = 0;
+  Vec3 static_gravity_g = Vec3::Zero();  // what the rocking turns
+  static constexpr double kRockingLeverArm_m = 0.03;
+  bool pure_sine() const { return harmonics.empty() && rocking_rad_per_g == 0; }
+  // The acceleration the plant's case feels (the decorators of vibration/decorators.hpp).
+  std::shared_ptr<const vibration::Excitation> excitation() const;
+};
+TableMotion table_motion(const RunRecord& r);  // the commanded sine, no imperfection
+
 // A candidate effect: a physical parameter that changes the nominal simulation (the plant
 // or the shaker's motion). `nominal` is the value without the effect.
 struct EffectModel {
@@ -84,8 +104,8 @@ struct EffectModel {
   bool acts_at_rest = false;
   // Lives in the shaker runs' data acquisition only: a lab reads its static test apart.
   bool shaker_runs_only = false;
-  // Applies parameter p to the nominal plant and to the vibration (sensor axes).
-  std::function<void(double p, plant::PlantConfig&, vibration::SineVibration&)> apply;
+  // Applies parameter p to the nominal plant and to the table's motion.
+  std::function<void(double p, plant::PlantConfig&, TableMotion&)> apply;
 };
 const std::vector<EffectModel>& effect_library();
 const EffectModel* find_effect(const std::string& name);
