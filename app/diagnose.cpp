@@ -127,6 +127,9 @@ validation::HiddenEffect draw_effect(const std::string& name, std::mt19937_64& r
   if (name == "higher_order_k5") return {name, s * log_uniform(rng, 5e-8, 5e-7)};
   if (name == "higher_order_k6") return {name, s * log_uniform(rng, 1e-8, 6e-8)};
   if (name == "readout_nonlinearity") return {name, s * log_uniform(rng, 1e-5, 4e-5)};
+  // The gap 1.0-1.2 mrad: the pendulum swings up to ~0.97 mrad at 4 g near 200 Hz; at 1.3 mrad
+  // and more the film's gap trades with the coefficients' errors (docs/diagnose.md).
+  if (name == "squeeze_film_damping") return {name, 1 / log_uniform(rng, 1.0e-3, 1.2e-3)};
   if (name == "shaker_harmonic_distortion") return {name, log_uniform(rng, 0.1, 0.3)};
   if (name == "fixture_rocking") return {name, s * log_uniform(rng, 0.2e-6, 1e-6)};
   // Outside the library: the DAQ's full scale just below the 4 g IA runs' peak output
@@ -284,6 +287,10 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
     validation::Diagnosis d;
     std::string error;
     double simulate_s = 0, wall_s = 0;  // the campaign's simulation; with its diagnosis
+    // A single effect's own size: the largest |simulation with it - without it| over the
+    // runs, in each run's sigma (the first-order model on the truth's coefficients, before
+    // the static test takes up any of it). The issue scores top-1 on those >= 5 sigma.
+    double effect_max_sigma = 0;
   };
   std::vector<Case1> cases(static_cast<std::size_t>(o.n));
   std::vector<std::string> library;
@@ -320,6 +327,12 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
         const plant::PlantConfig truth = random_truth(rng);
         const validation::Campaign camp = validation::simulate_campaign(truth, k.hidden, validation::default_design(), k.seed, 1);
         k.simulate_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (k.category == "single") {
+          const validation::EffectModel* e = validation::find_effect(k.hidden[0].name);
+          for (const auto& r : camp.runs)
+            k.effect_max_sigma = std::max(k.effect_max_sigma, std::abs(validation::predict_run_g(truth, r, e, k.hidden[0].parameter) -
+                                                                       validation::predict_run_g(truth, r)) / r.sigma_g);
+        }
         k.d = validation::diagnose(camp);  // the key (k.hidden) is not passed
       } catch (const std::exception& e) {
         k.error = e.what();
@@ -339,7 +352,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
 
   // Scores against the keys.
   int single = 0, single_right = 0, single_explained = 0, clean = 0, false_alarms = 0, ool = 0, ool_unexplained = 0, two = 0,
-      two_hit = 0, two_both = 0;
+      two_hit = 0, two_both = 0, small = 0, small_right = 0;
   std::vector<double> shrink;
   std::map<std::string, std::map<std::string, int>> confusion;
   json rows = json::array();
@@ -350,7 +363,13 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
     if (k.error.empty()) called = !k.d.gap_significant ? "clean" : k.d.explained ? k.d.chosen : "unexplained";
     ++confusion[truth][called];
     const std::string top = k.error.empty() ? k.d.effects.front().name : "";
-    if (k.category == "single") {
+    if (k.category == "single" && k.effect_max_sigma < 5) {
+      // Below the issue's "gap >= 5 sigma somewhere": reported, not scored.
+      ++small;
+      small_right += called == k.hidden[0].name;
+      wrong.push_back(fmt::format("campaign {} (seed {}): {} = {:.4g} hidden, at most {:.1f} sigma in any run (not scored); called {}",
+                                  k.index, k.seed, k.hidden[0].name, k.hidden[0].parameter, k.effect_max_sigma, called));
+    } else if (k.category == "single") {
       ++single;
       // Right: the gap found and attributed to the hidden effect (the verdict "explained by"
       // it); a right top rank with an "unexplained" verdict is counted apart.
@@ -383,6 +402,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
     for (const auto& x : k.hidden) h.push_back({{"name", x.name}, {"parameter", x.parameter}});
     json row = {{"index", k.index}, {"seed", k.seed},        {"category", k.category}, {"hidden", h},
                 {"called", called}, {"simulate_s", k.simulate_s}, {"wall_s", k.wall_s}};
+    if (k.category == "single") row["effect_max_sigma"] = k.effect_max_sigma;
     if (k.error.empty()) {
       row["top"] = top;
       row["top_parameter"] = k.d.effects.front().value;
@@ -403,6 +423,8 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
                  {"threads", threads},
                  {"top1_accuracy", single ? static_cast<double>(single_right) / single : 0.0},
                  {"single_effect_campaigns", single},
+                 {"single_effect_campaigns_below_5_sigma", small},
+                 {"single_below_5_sigma_explained_right", small_right},
                  {"top_ranked_right_whatever_the_verdict", single ? static_cast<double>(single_explained) / single : 0.0},
                  {"false_alarm_rate", clean ? static_cast<double>(false_alarms) / clean : 0.0},
                  {"clean_campaigns", clean},
@@ -444,6 +466,8 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   out << fmt::format("  top-1 attribution (single in-library effects, verdict 'explained by' the hidden one): {}/{} = {:.0f} %\n",
                      single_right, single, single ? 100.0 * single_right / single : 0.0);
   out << fmt::format("  hidden effect ranked first whatever the verdict: {}/{}\n", single_explained, single);
+  if (small > 0)
+    out << fmt::format("  single effects below 5 sigma in every run (not scored): {}, explained right anyway {}\n", small, small_right);
   out << fmt::format("  false alarms on clean campaigns: {}/{}\n", false_alarms, clean);
   out << fmt::format("  out-of-library called unexplained: {}/{}\n", ool_unexplained, ool);
   out << fmt::format("  two effects: explained by both (a pair) {}/{}, by one of them {}/{}\n", two_both, two, two_hit, two);

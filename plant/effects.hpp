@@ -107,6 +107,29 @@ class ReadoutClipping final : public Effect {
   double full_scale_g_;
 };
 
+// Squeeze-film damping: the gas film between the pendulum and the case stiffens in damping
+// as the gap closes, c(theta) = c0 / (1 - (theta / theta_gap)^2)^(3/2) (1/h^3 law, the gap
+// closing on either side), c0 = 2 zeta w_p the nominal damping (1/s) and theta_gap the angle
+// at which the pendulum would touch (rad). The extra torque -(c(theta) - c0) theta' is
+// c0 theta' times a function of theta: over a period the derivative of a periodic function,
+// mean zero, so it does not rectify by itself; it changes the loop's response with the
+// angle amplitude. Beyond 0.95 theta_gap the film is held at its value there.
+class SqueezeFilmDamping final : public Effect {
+ public:
+  // c0_per_s = 2 zeta w_p, angle_gain = b (rad/s^2 per g) of the plant it goes into.
+  SqueezeFilmDamping(double gap_angle_rad, double c0_per_s, double angle_gain_rad_per_s2_per_g);
+  std::string name() const override { return "squeeze_film_damping"; }
+  double extra_input_g(double theta_rad, double omega_rad_per_s, double s1_g, const Vec3& a_g) const override;
+  // The describing function: the damping that dissipates as much per period as the film
+  // does for theta = Theta sin(wt), relative to c0: 2 <f(Theta sin phi) cos^2 phi>_phi,
+  // f = c / c0 (1 + 3 x^2 / 8 + O(x^4), x = Theta / theta_gap).
+  double damping_factor(double theta_amplitude_rad) const;
+  double gap_angle_rad() const { return gap_rad_; }
+
+ private:
+  double gap_rad_, c0_, b_;
+};
+
 // A second mechanical mode (flexure or mount resonance) between the case and the pendulum
 // along the chosen axes: base-excited oscillator, transmissibility
 // (w^2 + 2 z w s) / (s^2 + 2 z w s + w^2), static gain 1.

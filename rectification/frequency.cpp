@@ -5,6 +5,8 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -55,10 +57,43 @@ LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
   return out;
 }
 
+PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::SineVibration& v) {
+  std::vector<const SqueezeFilmDamping*> films;
+  PlantConfig out = config;
+  out.effects.clear();
+  for (const auto& e : config.effects) {
+    if (const auto* f = dynamic_cast<const SqueezeFilmDamping*>(e.get())) films.push_back(f);
+    else out.effects.push_back(e);
+  }
+  if (films.empty()) return config;
+  // The servo stays the one built for the nominal damping (the electronics do not change).
+  if (!out.servo) out.servo = plant::design_servo(config.dynamics);
+  const double zeta0 = config.dynamics.pendulum_damping_ratio;
+  Eigen::Vector3cd w;
+  for (int i = 0; i < 3; ++i) w[i] = std::polar(v.amplitude_g[i], v.phase_rad[i]);
+  double factor = 1;
+  for (int it = 0; it < 200; ++it) {
+    out.dynamics.pendulum_damping_ratio = zeta0 * factor;
+    const LoopResponse r = loop_response(out, v.frequency_Hz);
+    const double theta = std::abs(r.angle_rad[0] * w[0] + r.angle_rad[1] * w[1] + r.angle_rad[2] * w[2]);
+    double next = 1;
+    for (const auto* f : films) next += f->damping_factor(theta) - 1;
+    const double updated = 0.5 * (factor + next);  // damped: the angle falls as the damping rises
+    if (std::abs(updated - factor) < 1e-10 * factor) {
+      out.dynamics.pendulum_damping_ratio = zeta0 * updated;
+      return out;
+    }
+    factor = updated;
+  }
+  throw std::runtime_error("amplitude_linearised: the squeeze film's equivalent damping did not converge at " +
+                           std::to_string(v.frequency_Hz) + " Hz");
+}
+
 FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
                                                     std::optional<double> range_g) {
   vibration::validate(v);
-  return sine_rectification_at_frequency(config, a, v, range_g, loop_response(config, v.frequency_Hz));
+  const PlantConfig lin = amplitude_linearised(config, v);
+  return sine_rectification_at_frequency(lin, a, v, range_g, loop_response(lin, v.frequency_Hz));
 }
 
 FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,

@@ -55,6 +55,13 @@ FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& pl
                                                     const vibration::SineVibration& v,
                                                     std::optional<double> range_limit_g = std::nullopt);
 
+// An amplitude-dependent linear part (plant::SqueezeFilmDamping) replaced by its describing
+// function for this vibration: the pendulum's damping ratio times damping_factor(|Theta|),
+// |Theta| the angle amplitude of the plant so damped (a fixed point, found by damped
+// iteration to 1e-10). The harmonics the film makes are left out (their rectification is of
+// higher order). Without such an effect the plant is returned as it is.
+plant::PlantConfig amplitude_linearised(const plant::PlantConfig& plant, const vibration::SineVibration& v);
+
 // The linear plant's response at one frequency (what the prediction filters through):
 // the rebalance current and the pendulum angle per g of vibration on each sensor axis, and
 // the loop's DC gain. It depends on the dynamics and the linear effects (a mechanical mode)

@@ -122,7 +122,9 @@ double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, cons
 
 struct DiagnoseSettings {
   double model_accuracy = 0.002;      // relative accuracy of the simulation (f_model)
-  double significance_sigma = 5.0;    // a run's gap is significant beyond this many sigma
+  // A run's gap is significant beyond this many sigma; the campaign's gap is when a run's is,
+  // when chi^2 as a normal deviate is, or when one effect's held-out evidence exceeds its square.
+  double significance_sigma = 5.0;
   // A gap is explained by the best effect when its evidence exceeds significance_sigma^2 and
   // either its held-out chi^2, as a normal deviate, stays below significance_sigma (the test
   // that found the gap no longer finds one on the held-out runs) or it removes at least
