@@ -62,7 +62,8 @@ TEST(EffectLibrary, EachEffectsPredictionMatchesTheOdeWithThatEffect) {
                {"nonlinearity_at_input", 1},  {"servo_dynamics", 0.7},    {"mechanical_mode", 700},
                {"shaker_transverse_motion", 0.05}, {"servo_phase_margin", -15},  {"higher_order_k5", 3e-8},
                {"higher_order_k6", 3e-9},         {"readout_nonlinearity", 2e-6},
-               {"shaker_harmonic_distortion", 0.2}, {"fixture_rocking", -1e-6},  {"squeeze_film_damping", 700}};
+               {"shaker_harmonic_distortion", 0.2}, {"fixture_rocking", -1e-6},  {"squeeze_film_damping", 700},
+               {"mounting_misalignment", 0.05}};
   for (const auto& c : cases) {
     const EffectModel* e = find_effect(c.name);
     ASSERT_NE(e, nullptr) << c.name;

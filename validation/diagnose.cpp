@@ -189,6 +189,28 @@ std::vector<EffectModel> make_library() {
   }
   {
     EffectModel e;
+    e.name = "mounting_misalignment";
+    e.parameter = "angle_about_OA_rad", e.unit = "rad";
+    e.physics = "the shaker fixture holds the sensor turned by the angle about OA from where the static test "
+                "held it: the table's IA motion puts angle x w on PA and its PA motion -angle x w on IA, so the "
+                "cross term k_IP rectifies angle k_IP (w_IA^2 - w_PA^2) / 2 and k2 sees angle^2 w_PA^2; flat in "
+                "frequency where the terms are at the input, opposite in sign along IA and PA, nothing along OA";
+    e.nominal = 0;
+    e.grid = {0};
+    for (double x : geometric(0.002, 0.2, 12)) e.grid.push_back(x), e.grid.push_back(-x);
+    std::sort(e.grid.begin(), e.grid.end());
+    e.apply = [](double p, PlantConfig&, TableMotion& m) {
+      if (p == 0) return;
+      vibration::SineVibration& v = m.sine;
+      Vec3 a;  // signed, in-phase amplitudes (phase 0 or 180 deg), turned about OA by p
+      for (int i = 0; i < 3; ++i) a[i] = v.amplitude_g[i] * std::cos(v.phase_rad[i]);
+      const Vec3 turned(std::cos(p) * a[0] - std::sin(p) * a[1], std::sin(p) * a[0] + std::cos(p) * a[1], a[2]);
+      for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(turned[i]), v.phase_rad[i] = turned[i] < 0 ? M_PI : 0.0;
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
     e.name = "squeeze_film_damping";
     e.changes_dynamics = true;
     e.parameter = "inverse_gap_angle", e.unit = "1/rad";
