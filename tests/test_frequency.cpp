@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <numbers>
 #include <array>
 #include <memory>
 #include <stdexcept>
@@ -17,7 +18,9 @@
 #include "plant/accelerometer.hpp"
 #include "rectification/eq3.hpp"
 #include "rectification/frequency.hpp"
+#include "plant/effects.hpp"
 #include "rectification/shake.hpp"
+#include "support/random_coefficients.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/excitation.hpp"
 
@@ -255,5 +258,30 @@ TEST(PeriodicRectification, ASecondHarmonicRectifiesThroughItsCrossProducts) {
     if (f == 2000.0) {
       EXPECT_GT(std::abs(predicted - expected), 0.05 * std::abs(expected));  // the loop matters there
     }
+  }
+}
+
+// A squeeze film by its describing function: the change of the paper-like instrument's
+// rectification that the film makes, predicted against the ODE's, 4 g along IA, the gap at
+// 1.5x the angle amplitude of the plain plant at each frequency. Measured: within 12 % of the
+// change at 50 Hz (0.56 vs 0.64 ug: the film's harmonics are left out) and 3 % at 200 and
+// 500 Hz; bound 15 % of the change, which is > 0.5 ug at each frequency (so the check is sharp).
+TEST(PeriodicRectification, SqueezeFilmDescribingFunctionPredictsTheOdesChange) {
+  PlantConfig base;
+  base.coefficients = test::paper_like();
+  const Dynamics& d = base.dynamics;
+  const double c0 = 2 * d.pendulum_damping_ratio * 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+  const Vec3 a = Vec3(1, 0, 1).normalized();
+  for (double f : {50.0, 200.0, 500.0}) {
+    vibration::SineVibration v;
+    v.amplitude_g = Vec3(4, 0, 0), v.frequency_Hz = f;
+    const double theta = std::abs(rectification::sine_rectification_at_frequency(base, a, v).angle_amplitude_rad);
+    PlantConfig film = base;
+    film.effects.push_back(std::make_shared<SqueezeFilmDamping>(1.5 * theta, c0, d.angle_gain_rad_per_s2_per_g));
+    const double predicted = rectification::sine_rectification_at_frequency(film, a, v).total_g() -
+                             rectification::sine_rectification_at_frequency(base, a, v).total_g();
+    const double measured = rectification::shake_sine(film, a, v).measured_g - rectification::shake_sine(base, a, v).measured_g;
+    EXPECT_GT(std::abs(measured), 0.5e-6) << f << " Hz";
+    EXPECT_NEAR(predicted, measured, 0.15 * std::abs(measured)) << f << " Hz";
   }
 }
