@@ -360,7 +360,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   // Scores against the keys.
   int single = 0, single_right = 0, single_explained = 0, clean = 0, false_alarms = 0, ool = 0, ool_unexplained = 0, two = 0,
       two_hit = 0, two_both = 0, small = 0, small_right = 0;
-  std::vector<double> shrink;
+  std::vector<double> shrink, shrink_sigma;  // of the held-out gap rms in g, and in each run's sigma
   std::map<std::string, std::map<std::string, int>> confusion;
   json rows = json::array();
   std::vector<std::string> wrong;
@@ -384,6 +384,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
       single_right += right;
       single_explained += k.error.empty() && k.d.gap_significant && top == k.hidden[0].name;
       if (k.error.empty() && k.d.rms_before_g > 0) shrink.push_back(1 - k.d.rms_after_g / k.d.rms_before_g);
+      if (k.error.empty() && k.d.rms_before_sigma > 0) shrink_sigma.push_back(1 - k.d.rms_after_sigma / k.d.rms_before_sigma);
       if (!right)
         wrong.push_back(fmt::format("campaign {} (seed {}): {} = {:.4g} hidden; called {} (top {}){}", k.index, k.seed,
                                     k.hidden[0].name, k.hidden[0].parameter, called, top,
@@ -420,8 +421,11 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
     }
     rows.push_back(row);
   }
-  std::sort(shrink.begin(), shrink.end());
-  const double median_shrink = shrink.empty() ? 0.0 : shrink[shrink.size() / 2];
+  const auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+  };
+  const double median_shrink = median(shrink), median_shrink_sigma = median(shrink_sigma);
   json scores = {{"program", program_record()},
                  {"command", "blind"},
                  {"n", o.n},
@@ -441,6 +445,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
                  {"two_effect_explained_by_both", two ? static_cast<double>(two_both) / two : 0.0},
                  {"two_effect_campaigns", two},
                  {"median_shrinkage", median_shrink},
+                 {"median_shrinkage_in_sigma", median_shrink_sigma},
                  {"wrong", wrong},
                  {"confusion", confusion},
                  {"campaigns", rows}};
@@ -478,7 +483,8 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   out << fmt::format("  false alarms on clean campaigns: {}/{}\n", false_alarms, clean);
   out << fmt::format("  out-of-library called unexplained: {}/{}\n", ool_unexplained, ool);
   out << fmt::format("  two effects: explained by both (a pair) {}/{}, by one of them {}/{}\n", two_both, two, two_hit, two);
-  out << fmt::format("  median held-out shrinkage of the gap rms: {:.0f} %\n", 100 * median_shrink);
+  out << fmt::format("  median held-out shrinkage of the gap rms: {:.0f} % (in each run's sigma: {:.0f} %)\n", 100 * median_shrink,
+                     100 * median_shrink_sigma);
   for (const auto& w : wrong) out << "  wrong: " << w << "\n";
   const std::string why = run_plot_script("confusion.py", o.out_dir);
   out << "Wrote " << o.out_dir << "/scores.json and confusion.csv"
