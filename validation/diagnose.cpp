@@ -897,11 +897,13 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   for (const auto& sc : scored) d.effects.push_back(sc.fit);
 
   // 4. The verdict and the held-out shrinkage of the chosen effect(s).
-  // The held-out gap must also shrink: a loosely pinned parameter (k6 fitted on 1 and 2 g)
-  // widens its held-out predictive variance until chi^2 passes while its point prediction
-  // made the gap 7x larger (blind --seed 59, a squeeze film called higher_order_k6).
+  // (Requiring the held-out gap rms to shrink as well was tried and dropped: it turned a
+  // squeeze film called higher_order_k6, whose point prediction made the gap 7x larger, into
+  // "unexplained", but it also failed a right harmonic distortion (h = 0.1265 +- 0.0057 for
+  // 0.1227, held-out chi^2 346 -> 156 for 168 runs) whose adjusted residuals, which leave out
+  // the runs' correlations, grew from 1.4 to 2.2 ug.)
   const auto explains = [&](const Scored& sc, double rms_after) {
-    return sc.fit.evidence > s.significance_sigma * s.significance_sigma && rms_after < d.rms_before_g &&
+    return sc.fit.evidence > s.significance_sigma * s.significance_sigma &&
            (chi2_as_sigma(sc.fit.heldout_chi2, n) < s.significance_sigma ||
             rms_after <= (1 - s.explained_shrinkage) * d.rms_before_g);
   };

@@ -129,8 +129,7 @@ struct DiagnoseSettings {
   // either its held-out chi^2, as a normal deviate, stays below significance_sigma (the test
   // that found the gap no longer finds one on the held-out runs) or it removes at least
   // explained_shrinkage of the held-out gap rms (a large effect leaves the first-order
-  // simulation's own error, which chi^2 alone would call unexplained); in either case the
-  // held-out gap rms must be smaller with the effect than without.
+  // simulation's own error, which chi^2 alone would call unexplained).
   double explained_shrinkage = 0.9;
   int resimulate_runs = 12;             // runs (largest gaps first) re-simulated on the ODE; 0: none
   bool try_pairs = true;                // two effects at once when no one effect explains the gap
