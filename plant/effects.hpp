@@ -125,6 +125,8 @@ class SqueezeFilmDamping final : public Effect {
   // f = c / c0 (1 + 3 x^2 / 8 + O(x^4), x = Theta / theta_gap).
   double damping_factor(double theta_amplitude_rad) const;
   double gap_angle_rad() const { return gap_rad_; }
+  // The film's nominal damping as the plant feels it, 1/s: c0 times b(plant) / b(film).
+  double c0_per_s(double plant_angle_gain_rad_per_s2_per_g) const { return c0_ * plant_angle_gain_rad_per_s2_per_g / b_; }
 
  private:
   double gap_rad_, c0_, b_;

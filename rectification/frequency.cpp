@@ -68,22 +68,28 @@ PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::Sin
   if (films.empty()) return config;
   // The servo stays the one built for the nominal damping (the electronics do not change).
   if (!out.servo) out.servo = plant::design_servo(config.dynamics);
-  const double zeta0 = config.dynamics.pendulum_damping_ratio;
+  // The damping the loop sees: 2 zeta w_p + sum of each film's c0 (describing function - 1).
+  const Dynamics& d0 = config.dynamics;
+  const double two_wp = 2 * 2 * std::numbers::pi * d0.pendulum_frequency_Hz;
+  const double zeta0 = d0.pendulum_damping_ratio;
   Eigen::Vector3cd w;
   for (int i = 0; i < 3; ++i) w[i] = std::polar(v.amplitude_g[i], v.phase_rad[i]);
-  double factor = 1;
+  const auto zeta_at = [&](double theta) {
+    double extra = 0;
+    for (const auto* f : films) extra += f->c0_per_s(d0.angle_gain_rad_per_s2_per_g) * (f->damping_factor(theta) - 1);
+    return zeta0 + extra / two_wp;
+  };
+  double zeta = zeta0;
   for (int it = 0; it < 200; ++it) {
-    out.dynamics.pendulum_damping_ratio = zeta0 * factor;
+    out.dynamics.pendulum_damping_ratio = zeta;
     const LoopResponse r = loop_response(out, v.frequency_Hz);
     const double theta = std::abs(r.angle_rad[0] * w[0] + r.angle_rad[1] * w[1] + r.angle_rad[2] * w[2]);
-    double next = 1;
-    for (const auto* f : films) next += f->damping_factor(theta) - 1;
-    const double updated = 0.5 * (factor + next);  // damped: the angle falls as the damping rises
-    if (std::abs(updated - factor) < 1e-10 * factor) {
-      out.dynamics.pendulum_damping_ratio = zeta0 * updated;
+    const double updated = 0.5 * (zeta + zeta_at(theta));  // damped: the angle falls as the damping rises
+    if (std::abs(updated - zeta) < 1e-10 * zeta) {
+      out.dynamics.pendulum_damping_ratio = updated;
       return out;
     }
-    factor = updated;
+    zeta = updated;
   }
   throw std::runtime_error("amplitude_linearised: the squeeze film's equivalent damping did not converge at " +
                            std::to_string(v.frequency_Hz) + " Hz");
@@ -258,7 +264,7 @@ FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3
   std::vector<Harmonic> hs;
   double dc_gain = 1.0;
   for (const auto& [h, W] : in.tones) {
-    const LoopResponse& r = response(h * in.frequency_Hz);
+    const LoopResponse r = response(h * in.frequency_Hz);
     dc_gain = r.dc_gain;
     Harmonic x{h, Eigen::Vector3cd::Zero(), 0.0, 0.0, 0.0};
     for (int j = 0; j < 3; ++j) {
@@ -312,7 +318,7 @@ FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3
     if (t >= 0) out.terms.g[t] += g;
     else out.input_mean_g += g;
   }
-  out.input_mean_g += in.mean_g[IA];
+  out.input_mean_g += dc_gain * in.mean_g[IA];
   for (const auto& e : config.effects)
     if (dynamic_cast<const OutputPolynomial*>(e.get())) readout_mean -= e->readout(u0) - u0;
   out.readout_g = readout_mean;

@@ -56,9 +56,10 @@ FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& pl
                                                     std::optional<double> range_limit_g = std::nullopt);
 
 // An amplitude-dependent linear part (plant::SqueezeFilmDamping) replaced by its describing
-// function for this vibration: the pendulum's damping ratio times damping_factor(|Theta|),
-// |Theta| the angle amplitude of the plant so damped (a fixed point, found by damped
-// iteration to 1e-10). The harmonics the film makes are left out (their rectification is of
+// function for this vibration: the damping 2 zeta w_p plus each film's c0 times
+// (damping_factor(|Theta|) - 1), |Theta| the angle amplitude of the plant so damped (a fixed
+// point, found by damped iteration to 1e-10), the servo held as designed for the nominal
+// damping. The harmonics the film makes are left out (their rectification is of
 // higher order). Without such an effect the plant is returned as it is.
 plant::PlantConfig amplitude_linearised(const plant::PlantConfig& plant, const vibration::SineVibration& v);
 
@@ -92,9 +93,9 @@ struct PeriodicInput {
 };
 PeriodicInput periodic_input(const vibration::SineVibration& v);  // exact
 // One period of `e` (which must repeat with 1 / frequency_Hz) sampled on 64 points and
-// resolved into its mean and harmonics h <= 16 (exact for content up to h = 31 when none lies
-// beyond; each harmonic's phase as e has it from t = 0); parts at the sampling's rounding,
-// 1e-12 of the largest sample, are dropped.
+// resolved into its mean and harmonics h <= 16, each harmonic's phase as e has it from t = 0
+// (content at 17 <= h <= 31 is dropped, and above 31 it would alias: the shaker models here
+// make 3f at most); parts at the sampling's rounding, 1e-12 of the largest sample, are dropped.
 PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz);
 
 // The vibration error for a periodic input: every harmonic through the plant's linear
@@ -106,7 +107,8 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
 // input's mean adds its first-order output (input_mean_g). With allow_closed_form, a single
 // tone without mean goes to sine_rectification_at_frequency (the same number, faster).
 // Clipping is not modelled here.
-using ResponseAt = std::function<const LoopResponse&(double frequency_Hz)>;
+// (By value: a reference-returning std::function would let a by-value lambda dangle.)
+using ResponseAt = std::function<LoopResponse(double frequency_Hz)>;
 FrequencyPrediction periodic_rectification(const plant::PlantConfig& plant, const Vec3& a_static_g,
                                            const PeriodicInput& input, const ResponseAt& response,
                                            bool allow_closed_form = true);

@@ -52,9 +52,13 @@ CampaignDesign small_design() {
 
 TEST(EffectLibrary, EachEffectsPredictionMatchesTheOdeWithThatEffect) {
   // The diagnosis compares the campaign (the ODE with the hidden effect) with the
-  // frequency-dependent eq. (3) with the candidate effect: they must agree where the effect
-  // matters. 4 g along IA+PA (every effect acts), at 40 and 400 Hz; bound 1 % of the
-  // prediction + 0.05 ug (the first-order model; docs/frequency.md measured <= 0.1 %).
+  // frequency-dependent eq. (3) with the candidate effect: the change each effect makes must
+  // agree where the effect matters. 4 g along IA+PA (every effect acts), at 40 and 400 Hz;
+  // the predicted change (with the effect less without) against the ODE's, within 1 % of the
+  // change + 0.02 ug. Measured: <= 0.31 % (the pickoff at 400 Hz, 0.63 of 203 ug), the
+  // squeeze film 1.1 % of 0.97 ug at 400 Hz; the first-order model's own error without any
+  // effect is 0.004 ug there. (Against the total, as first written, a reviewer showed the
+  // squeeze film would pass even left out of the prediction.)
   const struct {
     const char* name;
     double p;
@@ -73,12 +77,13 @@ TEST(EffectLibrary, EachEffectsPredictionMatchesTheOdeWithThatEffect) {
       plant::PlantConfig p = truth();
       TableMotion table = table_motion(r);
       e->apply(c.p, p, table);
-      const double ode = rectification::shake_sine(p, r.orientation_g, r.vibration(), {}, {}, table.excitation().get()).measured_g;
-      const double pred = predict_run_g(truth(), r, e, c.p);
-      EXPECT_NEAR(pred, ode, 0.01 * std::abs(pred) + 0.05e-6) << c.name << " at " << f << " Hz";
+      const double ode_change = rectification::shake_sine(p, r.orientation_g, r.vibration(), {}, {}, table.excitation().get()).measured_g -
+                                rectification::shake_sine(truth(), r.orientation_g, r.vibration()).measured_g;
+      const double change = predict_run_g(truth(), r, e, c.p) - predict_run_g(truth(), r);
+      EXPECT_NEAR(change, ode_change, 0.01 * std::abs(ode_change) + 0.02e-6) << c.name << " at " << f << " Hz";
       // And the effect is not nothing there (the test could not fail otherwise).
       if (f == 400.0) {
-        EXPECT_GT(std::abs(pred - predict_run_g(truth(), r)), 0.3e-6) << c.name;  // a run's sigma in the campaigns
+        EXPECT_GT(std::abs(change), 0.3e-6) << c.name;  // a run's sigma in the campaigns
       }
     }
   }

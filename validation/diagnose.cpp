@@ -331,7 +331,7 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
       key = e->name + buf;
     }
     const rectification::PeriodicInput input = periodic_input(m, r.frequency_Hz);
-    const rectification::ResponseAt h = [&](double f) -> const rectification::LoopResponse& { return cache.get(cfg, key, f); };
+    const rectification::ResponseAt h = [&](double f) { return cache.get(cfg, key, f); };
     // Coefficients as identified, then the effect's own change of them (if any) on top.
     const Coefficients shift = [&] {
       Coefficients z = nominal.coefficients;
@@ -626,7 +626,7 @@ double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effec
   if (e) e->apply(p, cfg, m);
   cfg = rectification::amplitude_linearised(cfg, m.sine);
   std::map<double, rectification::LoopResponse> responses;
-  const rectification::ResponseAt h = [&](double f) -> const rectification::LoopResponse& {
+  const rectification::ResponseAt h = [&](double f) {
     auto it = responses.find(f);
     if (it == responses.end()) it = responses.emplace(f, rectification::loop_response(cfg, f)).first;
     return it->second;
@@ -918,7 +918,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
     d.gap_significant = true;
     std::ostringstream w;
     w.precision(3);
-    w << "; " << best->fit.name << " removes " << best->fit.evidence << " of chi^2 on held-out runs (beyond "
+    w << "; " << best->fit.name << " lowers -2 ln L of the held-out runs by " << best->fit.evidence << " (beyond "
       << s.significance_sigma * s.significance_sigma << ")";
     d.where += w.str();
   }
