@@ -84,6 +84,21 @@ double clipping_gaussian(double a, double sigma, double r) {
   return mean_clip - clip(a, r);
 }
 
+int term_of_coefficient(int coef) {
+  switch (coef) {
+    case Coef::k1_asym: return t_k1_asym;
+    case Coef::k2: return t_k2;
+    case Coef::k3: return t_k3;
+    case Coef::k4: return t_k4;
+    case Coef::k_IP: return t_k_IP;
+    case Coef::k_IO: return t_k_IO;
+    case Coef::k_PO: return t_k_PO;
+    case Coef::k_PP: return t_k_PP;
+    case Coef::k_OO: return t_k_OO;
+    default: return -1;
+  }
+}
+
 Eq3Terms sine_rectification(const plant::Coefficients& c, const Vec3& a,
                             const vibration::SineVibration& v, std::optional<double> range_g) {
   // Covariance of w_i sin(wt + p_i) and w_j sin(wt + p_j): w_i w_j cos(p_i - p_j) / 2.

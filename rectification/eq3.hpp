@@ -27,6 +27,9 @@ namespace vrelab::rectification {
 enum Term : int { t_k2, t_k3, t_k4, t_k1_asym, t_k_IP, t_k_IO, t_k_PO, t_k_PP, t_k_OO, t_clipping };
 inline constexpr int kNumTerms = 10;
 std::string_view term_name(int t);  // "k2", ..., "k_OO", "clipping"
+// The term a coefficient of (1) rectifies into (-1 for K1, k0 and the misalignments, which
+// do not rectify a zero-mean vibration).
+int term_of_coefficient(int coef);
 
 struct Eq3Terms {
   std::array<double, kNumTerms> g{};  // each term's contribution, g

@@ -212,26 +212,6 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
   return p;
 }
 
-namespace {
-
-// The eq. (3) term a coefficient's rectification belongs to (-1: none; the misalignments
-// respond to the input's mean only).
-int term_of(int c) {
-  switch (c) {
-    case k1_asym: return t_k1_asym;
-    case k2: return t_k2;
-    case k3: return t_k3;
-    case k4: return t_k4;
-    case k_IP: return t_k_IP;
-    case k_IO: return t_k_IO;
-    case k_PO: return t_k_PO;
-    case k_PP: return t_k_PP;
-    case k_OO: return t_k_OO;
-    default: return -1;
-  }
-}
-
-}  // namespace
 
 FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3& a, const PeriodicInput& in,
                                            const ResponseAt& response, bool allow_closed_form) {
@@ -314,7 +294,7 @@ FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3
     const bool filtered = c <= k4 && config.location[c] != Location::input;
     const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
     const double g = gain * config.coefficients[c] * ((filtered ? in_loop[c] : at_input[c]) - b0[c]);
-    const int t = term_of(c);
+    const int t = term_of_coefficient(c);  // -1: the misalignments, from the input's mean
     if (t >= 0) out.terms.g[t] += g;
     else out.input_mean_g += g;
   }

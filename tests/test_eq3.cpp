@@ -37,21 +37,6 @@ double period_average(const Coefficients& c, const Vec3& a, const vibration::Sin
   return mean - output_g(c, a);
 }
 
-// The term of eq. (3) that belongs to coefficient i.
-int term_of(int coef) {
-  switch (coef) {
-    case k2: return t_k2;
-    case k3: return t_k3;
-    case k4: return t_k4;
-    case k1_asym: return t_k1_asym;
-    case k_IP: return t_k_IP;
-    case k_IO: return t_k_IO;
-    case k_PO: return t_k_PO;
-    case k_PP: return t_k_PP;
-    case k_OO: return t_k_OO;
-    default: return -1;
-  }
-}
 
 struct Draw {
   Coefficients c;
@@ -80,7 +65,7 @@ TEST(Eq3Sine, EachTermEqualsThePeriodAverageOfModel1) {
     const Draw d = draw(rng, n);
     if (std::abs(d.a[IA]) < d.v.amplitude_g[IA]) ++asymmetry_inside;
     for (int i = k1_asym; i < kNumCoefficients; ++i) {
-      const int t = term_of(i);
+      const int t = term_of_coefficient(i);
       if (t < 0) continue;  // odd and linear terms: zero mean (checked in the total below)
       Coefficients only;
       only[K1] = d.c[K1];

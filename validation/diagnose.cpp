@@ -33,6 +33,17 @@ std::vector<double> geometric(double from, double to, int n) {
   return v;
 }
 
+// A sine whose axes move in phase or in antiphase as one signed amplitude vector (g), and
+// back (the shaker effects that redistribute the table's motion over the axes).
+Vec3 signed_in_phase(const vibration::SineVibration& v) {
+  Vec3 a;
+  for (int i = 0; i < 3; ++i) a[i] = v.amplitude_g[i] * std::cos(v.phase_rad[i]);
+  return a;
+}
+void set_in_phase(vibration::SineVibration& v, const Vec3& a) {
+  for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(a[i]), v.phase_rad[i] = a[i] < 0 ? M_PI : 0.0;
+}
+
 std::vector<EffectModel> make_library() {
   std::vector<EffectModel> lib;
   {
@@ -146,12 +157,9 @@ std::vector<EffectModel> make_library() {
     e.grid = {-0.2, -0.15, -0.1, -0.07, -0.05, -0.03, -0.02, -0.01, -0.005, 0, 0.005, 0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2};
     e.apply = [](double p, PlantConfig&, TableMotion& m) {
       if (p == 0) return;
-      vibration::SineVibration& v = m.sine;
-      const double r = p * v.frequency_Hz / 1000;
-      Vec3 a;  // signed, in-phase amplitudes (phase 0 or 180 deg)
-      for (int i = 0; i < 3; ++i) a[i] = v.amplitude_g[i] * std::cos(v.phase_rad[i]);
-      a += r * Vec3(a[2], a[0], a[1]);
-      for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(a[i]), v.phase_rad[i] = a[i] < 0 ? M_PI : 0.0;
+      const double r = p * m.sine.frequency_Hz / 1000;
+      const Vec3 a = signed_in_phase(m.sine);
+      set_in_phase(m.sine, a + r * Vec3(a[2], a[0], a[1]));
     };
     lib.push_back(e);
   }
@@ -201,11 +209,8 @@ std::vector<EffectModel> make_library() {
     std::sort(e.grid.begin(), e.grid.end());
     e.apply = [](double p, PlantConfig&, TableMotion& m) {
       if (p == 0) return;
-      vibration::SineVibration& v = m.sine;
-      Vec3 a;  // signed, in-phase amplitudes (phase 0 or 180 deg), turned about OA by p
-      for (int i = 0; i < 3; ++i) a[i] = v.amplitude_g[i] * std::cos(v.phase_rad[i]);
-      const Vec3 turned(std::cos(p) * a[0] - std::sin(p) * a[1], std::sin(p) * a[0] + std::cos(p) * a[1], a[2]);
-      for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(turned[i]), v.phase_rad[i] = turned[i] < 0 ? M_PI : 0.0;
+      const Vec3 a = signed_in_phase(m.sine);  // turned about OA by p
+      set_in_phase(m.sine, Vec3(std::cos(p) * a[0] - std::sin(p) * a[1], std::sin(p) * a[0] + std::cos(p) * a[1], a[2]));
     };
     lib.push_back(e);
   }
