@@ -44,6 +44,14 @@ void set_in_phase(vibration::SineVibration& v, const Vec3& a) {
   for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(a[i]), v.phase_rad[i] = a[i] < 0 ? M_PI : 0.0;
 }
 
+// 0 and +-from .. +-to in n geometric steps, sorted: the grid of a signed parameter.
+std::vector<double> symmetric_geometric(double from, double to, int n) {
+  std::vector<double> v = {0};
+  for (double x : geometric(from, to, n)) v.push_back(x), v.push_back(-x);
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
 std::vector<EffectModel> make_library() {
   std::vector<EffectModel> lib;
   {
@@ -204,9 +212,7 @@ std::vector<EffectModel> make_library() {
                 "cross term k_IP rectifies angle k_IP (w_IA^2 - w_PA^2) / 2 and k2 sees angle^2 w_PA^2; flat in "
                 "frequency where the terms are at the input, opposite in sign along IA and PA, nothing along OA";
     e.nominal = 0;
-    e.grid = {0};
-    for (double x : geometric(0.002, 0.2, 12)) e.grid.push_back(x), e.grid.push_back(-x);
-    std::sort(e.grid.begin(), e.grid.end());
+    e.grid = symmetric_geometric(0.002, 0.2, 12);
     e.apply = [](double p, PlantConfig&, TableMotion& m) {
       if (p == 0) return;
       const Vec3 a = signed_in_phase(m.sine);  // turned about OA by p
@@ -260,9 +266,7 @@ std::vector<EffectModel> make_library() {
                 "rectified with the IA motion through k_IP and by itself through k_PP, the centripetal "
                 "acceleration (-r <alpha'^2>, along -IA, as f^2 alpha^2) and gravity turning with the fixture";
     e.nominal = 0;
-    e.grid = {0};
-    for (double x : geometric(0.03e-6, 5e-6, 12)) e.grid.push_back(x), e.grid.push_back(-x);
-    std::sort(e.grid.begin(), e.grid.end());
+    e.grid = symmetric_geometric(0.03e-6, 5e-6, 12);
     e.apply = [](double p, PlantConfig&, TableMotion& m) { m.rocking_rad_per_g = p; };
     lib.push_back(e);
   }
