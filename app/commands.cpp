@@ -17,16 +17,17 @@
 #include <fmt/ostream.h>
 #include <unistd.h>
 
-#include "app/case_file.hpp"
-#include "app/output.hpp"
-#include "rectification/eq3.hpp"
-#include "rectification/frequency.hpp"
-#include "rectification/series.hpp"
+#include "io/case_file.hpp"
+#include "io/output.hpp"
+#include "rectification/prediction/eq3.hpp"
+#include "rectification/prediction/frequency.hpp"
+#include "rectification/measurement/series.hpp"
 #include "vibration/sampled.hpp"
-#include "validation/static_test.hpp"
+#include "validation/identification/static_test.hpp"
 #include "vrelab_version.hpp"
 
 namespace vrelab::app {
+using namespace vrelab::io;
 namespace {
 
 using nlohmann::json;

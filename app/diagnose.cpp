@@ -10,16 +10,17 @@
 
 #include <fmt/format.h>
 
-#include "app/case_file.hpp"
+#include "io/case_file.hpp"
 #include "app/commands.hpp"
-#include "app/lab_data.hpp"
-#include "app/output.hpp"
-#include "app/report.hpp"
-#include "validation/campaign.hpp"
-#include "validation/diagnose.hpp"
+#include "io/lab_data.hpp"
+#include "io/output.hpp"
+#include "io/report.hpp"
+#include "validation/diagnosis/campaign.hpp"
+#include "validation/diagnosis/diagnose.hpp"
 #include "vrelab_version.hpp"
 
 namespace vrelab::app {
+using namespace vrelab::io;
 namespace {
 
 using nlohmann::json;

@@ -7,13 +7,14 @@
 
 #include <CLI/CLI.hpp>
 
-#include "app/case_file.hpp"
+#include "io/case_file.hpp"
 #include "app/commands.hpp"
 #include "plant/ode_solver.hpp"
 #include "vrelab_version.hpp"
 
 int main(int argc, char** argv) {
   using namespace vrelab::app;
+  using namespace vrelab::io;
   CLI::App app{"vrelab: a virtual shaker laboratory for the vibration rectification error of accelerometers"};
   app.set_version_flag("--version", std::string("vrelab ") + vrelab::kProgramVersion + " (" + vrelab::kGitDescribe + ")");
   app.require_subcommand(1);

@@ -8,15 +8,16 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "app/case_file.hpp"
+#include "io/case_file.hpp"
 #include "app/commands.hpp"
-#include "app/output.hpp"
-#include "app/report.hpp"
-#include "rectification/eq3.hpp"
-#include "validation/reproduce.hpp"
+#include "io/output.hpp"
+#include "io/report.hpp"
+#include "rectification/prediction/eq3.hpp"
+#include "validation/reproduce/reproduce.hpp"
 #include "vrelab_version.hpp"
 
 namespace vrelab::app {
+using namespace vrelab::io;
 namespace {
 
 using nlohmann::json;

@@ -13,7 +13,7 @@
 #include <cmath>
 #include <vector>
 
-#include "rectification/shake.hpp"
+#include "rectification/simulation/shake.hpp"
 #include "vibration/sampled.hpp"
 
 using namespace vrelab;

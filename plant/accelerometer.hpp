@@ -31,7 +31,7 @@
 
 #include <Eigen/Core>
 
-#include "plant/effects.hpp"
+#include "plant/effects/effects.hpp"
 #include "plant/model1.hpp"
 #include "plant/ode_solver.hpp"
 

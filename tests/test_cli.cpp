@@ -10,10 +10,11 @@
 #include <nlohmann/json.hpp>
 
 #include "support/files.hpp"
-#include "app/case_file.hpp"
+#include "io/case_file.hpp"
 #include "app/commands.hpp"
 
 using namespace vrelab::app;
+using namespace vrelab::io;
 namespace fs = std::filesystem;
 using vrelab::test::read_file;
 using vrelab::test::TempDir;

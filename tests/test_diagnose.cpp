@@ -16,13 +16,13 @@
 
 #include "support/files.hpp"
 #include "support/random_coefficients.hpp"
-#include "app/case_file.hpp"
+#include "io/case_file.hpp"
 #include "app/commands.hpp"
-#include "app/lab_data.hpp"
-#include "plant/effects.hpp"
-#include "rectification/shake.hpp"
-#include "validation/campaign.hpp"
-#include "validation/diagnose.hpp"
+#include "io/lab_data.hpp"
+#include "plant/effects/effects.hpp"
+#include "rectification/simulation/shake.hpp"
+#include "validation/diagnosis/campaign.hpp"
+#include "validation/diagnosis/diagnose.hpp"
 #include "vibration/excitation.hpp"
 
 using namespace vrelab;
@@ -241,11 +241,11 @@ TEST(Diagnose, AnEffectOutsideTheLibraryIsNotExplained) {
 TEST(LabData, RoundTripAndTheHandWrittenExample) {
   TempDir t;
   const Campaign c = simulate_campaign(truth(), {}, small_design(), 31, 2);
-  app::LabManifest m;
+  io::LabManifest m;
   m.name = "round trip";
-  app::write_campaign(t.path.string(), c, m);
-  app::LabManifest m2;
-  const Campaign back = app::read_campaign(t.path.string(), &m2);
+  io::write_campaign(t.path.string(), c, m);
+  io::LabManifest m2;
+  const Campaign back = io::read_campaign(t.path.string(), &m2);
   EXPECT_EQ(m2.name, "round trip");
   ASSERT_EQ(back.runs.size(), c.runs.size());
   ASSERT_EQ(back.statics.size(), c.statics.size());
@@ -257,7 +257,7 @@ TEST(LabData, RoundTripAndTheHandWrittenExample) {
   EXPECT_EQ(back.fixed[plant::k_PP], 0.0);
 
   // The shipped hand-written campaign: positions by series and angle, averaged readings.
-  const Campaign ex = app::read_campaign(std::string(VRELAB_CASES_DIR) + "/lab-example");
+  const Campaign ex = io::read_campaign(std::string(VRELAB_CASES_DIR) + "/lab-example");
   EXPECT_EQ(ex.statics.size(), 36u);
   EXPECT_EQ(ex.runs.size(), 10u);
   EXPECT_TRUE(ex.skipped.empty());
@@ -289,7 +289,7 @@ TEST(LabData, BadRunsAreSkippedWithFileAndLineAndBadFilesStop) {
   edit("runs.csv", "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,measured_ug,sigma_ug",
        "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,measured_ug,sigma_ug,series,rest_from_s,rest_to_s,on_from_s,on_to_s");
   edit("runs.csv", "(ia-40Hz-4g,[^\\n]*)", "$1,short.csv,0,0.04,0.05,0.5");
-  const Campaign c = app::read_campaign(dir);
+  const Campaign c = io::read_campaign(dir);
   EXPECT_EQ(c.runs.size(), 8u);
   ASSERT_EQ(c.skipped.size(), 2u);
   EXPECT_TRUE(std::regex_search(c.skipped[0], std::regex(R"(run 'ia-10Hz-2g': .*runs\.csv:\d+: column measured_ug: nan is not a finite number)")))
@@ -300,17 +300,17 @@ TEST(LabData, BadRunsAreSkippedWithFileAndLineAndBadFilesStop) {
   // Files that stop the diagnosis, each named.
   edit("static.csv", "output_mA,sigma_mA", "output_V,sigma_V");
   try {
-    app::read_campaign(dir);
+    io::read_campaign(dir);
     ADD_FAILURE() << "accepted a unit mismatch";
-  } catch (const app::InputError& e) {
+  } catch (const io::InputError& e) {
     EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(R"(static\.csv: column 'output_V' is in 'V', the manifest's output unit is 'mA')")))
         << e.what();
   }
   fs::remove(dir + "/static.csv");
   try {
-    app::read_campaign(dir);
+    io::read_campaign(dir);
     ADD_FAILURE() << "accepted a missing static.csv";
-  } catch (const app::InputError& e) {
+  } catch (const io::InputError& e) {
     EXPECT_NE(std::string(e.what()).find("static.csv: cannot open"), std::string::npos) << e.what();
   }
 }
@@ -321,21 +321,21 @@ TEST(LabData, QuotedCsvCellsAreRead) {
   TempDir t;
   const std::string dir = (t.path / "c").string();
   fs::copy(std::string(VRELAB_CASES_DIR) + "/lab-example", dir);
-  const Campaign plain = app::read_campaign(dir);
+  const Campaign plain = io::read_campaign(dir);
   std::string text = read_file(dir + "/runs.csv");
   text = std::regex_replace(text, std::regex("id,frequency_Hz,"), "\"id\", \"frequency_Hz\",");
   text = std::regex_replace(text, std::regex("\nia-100Hz-2g,100,"), "\n\"ia-100Hz-2g, \"\"quoted\"\"\" ,\"100\",");
   std::ofstream(dir + "/runs.csv") << text;
-  const Campaign quoted = app::read_campaign(dir);
+  const Campaign quoted = io::read_campaign(dir);
   ASSERT_EQ(quoted.runs.size(), plain.runs.size());
   EXPECT_EQ(quoted.runs[1].id, "ia-100Hz-2g, \"quoted\"");
   EXPECT_EQ(quoted.runs[1].frequency_Hz, 100.0);
   EXPECT_EQ(quoted.runs[1].measured_g, plain.runs[1].measured_g);
   std::ofstream(dir + "/runs.csv") << text << "\"unclosed,10,2,1,0,0,0.7071,0,0.7071,1,0.3\n";
   try {
-    app::read_campaign(dir);
+    io::read_campaign(dir);
     ADD_FAILURE() << "accepted an unclosed quote";
-  } catch (const app::InputError& e) {
+  } catch (const io::InputError& e) {
     EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(R"(runs\.csv:\d+: a quoted cell is not closed)"))) << e.what();
   }
 }
@@ -358,7 +358,7 @@ TEST(LabData, RawRecordIsMeasuredAsTheSummaryWouldBe) {
   std::ofstream(dir + "/runs.csv") << "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,series,rest_from_s,"
                                       "rest_to_s,on_from_s,on_to_s\n"
                                       "raw1,50,1,1,0,0,0.7071,0,0.7071,rec.csv,-1,0,0,0.9999\n";
-  const Campaign c = app::read_campaign(dir);
+  const Campaign c = io::read_campaign(dir);
   ASSERT_EQ(c.runs.size(), 1u) << (c.skipped.empty() ? "" : c.skipped[0]);
   // The offset in g through the identified K1 (within 0.1 % of 1.25): 25 ug to 0.05 ug.
   EXPECT_NEAR(c.runs[0].measured_g, 25e-6, 0.05e-6);
@@ -375,7 +375,7 @@ TEST(LabData, RawRecordIsMeasuredAsTheSummaryWouldBe) {
     ASSERT_NE(pos, std::string::npos);
     text.insert(pos, bad + "\n");
     std::ofstream(dir + "/rec.csv") << text;
-    const Campaign b = app::read_campaign(dir);
+    const Campaign b = io::read_campaign(dir);
     ASSERT_EQ(b.skipped.size(), 1u);
     EXPECT_TRUE(std::regex_search(b.skipped[0], std::regex(expect))) << b.skipped[0];
     text.erase(pos, bad.size() + 1);
@@ -424,7 +424,7 @@ seed = 43
   app::run_campaign(o, text);
   EXPECT_TRUE(fs::exists(t.path / "c.key.json"));
   EXPECT_TRUE(fs::exists(t.path / "c" / "records" / "run1.csv"));
-  const Campaign c = app::read_campaign(o.out_dir);
+  const Campaign c = io::read_campaign(o.out_dir);
   ASSERT_EQ(c.runs.size(), 12u);
   EXPECT_TRUE(c.skipped.empty()) << c.skipped.front();
   for (const auto& r : c.runs) EXPECT_LT(r.sigma_g, 3e-6) << r.id;  // batch means over whole periods

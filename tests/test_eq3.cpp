@@ -14,7 +14,7 @@
 #include <random>
 
 #include "plant/model1.hpp"
-#include "rectification/eq3.hpp"
+#include "rectification/prediction/eq3.hpp"
 #include "support/quadrature.hpp"
 #include "support/random_coefficients.hpp"
 

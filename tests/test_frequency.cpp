@@ -1,4 +1,4 @@
-// The frequency-dependent eq. (3) (rectification/frequency.hpp) against the ODE plant on the
+// The frequency-dependent eq. (3) (rectification/prediction/frequency.hpp) against the ODE plant on the
 // virtual shaker, each mechanism alone at small nonlinearity, 1 Hz to 5 kHz. The prediction is
 // first order in the nonlinearity: the remainder is of relative order (k w)^2 ~ 1e-8 here,
 // and the ODE's quadrature is good to ~1e-9 relative, so the 1 % bound is loose; the
@@ -16,10 +16,10 @@
 #include <vector>
 
 #include "plant/accelerometer.hpp"
-#include "rectification/eq3.hpp"
-#include "rectification/frequency.hpp"
-#include "plant/effects.hpp"
-#include "rectification/shake.hpp"
+#include "rectification/prediction/eq3.hpp"
+#include "rectification/prediction/frequency.hpp"
+#include "plant/effects/effects.hpp"
+#include "rectification/simulation/shake.hpp"
 #include "support/random_coefficients.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/excitation.hpp"

@@ -14,8 +14,8 @@
 
 #include "plant/model1.hpp"
 #include "support/random_coefficients.hpp"
-#include "validation/dividing_head.hpp"
-#include "validation/identification.hpp"
+#include "validation/identification/dividing_head.hpp"
+#include "validation/identification/identification.hpp"
 
 using namespace vrelab;
 using namespace vrelab::plant;

@@ -11,12 +11,12 @@
 #include <Eigen/Dense>
 
 #include "plant/accelerometer.hpp"
-#include "plant/effects.hpp"
+#include "plant/effects/effects.hpp"
 #include "plant/physical.hpp"
-#include "rectification/eq3.hpp"
-#include "rectification/shake.hpp"
+#include "rectification/prediction/eq3.hpp"
+#include "rectification/simulation/shake.hpp"
 #include "support/random_coefficients.hpp"
-#include "validation/dividing_head.hpp"
+#include "validation/identification/dividing_head.hpp"
 
 using namespace vrelab;
 using namespace vrelab::plant;

@@ -15,13 +15,13 @@
 #include <nlohmann/json.hpp>
 
 #include "support/files.hpp"
-#include "app/case_file.hpp"
+#include "io/case_file.hpp"
 #include "app/commands.hpp"
-#include "app/report.hpp"
-#include "rectification/eq3.hpp"
+#include "io/report.hpp"
+#include "rectification/prediction/eq3.hpp"
 #include "support/random_coefficients.hpp"
-#include "validation/reproduce.hpp"
-#include "validation/static_test.hpp"
+#include "validation/reproduce/reproduce.hpp"
+#include "validation/identification/static_test.hpp"
 
 using namespace vrelab;
 using namespace vrelab::plant;
@@ -299,7 +299,7 @@ TEST(Reproduce, BadReproduceTableIsNamedWithFileLineAndKey) {
     try {
       app::run_reproduce(o, text);
       ADD_FAILURE() << "accepted: " << with;
-    } catch (const app::InputError& e) {
+    } catch (const io::InputError& e) {
       EXPECT_TRUE(std::regex_search(std::string(e.what()), std::regex(expect))) << e.what();
       EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
     }
@@ -316,7 +316,7 @@ TEST(Reproduce, BadReproduceTableIsNamedWithFileLineAndKey) {
 }
 
 TEST(Report, MarkdownAndHtmlCarryTheSameContentAndHtmlIsEscaped) {
-  app::Report r("title <x>");
+  io::Report r("title <x>");
   r.heading("Section & more");
   r.paragraph("|a_IA| < |w_IA|");
   r.table({{"h1", "h|2"}, {"1", "<2>"}});

@@ -7,8 +7,8 @@
 #include <vector>
 
 #include "plant/accelerometer.hpp"
-#include "rectification/eq3.hpp"
-#include "rectification/shake.hpp"
+#include "rectification/prediction/eq3.hpp"
+#include "rectification/simulation/shake.hpp"
 
 using namespace vrelab;
 using namespace vrelab::plant;

@@ -6,8 +6,8 @@
 #include <cmath>
 
 #include "plant/accelerometer.hpp"
-#include "rectification/eq3.hpp"
-#include "rectification/shake.hpp"
+#include "rectification/prediction/eq3.hpp"
+#include "rectification/simulation/shake.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/random.hpp"
 #include "vibration/sampled.hpp"

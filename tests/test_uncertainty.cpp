@@ -9,7 +9,7 @@
 
 #include "support/random_coefficients.hpp"
 #include "plant/model1.hpp"
-#include "validation/static_test.hpp"
+#include "validation/identification/static_test.hpp"
 
 using namespace vrelab;
 using namespace vrelab::plant;

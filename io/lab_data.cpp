@@ -1,0 +1,440 @@
+#include "io/lab_data.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numbers>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "io/case_file.hpp"
+#include "io/output.hpp"
+#include "rectification/measurement/series.hpp"
+#include "validation/identification/dividing_head.hpp"
+
+namespace vrelab::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// One CSV line into cells, trimmed of blanks. A cell may be quoted ("a, b"; "" is a quote
+// inside), as spreadsheets write them; an unclosed quote is std::invalid_argument naming `where`.
+std::vector<std::string> split(const std::string& line, const std::string& where) {
+  std::vector<std::string> out;
+  std::size_t i = 0;
+  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  while (true) {
+    while (i < line.size() && blank(line[i])) ++i;
+    std::string cell;
+    if (i < line.size() && line[i] == '"') {
+      for (++i;; ++i) {
+        if (i >= line.size()) throw std::invalid_argument(where + ": a quoted cell is not closed");
+        if (line[i] == '"') {
+          if (i + 1 < line.size() && line[i + 1] == '"') cell += '"', ++i;
+          else break;
+        } else {
+          cell += line[i];
+        }
+      }
+      ++i;
+      while (i < line.size() && blank(line[i])) ++i;
+      if (i < line.size() && line[i] != ',') throw std::invalid_argument(where + ": text after a quoted cell");
+    } else {
+      const std::size_t end = std::min(line.find(',', i), line.size());
+      cell = line.substr(i, end - i);
+      while (!cell.empty() && blank(cell.back())) cell.pop_back();
+      i = end;
+    }
+    out.push_back(std::move(cell));
+    if (i >= line.size()) break;
+    ++i;  // the comma
+  }
+  return out;
+}
+
+// A CSV file with a header: rows with their line numbers; '#' lines and blank lines skipped.
+struct Csv {
+  std::string path;
+  std::map<std::string, std::size_t> column;
+  std::vector<std::pair<int, std::vector<std::string>>> rows;
+  bool has(const std::string& c) const { return column.count(c) > 0; }
+};
+
+Csv read_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open (no such file)");
+  Csv csv;
+  csv.path = path;
+  std::string line;
+  int n = 0;
+  bool header = false;
+  while (std::getline(in, line)) {
+    ++n;
+    if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::vector<std::string> cells;
+    try {
+      cells = split(line, path + ":" + std::to_string(n));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(e.what());
+    }
+    if (!header) {
+      for (std::size_t i = 0; i < cells.size(); ++i) csv.column[cells[i]] = i;
+      header = true;
+      continue;
+    }
+    csv.rows.emplace_back(n, std::move(cells));
+  }
+  if (!header) throw InputError(path + ": no header line");
+  return csv;
+}
+
+// The value of `col` in a row as a number; nullopt with `why` set when absent or not finite.
+std::optional<double> number(const Csv& csv, const std::pair<int, std::vector<std::string>>& row, const std::string& col,
+                             std::string* why) {
+  const auto it = csv.column.find(col);
+  if (it == csv.column.end() || it->second >= row.second.size() || row.second[it->second].empty()) {
+    *why = fmt::format("{}:{}: column {}: missing value", csv.path, row.first, col);
+    return std::nullopt;
+  }
+  const std::string& s = row.second[it->second];
+  char* end = nullptr;
+  const double x = std::strtod(s.c_str(), &end);
+  if (end == s.c_str() || *end != '\0') {
+    *why = fmt::format("{}:{}: column {}: '{}' is not a number", csv.path, row.first, col, s);
+    return std::nullopt;
+  }
+  if (!std::isfinite(x)) {
+    *why = fmt::format("{}:{}: column {}: {} is not a finite number", csv.path, row.first, col, s);
+    return std::nullopt;
+  }
+  return x;
+}
+
+void require_columns(const Csv& csv, const std::vector<std::string>& cols, const std::string& hint = "") {
+  for (const auto& c : cols)
+    if (!csv.has(c)) throw InputError(fmt::format("{}: the header lacks column '{}'{}", csv.path, c, hint));
+}
+
+// The output column of a file must carry the manifest's unit: output_<unit>, sigma_<unit>.
+void require_unit(const Csv& csv, const std::string& prefix, const std::string& unit) {
+  if (csv.has(prefix + unit)) return;
+  for (const auto& [name, i] : csv.column)
+    if (name.rfind(prefix, 0) == 0)
+      throw InputError(fmt::format("{}: column '{}' is in '{}', the manifest's output unit is '{}' (expected '{}{}')", csv.path,
+                                   name, name.substr(prefix.size()), unit, prefix, unit));
+  throw InputError(fmt::format("{}: the header lacks column '{}{}'", csv.path, prefix, unit));
+}
+
+double toml_number(const toml::table& t, const std::string& table, const char* key, double fallback, const std::string& file) {
+  const toml::node* n = t.get(key);
+  if (!n) return fallback;
+  if (!n->is_number())
+    throw InputError(fmt::format("{}:{}: [{}] {}: expected a number", file, n->source().begin.line, table, key));
+  const double x = n->value<double>().value();
+  if (!std::isfinite(x)) throw InputError(fmt::format("{}:{}: [{}] {}: must be finite", file, n->source().begin.line, table, key));
+  return x;
+}
+
+void check_keys(const toml::table& t, const std::string& table, const std::vector<std::string>& allowed, const std::string& file) {
+  for (auto&& [k, v] : t) {
+    bool ok = false;
+    for (const auto& a : allowed) ok = ok || a == k.str();
+    if (!ok) throw InputError(fmt::format("{}:{}: {}{}: unknown key", file, v.source().begin.line,
+                                          table.empty() ? "" : "[" + table + "] ", std::string(k.str())));
+  }
+}
+
+int coefficient_index(const std::string& name) {
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    if (plant::coefficient_name(i) == name) return i;
+  return -1;
+}
+
+}  // namespace
+
+validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest_out) {
+  const std::string mpath = (fs::path(dir) / "manifest.toml").string();
+  if (!fs::is_regular_file(mpath)) throw InputError(mpath + ": cannot open the manifest (no such file)");
+  toml::table root;
+  try {
+    root = toml::parse_file(mpath);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}: {}", mpath, e.source().begin.line, e.description()));
+  }
+  check_keys(root, "", {"campaign", "instrument", "dynamics", "identification", "files"}, mpath);
+  validation::Campaign c;
+  LabManifest m;
+  if (auto* t = root["campaign"].as_table()) {
+    check_keys(*t, "campaign", {"name", "format_version"}, mpath);
+    m.name = (*t)["name"].value_or(m.name);
+    if (const auto v = (*t)["format_version"].value<std::int64_t>(); v && *v != 1)
+      throw InputError(fmt::format("{}: [campaign] format_version: {} is not supported (this program reads 1)", mpath, *v));
+  }
+  c.name = m.name;
+  if (auto* t = root["instrument"].as_table()) {
+    check_keys(*t, "instrument", {"output_unit", "g_m_per_s2"}, mpath);
+    m.output_unit = (*t)["output_unit"].value_or(m.output_unit);
+    m.g_m_per_s2 = toml_number(*t, "instrument", "g_m_per_s2", m.g_m_per_s2, mpath);
+  }
+  if (auto* t = root["dynamics"].as_table()) {
+    m.dynamics_given = true;
+    check_keys(*t, "dynamics",
+               {"pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g", "loop_bandwidth_Hz",
+                "phase_margin_deg", "integrator", "integrator_zero_ratio"},
+               mpath);
+    plant::Dynamics& d = c.dynamics;
+    d.pendulum_frequency_Hz = toml_number(*t, "dynamics", "pendulum_frequency_Hz", d.pendulum_frequency_Hz, mpath);
+    d.pendulum_damping_ratio = toml_number(*t, "dynamics", "pendulum_damping_ratio", d.pendulum_damping_ratio, mpath);
+    d.angle_gain_rad_per_s2_per_g = toml_number(*t, "dynamics", "angle_gain_rad_per_s2_per_g", d.angle_gain_rad_per_s2_per_g, mpath);
+    d.loop_bandwidth_Hz = toml_number(*t, "dynamics", "loop_bandwidth_Hz", d.loop_bandwidth_Hz, mpath);
+    d.phase_margin_deg = toml_number(*t, "dynamics", "phase_margin_deg", d.phase_margin_deg, mpath);
+    d.integrator = (*t)["integrator"].value_or(d.integrator);
+    d.integrator_zero_ratio = toml_number(*t, "dynamics", "integrator_zero_ratio", d.integrator_zero_ratio, mpath);
+    std::string why;
+    if (!d.IsValid(&why)) throw InputError(mpath + ": [dynamics]: " + why);
+  }
+  if (auto* t = root["identification"].as_table()) {
+    check_keys(*t, "identification", {"fixed"}, mpath);
+    if (auto* f = (*t)["fixed"].as_table())
+      for (auto&& [k, v] : *f) {
+        const int i = coefficient_index(std::string(k.str()));
+        if (i < 0 || !v.is_number())
+          throw InputError(fmt::format("{}:{}: [identification] fixed: '{}' is not a coefficient of model (1) with a number",
+                                       mpath, v.source().begin.line, std::string(k.str())));
+        c.fixed[i] = v.value<double>().value();
+      }
+  }
+  std::string static_file = "static.csv", runs_file = "runs.csv";
+  if (auto* t = root["files"].as_table()) {
+    check_keys(*t, "files", {"static", "runs"}, mpath);
+    static_file = (*t)["static"].value_or(static_file);
+    runs_file = (*t)["runs"].value_or(runs_file);
+  }
+
+  // Static readings: every row must be usable (the identification needs them all).
+  const Csv st = read_csv((fs::path(dir) / static_file).string());
+  require_unit(st, "output_", m.output_unit);
+  require_unit(st, "sigma_", m.output_unit);
+  const bool by_vector = st.has("a_IA_g");
+  if (by_vector) require_columns(st, {"a_IA_g", "a_PA_g", "a_OA_g"});
+  else require_columns(st, {"series", "angle_deg"}, " (give a_IA_g, a_PA_g, a_OA_g or series, angle_deg)");
+  for (const auto& row : st.rows) {
+    std::string why;
+    auto get = [&](const std::string& col) {
+      const auto x = number(st, row, col, &why);
+      if (!x) throw InputError(why);
+      return *x;
+    };
+    validation::StaticRecord r;
+    if (by_vector) {
+      r.orientation_g = Vec3(get("a_IA_g"), get("a_PA_g"), get("a_OA_g"));
+      if (std::abs(r.orientation_g.norm() - 1) > 0.01)
+        throw InputError(fmt::format("{}:{}: the orientation has |a| = {:.4g} g; a static position is gravity, |a| = 1 g", st.path,
+                                     row.first, r.orientation_g.norm()));
+    } else {
+      const double s = get("series");
+      if (s != 1 && s != 2 && s != 3) throw InputError(fmt::format("{}:{}: column series: must be 1, 2 or 3", st.path, row.first));
+      r.orientation_g = validation::series_orientation(static_cast<int>(s), get("angle_deg") * std::numbers::pi / 180);
+    }
+    r.output = get("output_" + m.output_unit);
+    const double sigma = get("sigma_" + m.output_unit);
+    const bool has_count = st.has("count") && st.column.at("count") < row.second.size() && !row.second[st.column.at("count")].empty();
+    const double count = has_count ? get("count") : 1.0;
+    if (!(sigma > 0)) throw InputError(fmt::format("{}:{}: column sigma_{}: must be positive", st.path, row.first, m.output_unit));
+    if (!(count >= 1)) throw InputError(fmt::format("{}:{}: column count: must be at least 1", st.path, row.first));
+    r.sigma_output = sigma / std::sqrt(count);
+    r.where = fmt::format("{}:{}", st.path, row.first);
+    c.statics.push_back(r);
+  }
+  if (c.statics.empty()) throw InputError(st.path + ": no static readings");
+
+  // The runs: a bad one is skipped with why.
+  const Csv rn = read_csv((fs::path(dir) / runs_file).string());
+  require_columns(rn, {"id", "frequency_Hz", "amplitude_g", "d_IA", "d_PA", "d_OA", "a_IA_g", "a_PA_g", "a_OA_g"});
+  const bool summaries = rn.has("measured_ug"), series = rn.has("series");
+  if (!summaries && !series)
+    throw InputError(rn.path + ": the header needs measured_ug and sigma_ug (summaries) or series (raw records)");
+  if (summaries) require_columns(rn, {"sigma_ug"});
+  if (series) require_columns(rn, {"rest_from_s", "rest_to_s", "on_from_s", "on_to_s"});
+  // K1 for raw records: the static readings' least-squares scale factor.
+  double K1 = 0;
+  if (series) {
+    std::vector<validation::Position> pos;
+    std::vector<validation::Reading> rd;
+    std::vector<double> w;
+    for (std::size_t i = 0; i < c.statics.size(); ++i) {
+      pos.push_back(validation::vector_position(c.statics[i].orientation_g.normalized()));
+      rd.push_back({static_cast<int>(i), c.statics[i].output});
+      w.push_back(1 / std::pow(c.statics[i].sigma_output, 2));
+    }
+    K1 = validation::least_squares(pos, rd, w, c.fixed).estimate.value[plant::K1];
+  }
+  for (const auto& row : rn.rows) {
+    const std::string idc = rn.column.at("id") < row.second.size() ? row.second[rn.column.at("id")] : "";
+    const std::string label = fmt::format("{}:{} (run '{}')", rn.path, row.first, idc);
+    const std::string named = fmt::format("run '{}'", idc);  // `why` already names the file and line
+    std::string why;
+    auto get = [&](const std::string& col) { return number(rn, row, col, &why); };
+    validation::RunRecord r;
+    r.id = idc;
+    r.where = fmt::format("{}:{}", rn.path, row.first);
+    const auto f = get("frequency_Hz"), a = get("amplitude_g"), d0 = get("d_IA"), d1 = get("d_PA"), d2 = get("d_OA"),
+               o0 = get("a_IA_g"), o1 = get("a_PA_g"), o2 = get("a_OA_g");
+    if (!f || !a || !d0 || !d1 || !d2 || !o0 || !o1 || !o2) {
+      c.skipped.push_back(named + ": " + why);
+      continue;
+    }
+    const Vec3 d(*d0, *d1, *d2);
+    if (!(*f > 0) || !(*a > 0) || !(d.norm() > 0)) {
+      c.skipped.push_back(label + ": frequency, amplitude and direction must be positive / non-zero");
+      continue;
+    }
+    r.frequency_Hz = *f, r.amplitude_g = *a, r.direction = d.normalized(), r.orientation_g = Vec3(*o0, *o1, *o2);
+    if (std::abs(r.orientation_g.norm() - 1) > 0.01) {
+      c.skipped.push_back(fmt::format("{}: the static orientation has |a| = {:.4g} g; gravity is 1 g (a_*_g in g)", label,
+                                      r.orientation_g.norm()));
+      continue;
+    }
+    if (std::any_of(c.runs.begin(), c.runs.end(), [&](const validation::RunRecord& x) { return x.id == idc; })) {
+      c.skipped.push_back(label + ": the id is used by an earlier run");
+      continue;
+    }
+    const std::string file = series && rn.column.at("series") < row.second.size() ? row.second[rn.column.at("series")] : "";
+    if (!file.empty()) {
+      const auto rf = get("rest_from_s"), rt = get("rest_to_s"), of = get("on_from_s"), ot = get("on_to_s");
+      if (!rf || !rt || !of || !ot) {
+        c.skipped.push_back(named + ": " + why);
+        continue;
+      }
+      rectification::SeriesWindows win;
+      win.baseline_from_s = *rf, win.baseline_to_s = *rt, win.on_from_s = *of, win.on_to_s = *ot;
+      win.frequency_Hz = r.frequency_Hz, win.K1 = K1;
+      // Batch means over whole periods: up to 8 blocks of equal whole numbers of periods (the
+      // vibration window shortened to a multiple of the blocks).
+      const long periods = static_cast<long>(std::floor((*ot - *of) * r.frequency_Hz + 1e-9));
+      if (periods < 2) {
+        c.skipped.push_back(fmt::format("{}: the vibration window holds {} whole period(s) of {:g} Hz; at least 2 are needed",
+                                        label, periods, r.frequency_Hz));
+        continue;
+      }
+      win.blocks = static_cast<int>(std::min<long>(8, periods));
+      win.on_to_s = *of + static_cast<double>(periods / win.blocks * win.blocks) / r.frequency_Hz;
+      const std::string spath = (fs::path(dir) / file).string();
+      try {
+        win.validate();
+        std::ifstream in(spath);
+        if (!in) throw std::invalid_argument(spath + ": cannot open (no such file)");
+        rectification::SeriesMeasurer meas(win);
+        std::string line;
+        int ln = 0;
+        std::size_t tcol = 0, ucol = 1;
+        bool header = false;
+        double last_t = -INFINITY;
+        while (std::getline(in, line)) {
+          ++ln;
+          if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
+          const auto cells = split(line, spath + ":" + std::to_string(ln));
+          if (!header) {
+            header = true;
+            bool found_t = false, found_u = false;
+            for (std::size_t i = 0; i < cells.size(); ++i) {
+              if (cells[i] == "time_s") tcol = i, found_t = true;
+              if (cells[i] == "output_" + m.output_unit) ucol = i, found_u = true;
+            }
+            if (!found_t || !found_u)
+              throw std::invalid_argument(fmt::format("{}:{}: the header needs time_s and output_{}", spath, ln, m.output_unit));
+            continue;
+          }
+          if (tcol >= cells.size() || ucol >= cells.size())
+            throw std::invalid_argument(fmt::format("{}:{}: too few columns", spath, ln));
+          char* e1 = nullptr;
+          char* e2 = nullptr;
+          const double t = std::strtod(cells[tcol].c_str(), &e1), u = std::strtod(cells[ucol].c_str(), &e2);
+          if (cells[tcol].empty() || cells[ucol].empty() || *e1 != '\0' || *e2 != '\0' || !std::isfinite(t) || !std::isfinite(u))
+            throw std::invalid_argument(fmt::format("{}:{}: a sample is not a finite number", spath, ln));
+          if (!(t > last_t)) throw std::invalid_argument(fmt::format("{}:{}: time does not increase", spath, ln));
+          last_t = t;
+          meas.add(t, u);
+        }
+        if (last_t < *ot)
+          throw std::invalid_argument(fmt::format("{}: the record ends at {:g} s, before on_to_s = {:g} s", spath, last_t, *ot));
+        const rectification::SeriesResult res = meas.finish();
+        r.measured_g = res.measured_g, r.sigma_g = res.sigma_g;
+      } catch (const std::invalid_argument& e) {
+        c.skipped.push_back(label + ": " + e.what());
+        continue;
+      }
+    } else {
+      if (!summaries) {
+        c.skipped.push_back(label + ": neither a series nor measured_ug");
+        continue;
+      }
+      const auto mu = get("measured_ug"), su = get("sigma_ug");
+      if (!mu || !su) {
+        c.skipped.push_back(named + ": " + why);
+        continue;
+      }
+      if (!(*su > 0)) {
+        c.skipped.push_back(label + ": sigma_ug must be positive");
+        continue;
+      }
+      r.measured_g = *mu * 1e-6, r.sigma_g = *su * 1e-6;
+    }
+    c.runs.push_back(r);
+  }
+  if (manifest_out) *manifest_out = m;
+  return c;
+}
+
+void write_campaign(const std::string& dir, const validation::Campaign& c, const LabManifest& m,
+                    const std::vector<RawSeriesRef>& raw) {
+  const plant::Dynamics& d = c.dynamics;
+  std::string fixed;
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    if (c.fixed[i]) fixed += fmt::format("{}{} = {:.10g}", fixed.empty() ? "" : ", ", plant::coefficient_name(i), *c.fixed[i]);
+  write_atomic(dir + "/manifest.toml",
+               fmt::format("# vrelab lab data format 1 (docs/data-format.md)\n[campaign]\nname = \"{}\"\nformat_version = 1\n\n"
+                           "[instrument]\noutput_unit = \"{}\"\ng_m_per_s2 = {:.10g}\n\n"
+                           "[dynamics]                      # nominal, as the manufacturer states them\n"
+                           "pendulum_frequency_Hz = {:.10g}\npendulum_damping_ratio = {:.10g}\n"
+                           "angle_gain_rad_per_s2_per_g = {:.10g}\nloop_bandwidth_Hz = {:.10g}\nphase_margin_deg = {:.10g}\n"
+                           "integrator = {}\nintegrator_zero_ratio = {:.10g}\n\n"
+                           "[identification]\nfixed = {{ {} }}\n\n[files]\nstatic = \"static.csv\"\nruns = \"runs.csv\"\n",
+                           [&] {
+                             std::string e;
+                             for (char ch : m.name) e += ch == '"' || ch == '\\' ? std::string("\\") + ch : std::string(1, ch);
+                             return e;
+                           }(),
+                           m.output_unit, m.g_m_per_s2, d.pendulum_frequency_Hz, d.pendulum_damping_ratio,
+                           d.angle_gain_rad_per_s2_per_g, d.loop_bandwidth_Hz, d.phase_margin_deg, d.integrator ? "true" : "false",
+                           d.integrator_zero_ratio, fixed));
+  std::string st = fmt::format("# static readings: orientation in g (sensor axes), mean output and one reading's sigma in {}\n"
+                               "a_IA_g,a_PA_g,a_OA_g,output_{},sigma_{},count\n",
+                               m.output_unit, m.output_unit, m.output_unit);
+  for (const auto& s : c.statics)
+    st += fmt::format("{:.12g},{:.12g},{:.12g},{:.15g},{:.6g},1\n", s.orientation_g[0], s.orientation_g[1], s.orientation_g[2],
+                      s.output, s.sigma_output);
+  write_atomic(dir + "/static.csv", st);
+  std::string rn = "# shaker runs: sine, amplitude in g peak along d (sensor axes, in phase), static orientation a in g;\n"
+                   "# measured vibration error and its sigma in ug, or a raw series (time_s, output) with its windows in s\n";
+  rn += raw.empty() ? "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,measured_ug,sigma_ug\n"
+                    : "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,series,rest_from_s,rest_to_s,on_from_s,on_to_s\n";
+  for (std::size_t k = 0; k < c.runs.size(); ++k) {
+    const auto& r = c.runs[k];
+    rn += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.12g},{:.12g},{:.12g},", r.id, r.frequency_Hz, r.amplitude_g,
+                      r.direction[0], r.direction[1], r.direction[2], r.orientation_g[0], r.orientation_g[1], r.orientation_g[2]);
+    if (raw.empty())
+      rn += fmt::format("{:.10g},{:.6g}\n", r.measured_g * 1e6, r.sigma_g * 1e6);
+    else
+      rn += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g}\n", raw[k].file, raw[k].rest_from_s, raw[k].rest_to_s,
+                        raw[k].on_from_s, raw[k].on_to_s);
+  }
+  write_atomic(dir + "/runs.csv", rn);
+}
+
+}  // namespace vrelab::io

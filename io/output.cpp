@@ -1,0 +1,120 @@
+#include "io/output.hpp"
+
+#include <cstdlib>
+#include <filesystem>
+#include <numbers>
+#include <fstream>
+#include <stdexcept>
+
+#include <unistd.h>
+
+#include "vrelab_version.hpp"
+
+namespace vrelab::io {
+
+void write_atomic(const std::string& path, const std::string& text) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  std::error_code dir_error;
+  if (target.has_parent_path()) fs::create_directories(target.parent_path(), dir_error);
+  if (dir_error) throw InputError("cannot create the folder of " + target.string() + ": " + dir_error.message());
+  const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw InputError("cannot write " + tmp.string());
+    out << text;
+    out.flush();
+    if (!out) {
+      fs::remove(tmp);
+      throw std::runtime_error("writing " + tmp.string() + " failed");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    fs::remove(tmp);
+    throw InputError("cannot write " + target.string() + ": " + ec.message());
+  }
+}
+
+nlohmann::json program_record() {
+  return {{"name", "vrelab"}, {"version", kProgramVersion}, {"git", kGitDescribe}};
+}
+
+nlohmann::json case_record(const Case& c) { return {{"file", c.path}, {"content", c.content}}; }
+
+nlohmann::json result_record(const std::string& command, const Case& c) {
+  return {{"program", program_record()}, {"command", command}, {"case", case_record(c)}, {"seed", c.seed}};
+}
+
+using nlohmann::json;
+using plant::kNumCoefficients;
+
+std::string unit_of(int i, const Case& c) {
+  const std::string u(plant::coefficient_info()[i].unit);
+  return u == "out/g" ? c.output_unit + "/g" : u;
+}
+
+json coefficients_json(const plant::Coefficients& k, const validation::CoefFlags* available) {
+  json j = json::object();
+  for (int i = 0; i < kNumCoefficients; ++i) {
+    const std::string name(plant::coefficient_name(i));
+    j[name] = (available && !(*available)[i]) ? json(nullptr) : json(k[i]);
+  }
+  return j;
+}
+
+json vec_json(const Vec3& v) { return json::array({v[0], v[1], v[2]}); }
+
+json plant_json(const plant::PlantConfig& p, bool physical) {
+  const plant::Dynamics& d = p.dynamics;
+  const plant::Servo sv = p.servo ? *p.servo : plant::design_servo(d);
+  json loc = json::object();
+  for (int i = 1; i < kNumCoefficients; ++i)
+    loc[std::string(plant::coefficient_name(i))] = std::string(plant::location_name(p.location[i]));
+  json effects = json::array();
+  for (const auto& e : p.effects) effects.push_back(e->name());
+  return {{"type", physical ? "physical" : "from_coefficients"},
+          {"coefficients", coefficients_json(p.coefficients)},
+          {"torquer_c2_per_g", p.torquer_c2_per_g},
+          {"torquer_c3_per_g2", p.torquer_c3_per_g2},
+          {"dynamics",
+           {{"pendulum_frequency_Hz", d.pendulum_frequency_Hz},
+            {"pendulum_damping_ratio", d.pendulum_damping_ratio},
+            {"angle_gain_rad_per_s2_per_g", d.angle_gain_rad_per_s2_per_g},
+            {"loop_bandwidth_Hz", d.loop_bandwidth_Hz},
+            {"phase_margin_deg", d.phase_margin_deg},
+            {"integrator", d.integrator},
+            {"integrator_zero_ratio", d.integrator_zero_ratio},
+            {"antialias_Hz", d.antialias_Hz}}},
+          {"servo",
+           {{"gain_g_per_rad", sv.gain_g_per_rad},
+            {"lead_zero_Hz", sv.lead_zero_rad_per_s / (2 * std::numbers::pi)},
+            {"lead_pole_Hz", sv.lead_pole_rad_per_s / (2 * std::numbers::pi)},
+            {"integrator_Hz", sv.integrator_rad_per_s / (2 * std::numbers::pi)}}},
+          {"location", loc},
+          {"effects", effects}};
+}
+
+std::string run_plot_script(const std::string& script, const std::string& dir) {
+  std::string py;
+  for (const char* candidate : {"/usr/bin/python3", "python3"}) {
+    const std::string probe = std::string(candidate) + " -c 'import matplotlib' >/dev/null 2>&1";
+    if (std::system(probe.c_str()) == 0) {
+      py = candidate;
+      break;
+    }
+  }
+  if (py.empty()) return "no Python with matplotlib found (install it: apt-get install python3-matplotlib)";
+  // Single-quoted for the shell, with any ' inside written as '\'' (a path may hold one).
+  const auto quote = [](const std::string& x) {
+    std::string q = "'";
+    for (char ch : x) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    return q + "'";
+  };
+  const std::string cmd = py + " " + quote(std::string(VRELAB_SOURCE_DIR) + "/tools/plots/" + script) + " " + quote(dir);
+  if (std::system(cmd.c_str()) != 0) return "the figure script failed: " + cmd;
+  return "";
+}
+
+}  // namespace vrelab::io

@@ -1,0 +1,117 @@
+#include "io/report.hpp"
+
+#include <fmt/format.h>
+
+namespace vrelab::io {
+namespace {
+
+std::string escape(const std::string& s) {
+  std::string o;
+  for (char ch : s) {
+    switch (ch) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += ch;
+    }
+  }
+  return o;
+}
+
+std::string md_cell(const std::string& s) {
+  std::string o;
+  for (char ch : s) o += ch == '|' ? std::string("\\|") : std::string(1, ch);
+  return o;
+}
+
+}  // namespace
+
+void Report::heading(const std::string& text) { blocks_.push_back({Block::heading, text, {}, "", "", true}); }
+void Report::paragraph(const std::string& text) { blocks_.push_back({Block::paragraph, text, {}, "", "", true}); }
+void Report::list(const std::vector<std::string>& items) { blocks_.push_back({Block::list, "", {items}, "", "", true}); }
+void Report::table(const std::vector<std::vector<std::string>>& rows) {
+  blocks_.push_back({Block::table, "", rows, "", "", true});
+}
+void Report::figure(const std::string& stem, const std::string& caption, bool present, const std::string& missing_reason) {
+  blocks_.push_back({Block::figure, caption, {}, stem, missing_reason, present});
+}
+
+std::string Report::markdown() const {
+  std::string o = fmt::format("# {}\n\n", title_);
+  for (const Block& b : blocks_) {
+    switch (b.kind) {
+      case Block::heading: o += fmt::format("## {}\n\n", b.text); break;
+      case Block::paragraph: o += fmt::format("{}\n\n", b.text); break;
+      case Block::list:
+        for (const auto& item : b.rows[0]) o += fmt::format("- {}\n", item);
+        o += "\n";
+        break;
+      case Block::table:
+        for (std::size_t r = 0; r < b.rows.size(); ++r) {
+          o += "|";
+          for (const auto& c : b.rows[r]) o += fmt::format(" {} |", md_cell(c));
+          o += "\n";
+          if (r == 0) {
+            o += "|";
+            for (std::size_t c = 0; c < b.rows[0].size(); ++c) o += " --- |";
+            o += "\n";
+          }
+        }
+        o += "\n";
+        break;
+      case Block::figure:
+        if (b.present)
+          o += fmt::format("![{0}]({1}.png)\n\n*{0}* ([SVG]({1}.svg))\n\n", b.text, b.stem);
+        else
+          o += fmt::format("*Figure {} not drawn: {}.* {}\n\n", b.stem, b.note, b.text);
+        break;
+    }
+  }
+  return o;
+}
+
+std::string Report::html() const {
+  std::string o = fmt::format("<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>{}</title>\n", escape(title_));
+  o += "<style>\n"
+                  "body{font-family:system-ui,sans-serif;max-width:70em;margin:2em auto;padding:0 1em;line-height:1.45;color:#222}\n"
+                  "table{border-collapse:collapse;margin:1em 0;font-size:0.9em}\n"
+                  "th,td{border:1px solid #bbb;padding:0.25em 0.6em;text-align:right}\n"
+                  "th{background:#eee}td:first-child,th:first-child{text-align:left}\n"
+                  "figure{margin:1.5em 0}figure img{max-width:100%;border:1px solid #ddd}\n"
+                  "figcaption{font-size:0.9em;color:#444}\n"
+       "</style>\n</head>\n<body>\n";
+  o += fmt::format("<h1>{}</h1>\n", escape(title_));
+  for (const Block& b : blocks_) {
+    switch (b.kind) {
+      case Block::heading: o += fmt::format("<h2>{}</h2>\n", escape(b.text)); break;
+      case Block::paragraph: o += fmt::format("<p>{}</p>\n", escape(b.text)); break;
+      case Block::list:
+        o += "<ul>\n";
+        for (const auto& item : b.rows[0]) o += fmt::format("<li>{}</li>\n", escape(item));
+        o += "</ul>\n";
+        break;
+      case Block::table:
+        o += "<table>\n";
+        for (std::size_t r = 0; r < b.rows.size(); ++r) {
+          o += "<tr>";
+          for (const auto& c : b.rows[r]) o += fmt::format("<{0}>{1}</{0}>", r == 0 ? "th" : "td", escape(c));
+          o += "</tr>\n";
+        }
+        o += "</table>\n";
+        break;
+      case Block::figure:
+        if (b.present)
+          o += fmt::format("<figure><a href=\"{0}.svg\"><img src=\"{0}.png\" alt=\"{1}\"></a><figcaption>{1} (click for "
+                           "SVG)</figcaption></figure>\n",
+                           escape(b.stem), escape(b.text));
+        else
+          o += fmt::format("<p><em>Figure {} not drawn: {}.</em> {}</p>\n", escape(b.stem), escape(b.note), escape(b.text));
+        break;
+    }
+  }
+  o += "</body>\n</html>\n";
+  return o;
+}
+
+}  // namespace vrelab::io

@@ -1,0 +1,40 @@
+#pragma once
+// io/report.hpp -- a report written once, rendered as Markdown and as HTML.
+//
+// Takes: headings, paragraphs, tables (first row: the header), figures (a file stem in the
+//        report's folder: stem.png shown, stem.svg linked) and bullet lists, in order.
+// Gives: the same document as Markdown and as a self-contained HTML page (no scripts, no
+//        external resources; the figures are the files beside it). Text is plain: HTML
+//        special characters are escaped, nothing is interpreted as markup.
+#include <string>
+#include <vector>
+
+namespace vrelab::io {
+
+class Report {
+ public:
+  explicit Report(std::string title) : title_(std::move(title)) {}
+  void heading(const std::string& text);  // a section (level 2)
+  void paragraph(const std::string& text);
+  void list(const std::vector<std::string>& items);
+  void table(const std::vector<std::vector<std::string>>& rows);
+  // A figure `stem` (.png/.svg) with its caption; `present` false: the caption says the
+  // figure was not drawn and why (`missing_reason`).
+  void figure(const std::string& stem, const std::string& caption, bool present, const std::string& missing_reason);
+
+  std::string markdown() const;
+  std::string html() const;
+
+ private:
+  struct Block {
+    enum Kind { heading, paragraph, list, table, figure } kind;
+    std::string text;
+    std::vector<std::vector<std::string>> rows;  // table rows; list items in rows[0]
+    std::string stem, note;
+    bool present = true;
+  };
+  std::string title_;
+  std::vector<Block> blocks_;
+};
+
+}  // namespace vrelab::io

@@ -1,0 +1,316 @@
+#include "rectification/prediction/frequency.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace vrelab::rectification {
+
+using plant::Accelerometer;
+using namespace plant;
+
+LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
+  if (!(frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+  // The linear plant: the same dynamics, K1 and the linear cross terms, no nonlinear part.
+  PlantConfig lin_cfg = config;
+  for (int c : {k1_asym, k2, k3, k4, k_IP, k_IO, k_PO, k_PP, k_OO}) lin_cfg.coefficients[c] = 0.0;
+  lin_cfg.torquer_c2_per_g = lin_cfg.torquer_c3_per_g2 = 0.0;
+  lin_cfg.effects.clear();
+  LoopResponse out;
+  const double w_rad = 2 * std::numbers::pi * frequency_Hz;
+  for (const auto& e : config.effects)
+    if (const auto* mode = dynamic_cast<const MechanicalMode*>(e.get())) {
+      lin_cfg.effects.push_back(e);  // linear: keep
+      for (int j = 0; j < 3; ++j) out.mechanical[static_cast<std::size_t>(j)] *= mode->transmissibility(j, w_rad);
+    }
+  // Linear: the response does not depend on the static orientation (IA up is as good as any).
+  const Accelerometer plant(lin_cfg, Vec3(1, 0, 0));
+  const Accelerometer::Linear lin = plant.linearise();
+  const int n = plant.size();
+  const double w = 2 * std::numbers::pi * frequency_Hz;
+  const Eigen::MatrixXcd m = std::complex<double>(0, w) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
+  const Eigen::MatrixXcd x = m.fullPivLu().solve(lin.B.cast<std::complex<double>>());  // n x 3: per unit input axis
+  // The rebalance current of the linear plant: i = k G theta + (1 - k) q + w_i r, with
+  // k = lead pole / lead zero (plant/accelerometer.cpp, the servo's realisation).
+  const plant::Servo& sv = plant.servo();
+  const double lead_ratio = sv.lead_pole_rad_per_s / sv.lead_zero_rad_per_s;
+  out.frequency_Hz = frequency_Hz;
+  for (int j = 0; j < 3; ++j) {
+    out.current[j] = lead_ratio * sv.gain_g_per_rad * x(Accelerometer::kTheta, j) + (1 - lead_ratio) * x(Accelerometer::kLead, j) +
+                     sv.integrator_rad_per_s * x(Accelerometer::kIntegral, j);
+    out.angle_rad[j] = x(Accelerometer::kTheta, j);
+  }
+  // DC gain of the loop from a disturbance entering before it (an input term, a torque) to
+  // the current: exactly 1 with the integrator, L0 / (1 + L0) without (L0 = b G / w_p^2).
+  // Evaluated at 0.01 Hz: within O((f / f_c)^2) ~ 1e-9 of DC, and clear of the pivot
+  // threshold that the quadrature and inert states (zero poles) would hit at f = 0.
+  const Eigen::MatrixXcd m_dc = std::complex<double>(0, 2 * std::numbers::pi * 0.01) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
+  const Eigen::VectorXcd x_dc = m_dc.fullPivLu().solve(lin.B.col(IA).cast<std::complex<double>>());
+  out.dc_gain = std::abs(lead_ratio * sv.gain_g_per_rad * x_dc[Accelerometer::kTheta] +
+                         (1 - lead_ratio) * x_dc[Accelerometer::kLead] + sv.integrator_rad_per_s * x_dc[Accelerometer::kIntegral]);
+  return out;
+}
+
+PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::SineVibration& v) {
+  std::vector<const SqueezeFilmDamping*> films;
+  PlantConfig out = config;
+  out.effects.clear();
+  for (const auto& e : config.effects) {
+    if (const auto* f = dynamic_cast<const SqueezeFilmDamping*>(e.get())) films.push_back(f);
+    else out.effects.push_back(e);
+  }
+  if (films.empty()) return config;
+  // The servo stays the one built for the nominal damping (the electronics do not change).
+  if (!out.servo) out.servo = plant::design_servo(config.dynamics);
+  // The damping the loop sees: 2 zeta w_p + sum of each film's c0 (describing function - 1).
+  const Dynamics& d0 = config.dynamics;
+  const double two_wp = 2 * 2 * std::numbers::pi * d0.pendulum_frequency_Hz;
+  const double zeta0 = d0.pendulum_damping_ratio;
+  Eigen::Vector3cd w;
+  for (int i = 0; i < 3; ++i) w[i] = std::polar(v.amplitude_g[i], v.phase_rad[i]);
+  const auto zeta_at = [&](double theta) {
+    double extra = 0;
+    for (const auto* f : films) extra += f->c0_per_s(d0.angle_gain_rad_per_s2_per_g) * (f->damping_factor(theta) - 1);
+    return zeta0 + extra / two_wp;
+  };
+  double zeta = zeta0;
+  for (int it = 0; it < 200; ++it) {
+    out.dynamics.pendulum_damping_ratio = zeta;
+    const LoopResponse r = loop_response(out, v.frequency_Hz);
+    const double theta = std::abs(r.angle_rad[0] * w[0] + r.angle_rad[1] * w[1] + r.angle_rad[2] * w[2]);
+    const double updated = 0.5 * (zeta + zeta_at(theta));  // damped: the angle falls as the damping rises
+    if (std::abs(updated - zeta) < 1e-10 * zeta) {
+      out.dynamics.pendulum_damping_ratio = updated;
+      return out;
+    }
+    zeta = updated;
+  }
+  throw std::runtime_error("amplitude_linearised: the squeeze film's equivalent damping did not converge at " +
+                           std::to_string(v.frequency_Hz) + " Hz");
+}
+
+FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
+                                                    std::optional<double> range_g) {
+  vibration::validate(v);
+  const PlantConfig lin = amplitude_linearised(config, v);
+  return sine_rectification_at_frequency(lin, a, v, range_g, loop_response(lin, v.frequency_Hz));
+}
+
+FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
+                                                    std::optional<double> range_g, const LoopResponse& h) {
+  if (std::abs(h.frequency_Hz - v.frequency_Hz) > 1e-9 * v.frequency_Hz)
+    throw std::invalid_argument("sine_rectification_at_frequency: the loop response is for another frequency");
+  double p2 = 0.0;
+  bool geometry = false;
+  for (const auto& e : config.effects) {
+    if (const auto* p = dynamic_cast<const PickoffNonlinearity*>(e.get())) p2 += p->p2_per_rad();
+    if (dynamic_cast<const PendulumGeometry*>(e.get())) geometry = true;
+  }
+  Eigen::Vector3cd W, F;  // the case's vibration, and what the pendulum's base feels
+  vibration::SineVibration felt = v;
+  for (int i = 0; i < 3; ++i) {
+    W[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
+    F[i] = h.mechanical[static_cast<std::size_t>(i)] * W[i];
+    felt.amplitude_g[i] = std::abs(F[i]);
+    felt.phase_rad[i] = std::arg(F[i]);
+  }
+  const std::complex<double> current = h.current[0] * W[0] + h.current[1] * W[1] + h.current[2] * W[2];
+  const double dc_gain = h.dc_gain;
+  FrequencyPrediction out;
+  out.current_amplitude_g = current;
+  out.angle_amplitude_rad = h.angle_rad[0] * W[0] + h.angle_rad[1] * W[1] + h.angle_rad[2] * W[2];
+
+  // Terms of (1): each through the place where it acts.
+  const double amp_i = std::abs(current);
+  vibration::SineVibration through_loop = felt;
+  through_loop.amplitude_g[IA] = amp_i;
+  for (int c = k0; c < kNumCoefficients; ++c) {
+    if (c == k0 || c == delta_OA || c == delta_PA || config.coefficients[c] == 0) continue;
+    Coefficients only;
+    only[K1] = 1;
+    only[c] = config.coefficients[c];
+    const bool ia_term = c <= k4;
+    const bool filtered = ia_term && config.location[c] != Location::input;
+    const Eq3Terms t = sine_rectification(only, a, filtered ? through_loop : felt);
+    // What rectifies before the loop (input, torquer) reaches the output with the loop's DC gain.
+    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
+    for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
+  }
+  if (range_g) out.terms.g[t_clipping] = clipping_sine(a[IA], amp_i, *range_g);
+  // Effects beyond (1), from the averaged torque balance.
+  const Dynamics& d = config.dynamics;
+  const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+  const std::complex<double> theta = out.angle_amplitude_rad;
+  out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * std::norm(theta) / 2;
+  if (geometry)
+    out.pendulum_geometry_g = dc_gain * (-0.5 * std::real(F[PA] * std::conj(theta)) - a[IA] * std::norm(theta) / 4);
+  // A readout polynomial: the period average of R over the output's oscillation, by the
+  // trapezoidal rule on 32 points (exact for a trigonometric polynomial of degree < 32).
+  // U: the output's oscillation, the current plus the output-placed cross terms' linear part
+  // (their gradient at the static orientation, on what the pendulum's base feels).
+  Coefficients cross_out;
+  cross_out[K1] = 1;
+  for (int c = delta_OA; c < kNumCoefficients; ++c)
+    if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
+  const Vec3 slope = plant::output_gradient(cross_out, a) - Vec3::UnitX();
+  std::complex<double> U = current + slope[IA] * F[IA] + slope[PA] * F[PA] + slope[OA] * F[OA];
+  const double u0 = plant::output_g(config.coefficients, a);
+  for (const auto& e : config.effects) {
+    if (!dynamic_cast<const OutputPolynomial*>(e.get())) continue;
+    constexpr int kN = 32;
+    double mean = 0;
+    for (int k = 0; k < kN; ++k) mean += e->readout(u0 + std::real(U * std::polar(1.0, 2 * std::numbers::pi * k / kN)));
+    out.readout_g += mean / kN - e->readout(u0);
+  }
+  out.loop_dc_gain = dc_gain;
+  return out;
+}
+
+bool PeriodicInput::single_tone() const {
+  return mean_g.isZero(0.0) && tones.size() == 1 && tones.front().first == 1;
+}
+
+PeriodicInput periodic_input(const vibration::SineVibration& v) {
+  vibration::validate(v);
+  PeriodicInput p;
+  p.frequency_Hz = v.frequency_Hz;
+  Eigen::Vector3cd w;
+  for (int i = 0; i < 3; ++i) w[i] = std::polar(v.amplitude_g[i], v.phase_rad[i]);
+  p.tones.push_back({1, w});
+  return p;
+}
+
+PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz) {
+  if (!(frequency_Hz > 0)) throw std::invalid_argument("periodic_input: frequency_Hz must be positive");
+  constexpr int kN = 64, kMaxHarmonic = 16;
+  std::array<Vec3, kN> a;
+  for (int k = 0; k < kN; ++k) a[static_cast<std::size_t>(k)] = e.acceleration_g(k / (kN * frequency_Hz));
+  // Parts below the sampling's rounding (1e-12 of the largest sample) are noise, not motion.
+  double peak = 0;
+  for (const Vec3& x : a) peak = std::max(peak, x.cwiseAbs().maxCoeff());
+  const double floor_g = 1e-12 * peak;
+  PeriodicInput p;
+  p.frequency_Hz = frequency_Hz;
+  for (const Vec3& x : a) p.mean_g += x / kN;
+  for (int i = 0; i < 3; ++i)
+    if (std::abs(p.mean_g[i]) <= floor_g) p.mean_g[i] = 0.0;
+  for (int h = 1; h <= kMaxHarmonic; ++h) {
+    // X_h = sum_k a_k e^{-j 2 pi h k / N}; for a_k = Im(W e^{j 2 pi h k / N}), X_h = N W / (2j).
+    Eigen::Vector3cd x = Eigen::Vector3cd::Zero();
+    for (int k = 0; k < kN; ++k) x += a[static_cast<std::size_t>(k)].cast<std::complex<double>>() * std::polar(1.0, -2 * std::numbers::pi * h * k / kN);
+    Eigen::Vector3cd w = std::complex<double>(0, 2.0 / kN) * x;
+    for (int i = 0; i < 3; ++i)
+      if (std::abs(w[i]) <= floor_g) w[i] = 0.0;
+    if (!w.isZero(0.0)) p.tones.push_back({h, w});
+  }
+  return p;
+}
+
+
+FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3& a, const PeriodicInput& in,
+                                           const ResponseAt& response, bool allow_closed_form) {
+  if (!(in.frequency_Hz > 0)) throw std::invalid_argument("periodic_rectification: frequency_Hz must be positive");
+  if (allow_closed_form && in.single_tone()) {
+    vibration::SineVibration v;
+    v.frequency_Hz = in.frequency_Hz;
+    const Eigen::Vector3cd& w = in.tones.front().second;
+    for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(w[i]), v.phase_rad[i] = std::arg(w[i]);
+    return sine_rectification_at_frequency(config, a, v, std::nullopt, response(in.frequency_Hz));
+  }
+  double p2 = 0.0;
+  bool geometry = false;
+  for (const auto& e : config.effects) {
+    if (const auto* p = dynamic_cast<const PickoffNonlinearity*>(e.get())) p2 += p->p2_per_rad();
+    if (dynamic_cast<const PendulumGeometry*>(e.get())) geometry = true;
+  }
+  // Per harmonic: what the pendulum's base feels F, the rebalance current I, the angle Theta,
+  // and the output's oscillation U (the current plus the output-placed cross terms' slope).
+  Coefficients cross_out;
+  cross_out[K1] = 1;
+  for (int c = delta_OA; c < kNumCoefficients; ++c)
+    if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
+  const Vec3 slope = plant::output_gradient(cross_out, a) - Vec3::UnitX();
+  struct Harmonic {
+    int h;
+    Eigen::Vector3cd F;
+    std::complex<double> I, Theta, U;
+  };
+  std::vector<Harmonic> hs;
+  double dc_gain = 1.0;
+  for (const auto& [h, W] : in.tones) {
+    const LoopResponse r = response(h * in.frequency_Hz);
+    dc_gain = r.dc_gain;
+    Harmonic x{h, Eigen::Vector3cd::Zero(), 0.0, 0.0, 0.0};
+    for (int j = 0; j < 3; ++j) {
+      const auto sj = static_cast<std::size_t>(j);
+      x.F[j] = r.mechanical[sj] * W[j];
+      x.I += r.current[sj] * W[j];
+      x.Theta += r.angle_rad[sj] * W[j];
+    }
+    x.U = x.I + slope[IA] * x.F[IA] + slope[PA] * x.F[PA] + slope[OA] * x.F[OA];
+    hs.push_back(x);
+  }
+  FrequencyPrediction out;
+  out.loop_dc_gain = dc_gain;
+  if (!hs.empty() && hs.front().h == 1) out.current_amplitude_g = hs.front().I, out.angle_amplitude_rad = hs.front().Theta;
+
+  // One period on kM points: the felt acceleration (about the static point moved by the
+  // input's mean) and the current's oscillation; each coefficient's basis function averaged
+  // at its place, less its static value.
+  int h_max = 1;
+  for (const Harmonic& x : hs) h_max = std::max(h_max, x.h);
+  const int kM = std::max(64, 6 * h_max + 1);  // exact for degree-6 trigonometric polynomials
+  const Vec3 a_mean = a + in.mean_g;
+  std::array<double, kNumCoefficients> at_input{}, in_loop{};
+  const plant::Basis b0 = plant::basis(a);
+  double readout_mean = 0, u0 = plant::output_g(config.coefficients, a);
+  const double u_mean = u0 + in.mean_g[IA] + slope.dot(in.mean_g);
+  for (int k = 0; k < kM; ++k) {
+    const double phi = 2 * std::numbers::pi * k / kM;
+    Vec3 felt = a_mean;
+    double current = 0, u = u_mean;
+    for (const Harmonic& x : hs) {
+      const std::complex<double> e = std::polar(1.0, x.h * phi);
+      for (int i = 0; i < 3; ++i) felt[i] += std::imag(x.F[i] * e);
+      current += std::imag(x.I * e);
+      u += std::imag(x.U * e);
+    }
+    const plant::Basis bf = plant::basis(felt);
+    Vec3 loop = felt;
+    loop[IA] = a_mean[IA] + current;
+    const plant::Basis bl = plant::basis(loop);
+    for (int c = 0; c < kNumCoefficients; ++c) at_input[c] += bf[c] / kM, in_loop[c] += bl[c] / kM;
+    for (const auto& e : config.effects)
+      if (dynamic_cast<const OutputPolynomial*>(e.get())) readout_mean += (e->readout(u) - u) / kM;
+  }
+  for (int c = k1_asym; c < kNumCoefficients; ++c) {
+    if (config.coefficients[c] == 0) continue;
+    const bool filtered = c <= k4 && config.location[c] != Location::input;
+    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
+    const double g = gain * config.coefficients[c] * ((filtered ? in_loop[c] : at_input[c]) - b0[c]);
+    const int t = term_of_coefficient(c);  // -1: the misalignments, from the input's mean
+    if (t >= 0) out.terms.g[t] += g;
+    else out.input_mean_g += g;
+  }
+  out.input_mean_g += dc_gain * in.mean_g[IA];
+  for (const auto& e : config.effects)
+    if (dynamic_cast<const OutputPolynomial*>(e.get())) readout_mean -= e->readout(u0) - u0;
+  out.readout_g = readout_mean;
+  // Effects beyond (1): quadratic in the angle, so harmonics add (their cross products
+  // average out over a period).
+  const Dynamics& d = config.dynamics;
+  const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+  double theta2 = 0, pa_theta = 0;  // <theta^2>, <f_PA theta>
+  for (const Harmonic& x : hs) theta2 += std::norm(x.Theta) / 2, pa_theta += std::real(x.F[PA] * std::conj(x.Theta)) / 2;
+  out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * theta2;
+  if (geometry) out.pendulum_geometry_g = dc_gain * (-pa_theta - a_mean[IA] * theta2 / 2);
+  return out;
+}
+
+}  // namespace vrelab::rectification

@@ -1,0 +1,116 @@
+#pragma once
+// rectification/prediction/frequency.hpp -- eq. (3) at a vibration frequency: what the paper left open.
+//
+// Takes: a plant (plant/accelerometer.hpp), the static orientation (g), a sine vibration
+//        (g peak, per-axis phase, frequency in Hz).
+// Gives: the vibration error per term (g) to first order in the nonlinearities, each term
+//        seen through the plant's linear dynamics at that frequency (docs/frequency.md):
+//  - terms at the input (mechanical) and the cross terms: the vibration itself (eq. (3));
+//  - IA terms in the loop or at the output: eq. (3) with the IA amplitude replaced by the
+//    amplitude |I| of the rebalance current, I = sum_j H_ij(jw) W_j (W_j = w_j e^{j phi_j});
+//    the averaged torque balance makes both places rectify alike;
+//  - pickoff nonlinearity p2: (w_p^2 / b) p2 |Theta|^2 / 2, Theta = sum_j G_j(jw) W_j the
+//    pendulum angle (<theta> = -p2 <theta^2> and the hinge stiffness turns it into torque);
+//  - pendulum geometry: -Re(W_PA conj(Theta)) / 2 - a_IA |Theta|^2 / 4 (vibropendulous);
+//  - clipping at [range]: of the current's amplitude |I|;
+//  - a polynomial on the readout R(u) (plant::OutputPolynomial): <R(u0 + Re(U e^{jwt}))> -
+//    R(u0), u0 the static output of (1), U = I + the output-placed cross terms' linear part.
+// H and G come from the linearisation of the plant with every nonlinear part removed. What
+// rectifies before the loop (input terms, the torquer, the pendulum geometry) reaches the
+// output with the loop's DC gain: 1 with the integrator, L0/(1 + L0) without (L0 = b G/w_p^2).
+// The pickoff formula assumes the integrator (<u> = 0).
+// Behind a mechanical mode, the input-placed terms, the cross terms and the pendulum geometry
+// see the vibration through the mode's transmissibility (what the pendulum's base feels).
+#include <array>
+#include <complex>
+#include <functional>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "plant/accelerometer.hpp"
+#include "rectification/prediction/eq3.hpp"
+#include "vibration/excitation.hpp"
+#include "vibration/profile.hpp"
+
+namespace vrelab::rectification {
+
+struct FrequencyPrediction {
+  Eq3Terms terms;                         // the terms of (1), at this frequency
+  double pickoff_g = 0.0;                 // effect: pickoff nonlinearity
+  double pendulum_geometry_g = 0.0;       // effect: vibropendulous coupling
+  double readout_g = 0.0;                 // effect: a polynomial on the readout
+  std::complex<double> current_amplitude_g;  // I
+  std::complex<double> angle_amplitude_rad;  // Theta
+  double loop_dc_gain = 1.0;  // from a disturbance before the loop to the output; 1 with the integrator
+  // A periodic input's mean (periodic_rectification): the output's first-order response to it,
+  // a_IA's mean plus the misalignments' share of the other axes' means. Not a rectification
+  // of the sensor but the measured error contains it (e.g. a rocking fixture's centripetal part).
+  double input_mean_g = 0.0;
+  double total_g() const { return terms.total_g() + pickoff_g + pendulum_geometry_g + readout_g + input_mean_g; }
+};
+
+FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
+                                                    const vibration::SineVibration& v,
+                                                    std::optional<double> range_limit_g = std::nullopt);
+
+// An amplitude-dependent linear part (plant::SqueezeFilmDamping) replaced by its describing
+// function for this vibration: the damping 2 zeta w_p plus each film's c0 times
+// (damping_factor(|Theta|) - 1), |Theta| the angle amplitude of the plant so damped (a fixed
+// point, found by damped iteration to 1e-10), the servo held as designed for the nominal
+// damping. The harmonics the film makes are left out (their rectification is of
+// higher order). Without such an effect the plant is returned as it is.
+plant::PlantConfig amplitude_linearised(const plant::PlantConfig& plant, const vibration::SineVibration& v);
+
+// The linear plant's response at one frequency (what the prediction filters through):
+// the rebalance current and the pendulum angle per g of vibration on each sensor axis, and
+// the loop's DC gain. It depends on the dynamics and the linear effects (a mechanical mode)
+// only, not on the coefficients, the orientation or the amplitude: compute it once per
+// (plant dynamics, frequency) and reuse it.
+struct LoopResponse {
+  double frequency_Hz = 0;
+  std::array<std::complex<double>, 3> current{}, angle_rad{};
+  // What the pendulum's base feels per g of case vibration on each axis: the mechanical
+  // modes' transmissibility (1 without a mode).
+  std::array<std::complex<double>, 3> mechanical{1.0, 1.0, 1.0};
+  double dc_gain = 1;
+};
+LoopResponse loop_response(const plant::PlantConfig& plant, double frequency_Hz);
+// The same prediction with the response given (its frequency must be v's).
+FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
+                                                    const vibration::SineVibration& v, std::optional<double> range_limit_g,
+                                                    const LoopResponse& response);
+
+// A periodic vibration of fundamental frequency f (a distorted sine, a rocking fixture's motion):
+//   a(t) = mean_g + sum_h Im(W_h e^{j h 2 pi f t}),  sensor axes, g,
+// the sine convention of vibration::SineVibration (W = amplitude e^{j phase}).
+struct PeriodicInput {
+  double frequency_Hz = 0;
+  Vec3 mean_g = Vec3::Zero();
+  std::vector<std::pair<int, Eigen::Vector3cd>> tones;  // (h >= 1, W_h)
+  bool single_tone() const;  // one tone at h = 1 and no mean
+};
+PeriodicInput periodic_input(const vibration::SineVibration& v);  // exact
+// One period of `e` (which must repeat with 1 / frequency_Hz) sampled on 64 points and
+// resolved into its mean and harmonics h <= 16, each harmonic's phase as e has it from t = 0
+// (content at 17 <= h <= 31 is dropped, and above 31 it would alias: the shaker models here
+// make 3f at most); parts at the sampling's rounding, 1e-12 of the largest sample, are dropped.
+PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz);
+
+// The vibration error for a periodic input: every harmonic through the plant's linear
+// response at its own frequency (`response(h f)`, loop_response or a cache of it), then
+// each term of (1) at its place and each effect averaged over one period by the trapezoid
+// rule on max(64, 6 h_max + 1) points (exact for the polynomial terms and the readout
+// polynomial, of degree <= 6; the |a_IA| of k1' converges as 1 / points^2). Cross-harmonic products are what a distorted tone adds: e.g.
+// <a^3> = -(3/4) h2 sin(phi2) w^3 for w (sin t + h2 sin(2t + phi2)). The
+// input's mean adds its first-order output (input_mean_g). With allow_closed_form, a single
+// tone without mean goes to sine_rectification_at_frequency (the same number, faster).
+// Clipping is not modelled here.
+// (By value: a reference-returning std::function would let a by-value lambda dangle.)
+using ResponseAt = std::function<LoopResponse(double frequency_Hz)>;
+FrequencyPrediction periodic_rectification(const plant::PlantConfig& plant, const Vec3& a_static_g,
+                                           const PeriodicInput& input, const ResponseAt& response,
+                                           bool allow_closed_form = true);
+
+}  // namespace vrelab::rectification

@@ -1,0 +1,55 @@
+#pragma once
+// validation/diagnosis/campaign.hpp -- the virtual lab: a whole test campaign simulated from a "truth"
+// instrument that may carry hidden effects (issue 5).
+//
+// Takes: the truth plant (coefficients, dynamics), the hidden effects (names of
+//        validation/diagnosis/diagnose.hpp's library with their parameter, or the out-of-library
+//        "readout_clipping" with the shaker runs' DAQ full scale in g and
+//        "shaker_third_harmonic" with the table's 3rd-harmonic ratio), the campaign design (the
+//        static positions and errors; the shaker runs: frequencies x amplitudes x directions
+//        x static orientations; each run's measurement sigma), a seed.
+// Gives: a Campaign as a lab would hand it over: static readings (the ODE plant settled in
+//        each position, with set-angle errors and noise, each with its first-order sigma)
+//        and per run the measured vibration error (the ODE on the virtual shaker with the
+//        hidden effects, plus Gaussian noise of the run's sigma). The nominal dynamics are
+//        the truth's without its hidden effects. Nothing of the truth is in the Campaign.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "plant/accelerometer.hpp"
+#include "validation/diagnosis/diagnose.hpp"
+#include "validation/identification/dividing_head.hpp"
+
+namespace vrelab::validation {
+
+struct HiddenEffect {
+  std::string name;
+  double parameter = 0;
+};
+
+struct CampaignDesign {
+  int positions_per_series = 12;  // 30 deg steps: rank 12 of 13, only k_PP must be held
+  StaticTestErrors errors;
+  std::vector<double> frequencies_Hz, amplitudes_g;
+  std::vector<Vec3> directions, orientations_g;
+  double run_sigma_g = 0.3e-6;
+  // Raw records instead of summaries (raw_sample_rate_Hz > 0): each run read by a readout at
+  // that rate (raised to at least 20 samples per period) with this noise per sample, a record
+  // at rest then at least raw_record_s under vibration; Campaign::raw holds them and each
+  // run's measured_g / sigma_g is the batch-means measurement of its own record.
+  double raw_sample_rate_Hz = 0, raw_noise_sigma_g = 20e-6, raw_record_s = 1.0;
+};
+
+// The default design (docs/data-format.md): 7 frequencies 10 Hz - 1.5 kHz x 1, 2, 4 g x
+// IA, PA, OA, IA+PA x two static orientations with opposite a_IA (+-0.71 g, OA up: the
+// terms odd in a_IA change sign, the even ones do not); 3 x 12 static positions, twice each.
+CampaignDesign default_design();
+
+// Out-of-library effects the virtual lab can hide (diagnose must call them unexplained).
+bool is_out_of_library(const std::string& name);
+
+Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
+                           const CampaignDesign& design, std::uint64_t seed, int threads = 1);
+
+}  // namespace vrelab::validation

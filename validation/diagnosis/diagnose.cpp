@@ -1,0 +1,1088 @@
+#include "validation/diagnosis/diagnose.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <numbers>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <tuple>
+#include <memory>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Dense>
+
+#include "plant/effects/effects.hpp"
+#include "rectification/prediction/frequency.hpp"
+#include "rectification/simulation/shake.hpp"
+#include "vibration/excitation.hpp"
+#include "validation/reproduce/reproduce.hpp"
+
+namespace vrelab::validation {
+namespace {
+
+using plant::Coefficients;
+using plant::PlantConfig;
+
+std::vector<double> geometric(double from, double to, int n) {
+  std::vector<double> v;
+  for (int k = 0; k < n; ++k) v.push_back(from * std::pow(to / from, k / (n - 1.0)));
+  return v;
+}
+
+// A sine whose axes move in phase or in antiphase as one signed amplitude vector (g), and
+// back (the shaker effects that redistribute the table's motion over the axes).
+Vec3 signed_in_phase(const vibration::SineVibration& v) {
+  Vec3 a;
+  for (int i = 0; i < 3; ++i) a[i] = v.amplitude_g[i] * std::cos(v.phase_rad[i]);
+  return a;
+}
+void set_in_phase(vibration::SineVibration& v, const Vec3& a) {
+  for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(a[i]), v.phase_rad[i] = a[i] < 0 ? M_PI : 0.0;
+}
+
+// 0 and +-from .. +-to in n geometric steps, sorted: the grid of a signed parameter.
+std::vector<double> symmetric_geometric(double from, double to, int n) {
+  std::vector<double> v = {0};
+  for (double x : geometric(from, to, n)) v.push_back(x), v.push_back(-x);
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+std::vector<EffectModel> make_library() {
+  std::vector<EffectModel> lib;
+  {
+    EffectModel e;
+    e.name = "pickoff_nonlinearity";
+    e.parameter = "p2", e.unit = "1/rad";
+    e.physics = "the pickoff reads theta + p2 theta^2: under vibration <theta> = -p2 <theta^2>, an output shift "
+                "growing with the pendulum's angle amplitude (quadratic in amplitude, rising towards the pendulum's "
+                "and the loop's resonances)";
+    e.linear = true, e.unit_value = 10;
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
+      if (p != 0) c.effects.push_back(std::make_shared<plant::PickoffNonlinearity>(p));
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "pendulum_geometry";
+    e.parameter = "fraction", e.unit = "1";  // a hypothesis: 1 = present; the fit says how much of it the data show
+    e.lower = -0.5, e.upper = 1.5;
+    e.physics = "vibropendulous coupling: the input axis turns with the pendulum, so vibration along IA and PA in "
+                "phase rectifies as -<a_PA theta>; with a static a_IA also -a_IA <theta^2> / 4, which alone looks like "
+                "the pickoff nonlinearity";
+    e.linear = true, e.unit_value = 1;
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
+      if (p != 0) c.effects.push_back(std::make_shared<plant::PendulumGeometry>());
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "quadratic_cross_axis";
+    e.parameter = "k_PP", e.unit = "1/g";
+    e.physics = "k_PP a_PA^2 (and the common part of k_PP, k_OO, k2 with k0): invisible to any static test in 1 g, "
+                "so held at 0 by the identification; rectifies k_PP |w|^2 / 2 whatever the direction (its k2 part "
+                "through the loop, like k2; flat in frequency along PA and OA)";
+    e.linear = true, e.unit_value = 1e-6;
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
+      // The static test identified (k0 + p, k2 - p, 0, k_OO - p): give the part back.
+      c.coefficients[plant::k0] -= p;
+      for (int i : {plant::k2, plant::k_PP, plant::k_OO}) c.coefficients[i] += p;
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "nonlinearity_at_input";
+    e.parameter = "fraction", e.unit = "1";
+    e.lower = -0.5, e.upper = 1.5;  // a hypothesis: 0 (in the loop) or 1 (at the input)
+    e.physics = "the input-axis nonlinearity (k1', k2, k3, k4) acts on the mechanical input, not in the torquer: it "
+                "sees the vibration itself, not the rebalance current, so it stays flat with frequency where the "
+                "loop-placed one peaks near the crossover and falls above it";
+    e.linear = true, e.unit_value = 1;
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
+      if (p >= 0.5)
+        for (int i : {plant::k1_asym, plant::k2, plant::k3, plant::k4}) c.location[i] = plant::Location::input;
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "servo_dynamics";
+    e.changes_dynamics = true;
+    e.parameter = "bandwidth_ratio", e.unit = "1";
+    e.physics = "the servo loop's crossover differs from nominal: the rebalance current's resonance, and with it "
+                "the loop-placed terms' rectification, moves in frequency; no effect at low frequency";
+    e.nominal = 1;
+    e.grid = geometric(0.5, 2.0, 41);
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
+      c.dynamics.loop_bandwidth_Hz *= p;
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "servo_phase_margin";
+    e.changes_dynamics = true;
+    e.parameter = "phase_margin_change_deg", e.unit = "deg";
+    e.physics = "the servo's phase margin differs from nominal (lead network, torquer or pickoff phase): the "
+                "closed loop's peaking at the crossover, and with it the rectification of the loop-placed terms "
+                "there, grows as the margin falls; no effect at low frequency or far above the crossover";
+    e.nominal = 0;
+    for (int k = -8; k <= 8; ++k) e.grid.push_back(4.0 * k);  // -32 .. +32 deg (the plant takes 10 .. 85)
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
+      c.dynamics.phase_margin_deg = std::clamp(c.dynamics.phase_margin_deg + p, 10.0, 85.0);
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "mechanical_mode";
+    e.changes_dynamics = true;
+    e.parameter = "frequency_Hz", e.unit = "Hz";
+    e.physics = "a second mechanical mode (flexure or mount, along IA, damping 0.05) amplifies the IA vibration "
+                "that reaches the pendulum near its frequency: a resonance in the gap over frequency, along IA";
+    e.nominal = 0;  // 0: no mode
+    e.grid = geometric(100, 5000, 41);
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
+      if (p > 0) c.effects.push_back(std::make_shared<plant::MechanicalMode>(p, 0.05, Vec3(1, 0, 0)));
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "shaker_transverse_motion";
+    e.parameter = "ratio_at_1kHz", e.unit = "1";
+    e.physics = "the shaker moves transversely, in phase, by ratio x (f / 1 kHz) of the commanded amplitude, on the "
+                "next sensor axis (IA -> PA -> OA -> IA): the cross terms and the other axis's quadratic terms "
+                "rectify, growing with frequency";
+    e.linear = false;
+    e.grid = {-0.2, -0.15, -0.1, -0.07, -0.05, -0.03, -0.02, -0.01, -0.005, 0, 0.005, 0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2};
+    e.apply = [](double p, PlantConfig&, TableMotion& m) {
+      if (p == 0) return;
+      const double r = p * m.sine.frequency_Hz / 1000;
+      const Vec3 a = signed_in_phase(m.sine);
+      set_in_phase(m.sine, a + r * Vec3(a[2], a[0], a[1]));
+    };
+    lib.push_back(e);
+  }
+  for (int n : {5, 6}) {
+    EffectModel e;
+    e.name = "higher_order_k" + std::to_string(n);
+    e.parameter = "k" + std::to_string(n), e.unit = "1/g^" + std::to_string(n - 1);
+    e.physics = n == 5 ? "an input-axis term k5 a^5 beyond the identified k4: in 1 g the static test folds it into K1 "
+                         "and k3 (and leaves its cos 5 phi part as misfit); under vibration it rectifies "
+                         "5 a0^3 |I|^2 + (15/8) a0 |I|^4 beyond what k3 predicts, as amplitude^4 at a static a_IA"
+                       : "an input-axis term k6 a^6 beyond the identified k4: folded into k0, k2, k4 by the static "
+                         "test; under vibration it rectifies (5/16) |I|^6 + ..., as amplitude^6, along IA";
+    e.linear = true, e.unit_value = n == 5 ? 1e-8 : 1e-9;
+    e.acts_at_rest = true;
+    e.apply = [n, name = e.name](double p, PlantConfig& c, TableMotion&) {
+      std::array<double, 7> poly{};
+      poly[static_cast<std::size_t>(n)] = p;
+      if (p != 0) c.effects.push_back(std::make_shared<plant::OutputPolynomial>(name, poly));
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "readout_nonlinearity";
+    e.parameter = "q2", e.unit = "1/g";
+    e.physics = "the data acquisition that records the shaker runs reads u + q2 u^2 (integral nonlinearity of its "
+                "ADC or amplifier, in g of input); the static test, read with another instrument, does not see "
+                "it. It rectifies q2 |U|^2 / 2: the shape of a loop-placed k2 error, along IA only";
+    e.linear = true, e.unit_value = 1e-6;
+    e.shaker_runs_only = true;
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
+      if (p != 0) c.effects.push_back(std::make_shared<plant::OutputPolynomial>("readout_nonlinearity", std::array<double, 7>{0, 0, p, 0, 0, 0, 0}));
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "mounting_misalignment";
+    e.parameter = "angle_about_OA_rad", e.unit = "rad";
+    e.physics = "the shaker fixture holds the sensor turned by the angle about OA from where the static test "
+                "held it: the table's IA motion puts angle x w on PA and its PA motion -angle x w on IA, so the "
+                "cross term k_IP rectifies angle k_IP (w_IA^2 - w_PA^2) / 2 and k2 sees angle^2 w_PA^2; flat in "
+                "frequency where the terms are at the input, opposite in sign along IA and PA, nothing along OA";
+    e.nominal = 0;
+    e.grid = symmetric_geometric(0.002, 0.2, 12);
+    e.apply = [](double p, PlantConfig&, TableMotion& m) {
+      if (p == 0) return;
+      const Vec3 a = signed_in_phase(m.sine);  // turned about OA by p
+      set_in_phase(m.sine, Vec3(std::cos(p) * a[0] - std::sin(p) * a[1], std::sin(p) * a[0] + std::cos(p) * a[1], a[2]));
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "squeeze_film_damping";
+    e.changes_dynamics = true;
+    e.parameter = "inverse_gap_angle", e.unit = "1/rad";
+    e.physics = "the gas film's damping rises as the pendulum nears the case, c0 / (1 - (theta / theta_gap)^2)^(3/2); "
+                "the parameter is 1 / theta_gap (0: no film nonlinearity). It does not rectify by itself (its torque "
+                "is c0 theta' times a function of theta, mean zero over a period) but the damping grows with the "
+                "angle amplitude, which changes the loop's response and so the loop-placed terms' rectification: "
+                "~ amplitude^4, near the pendulum's and the loop's resonances";
+    e.nominal = 0;
+    e.grid = {0};
+    for (double x : geometric(30, 3000, 16)) e.grid.push_back(x);
+    e.apply = [](double p, PlantConfig& c, TableMotion&) {
+      if (p <= 0) return;
+      const plant::Dynamics& d = c.dynamics;
+      const double c0 = 2 * d.pendulum_damping_ratio * 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+      c.effects.push_back(std::make_shared<plant::SqueezeFilmDamping>(1 / p, c0, d.angle_gain_rad_per_s2_per_g));
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "shaker_harmonic_distortion";
+    e.parameter = "second_harmonic_ratio", e.unit = "1";
+    e.physics = "the table's motion carries a 2nd harmonic, ratio h of the fundamental on every axis, as "
+                "w (sin t + h sin 2t): the quadratic terms see (1 + h^2) w^2 / 2, the cubic and quartic ones "
+                "cross products of the two tones, each tone through the loop at its own frequency; grows as "
+                "h^2 in the quadratic terms, along every direction the instrument is nonlinear in";
+    e.nominal = 0;
+    e.grid = {0};
+    for (double h : geometric(0.01, 0.5, 22)) e.grid.push_back(h);
+    e.apply = [](double p, PlantConfig&, TableMotion& m) {
+      if (p > 0) m.harmonics.push_back({2, p, 0.0});
+    };
+    lib.push_back(e);
+  }
+  {
+    EffectModel e;
+    e.name = "fixture_rocking";
+    e.parameter = "rocking_rad_per_g", e.unit = "rad/g";
+    e.physics = "the fixture rocks about OA in phase with the table, by the parameter per g of amplitude, the "
+                "sensor 30 mm from the axis along IA: a tangential acceleration along PA growing as f^2, "
+                "rectified with the IA motion through k_IP and by itself through k_PP, the centripetal "
+                "acceleration (-r <alpha'^2>, along -IA, as f^2 alpha^2) and gravity turning with the fixture";
+    e.nominal = 0;
+    e.grid = symmetric_geometric(0.03e-6, 5e-6, 12);
+    e.apply = [](double p, PlantConfig&, TableMotion& m) { m.rocking_rad_per_g = p; };
+    lib.push_back(e);
+  }
+  for (EffectModel& e : lib)
+    if (e.linear && !std::isfinite(e.lower)) {
+      const double span = 100 * std::abs(e.unit_value - e.nominal);
+      e.lower = e.nominal - span, e.upper = e.nominal + span;
+    }
+  return lib;
+}
+
+
+// The table's motion as the prediction takes it: a pure sine exactly, else one period of
+// the excitation resolved into harmonics.
+rectification::PeriodicInput periodic_input(const TableMotion& m, double frequency_Hz) {
+  return m.pure_sine() ? rectification::periodic_input(m.sine) : rectification::periodic_input(*m.excitation(), frequency_Hz);
+}
+
+Eigen::VectorXd sub(const Eigen::VectorXd& v, const std::vector<int>& idx) {
+  Eigen::VectorXd s(idx.size());
+  for (std::size_t i = 0; i < idx.size(); ++i) s(i) = v(idx[i]);
+  return s;
+}
+Eigen::MatrixXd rows(const Eigen::MatrixXd& m, const std::vector<int>& idx) {
+  Eigen::MatrixXd s(idx.size(), m.cols());
+  for (std::size_t i = 0; i < idx.size(); ++i) s.row(i) = m.row(idx[i]);
+  return s;
+}
+
+// The simulation of every run under one effect value: pred = f0 + G c (exact: the
+// prediction is linear in the coefficients), evaluated at the identified coefficients.
+struct Table {
+  Eigen::VectorXd pred;  // at the identified coefficients
+  Eigen::MatrixXd G;     // d pred / d coefficient
+};
+
+// The loop responses, per (dynamics-changing effect value, frequency).
+class ResponseCache {
+ public:
+  const rectification::LoopResponse& get(const PlantConfig& cfg, const std::string& key, double f) {
+    auto k = std::make_pair(key, f);
+    auto it = cache_.find(k);
+    if (it == cache_.end()) it = cache_.emplace(k, rectification::loop_response(cfg, f)).first;
+    return it->second;
+  }
+
+ private:
+  std::map<std::pair<std::string, double>, rectification::LoopResponse> cache_;
+};
+
+// What the static test took up of an effect that acts at rest, per unit of (p - nominal)
+// (taken_up_by_static_test): subtracted from the identified coefficients under the effect.
+using Absorbed = std::map<std::string, Coefficients>;
+
+Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const EffectModel* e, double p,
+               ResponseCache& cache, const Absorbed& absorbed) {
+  const int n = static_cast<int>(runs.size());
+  Table t{Eigen::VectorXd(n), Eigen::MatrixXd(n, plant::kNumCoefficients)};
+  for (int k = 0; k < n; ++k) {
+    const RunRecord& r = runs[static_cast<std::size_t>(k)];
+    PlantConfig cfg = nominal;
+    TableMotion m = table_motion(r);
+    if (e) e->apply(p, cfg, m);
+    cfg = rectification::amplitude_linearised(cfg, m.sine);
+    // The loop responses depend on the effect's value and, for an amplitude-dependent one,
+    // on the run: the key says both.
+    std::string key;
+    if (e && e->changes_dynamics) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "=%.17g|%.17g", p, cfg.dynamics.pendulum_damping_ratio);
+      key = e->name + buf;
+    }
+    const rectification::PeriodicInput input = periodic_input(m, r.frequency_Hz);
+    const rectification::ResponseAt h = [&](double f) { return cache.get(cfg, key, f); };
+    // Coefficients as identified, then the effect's own change of them (if any) on top.
+    const Coefficients shift = [&] {
+      Coefficients z = nominal.coefficients;
+      for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] = cfg.coefficients[i] - nominal.coefficients[i];
+      if (e && e->acts_at_rest) {
+        for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] -= (p - e->nominal) * absorbed.at(e->name)[i];
+      }
+      return z;
+    }();
+    const auto f = [&](const Coefficients& co) {
+      PlantConfig q = cfg;
+      for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
+      return rectification::periodic_rectification(q, r.orientation_g, input, h).total_g();
+    };
+    const CoefArray g = prediction_gradient(f, nominal.coefficients);
+    for (int i = 0; i < plant::kNumCoefficients; ++i) t.G(k, i) = g[i];
+    t.pred(k) = f(nominal.coefficients);
+  }
+  return t;
+}
+
+// -2 log(likelihood) of the runs `idx` (up to a constant), with the residual's covariance
+// V = diag(sigma_run^2 + (f_model pred)^2) + G Sigma G^T; and chi^2 = r^T V^-1 r.
+struct Likelihood {
+  double m2logl = 0, chi2 = 0;
+};
+struct Data {
+  Eigen::VectorXd measured, sigma2;  // sigma2: the run's variance plus the simulation's own, (f_model pred_nominal)^2
+  Eigen::MatrixXd Sigma;
+};
+
+// The model-accuracy part is fixed at the nominal prediction: were it taken at each effect's
+// prediction, an effect could lower chi^2 by inflating its predictions.
+Eigen::MatrixXd covariance(const Data& d, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
+  const Eigen::MatrixXd Gi = rows(G, idx);
+  Eigen::MatrixXd V = Gi * d.Sigma * Gi.transpose();
+  for (std::size_t i = 0; i < idx.size(); ++i) V(i, i) += d.sigma2(idx[i]);
+  return V;
+}
+
+Likelihood likelihood(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, G, idx));
+  const Eigen::VectorXd r = sub(d.measured, idx) - sub(pred, idx);
+  Likelihood l;
+  l.chi2 = r.dot(ldlt.solve(r));
+  l.m2logl = l.chi2 + ldlt.vectorD().array().abs().log().sum();
+  return l;
+}
+
+// The residual the static test's coefficient errors cannot take up: r - G dc*, with dc* the
+// coefficients' correction estimated from the runs `from` (and the static test's prior).
+Eigen::VectorXd adjusted_residual(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G,
+                                  const std::vector<int>& from, const std::vector<int>& at) {
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, G, from));
+  const Eigen::VectorXd rf = sub(d.measured, from) - sub(pred, from);
+  const Eigen::VectorXd dc = d.Sigma * rows(G, from).transpose() * ldlt.solve(rf);
+  return sub(d.measured, at) - sub(pred, at) - rows(G, at) * dc;
+}
+
+// One effect: its tables (linear effects: nominal and unit, interpolated), the fit of its
+// parameter on a set of runs, the model at any parameter value.
+class EffectFitter {
+ public:
+  EffectFitter(const EffectModel& e, const Table& nominal, const PlantConfig& plant, const std::vector<RunRecord>& runs,
+               ResponseCache& cache, const Absorbed& absorbed)
+      : e_(e), nominal_(nominal), plant_(plant), runs_(runs), cache_(cache), absorbed_(absorbed) {
+    if (e.linear) {
+      unit_ = tabulate(plant, runs, &e, e.unit_value, cache, absorbed);
+    } else {
+      // Values the plant cannot take (a servo the loop design refuses) leave the grid.
+      for (double p : e.grid) {
+        try {
+          grid_.push_back(p == e.nominal ? nominal : tabulate(plant, runs, &e, p, cache, absorbed));
+          values_.push_back(p);
+        } catch (const std::invalid_argument&) {
+        }
+      }
+    }
+  }
+  Table at(double p) const {
+    if (e_.linear) {
+      const double u = (p - e_.nominal) / (e_.unit_value - e_.nominal);
+      return {nominal_.pred + u * (unit_.pred - nominal_.pred), nominal_.G + u * (unit_.G - nominal_.G)};
+    }
+    // Nonlinear: the grid's tables, or the simulation at p itself (kept: the folds' fits
+    // and the final one revisit the same values).
+    const auto& g = values_;
+    const auto node = std::find(g.begin(), g.end(), p);
+    if (node != g.end()) return grid_[static_cast<std::size_t>(node - g.begin())];
+    auto it = extra_.find(p);
+    if (it == extra_.end()) it = extra_.emplace(p, tabulate(plant_, runs_, &e_, p, cache_, absorbed_)).first;
+    return it->second;
+  }
+  // d pred / d p at p: exact for linear effects, central over +-h for the others (a value the
+  // plant refuses: one-sided).
+  Eigen::VectorXd slope(double p, double h) const {
+    if (e_.linear) return (unit_.pred - nominal_.pred) / (e_.unit_value - e_.nominal);
+    const auto pred_at = [&](double x) -> std::optional<Eigen::VectorXd> {
+      try {
+        return at(x).pred;
+      } catch (const std::invalid_argument&) {
+        return std::nullopt;
+      }
+    };
+    const auto up = pred_at(p + h), down = pred_at(p - h);
+    if (up && down) return (*up - *down) / (2 * h);
+    const Eigen::VectorXd mid = at(p).pred;
+    if (up) return (*up - mid) / h;
+    if (down) return (mid - *down) / h;
+    return Eigen::VectorXd::Zero(mid.size());
+  }
+  // Maximum likelihood over the runs `idx`; sigma from the curvature of -2 log L.
+  std::pair<double, double> fit(const Data& d, const std::vector<int>& idx) const {
+    auto L = [&](double p) {  // a value the plant refuses (a servo the design cannot build) is no fit
+      try {
+        const Table t = at(p);
+        return likelihood(d, t.pred, t.G, idx).m2logl;
+      } catch (const std::invalid_argument&) {
+        return static_cast<double>(INFINITY);
+      }
+    };
+    std::vector<double> xs;
+    if (e_.linear) {
+      // A bracket from the fixed-covariance (nominal V) estimate, then a scan and a refinement.
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, nominal_.G, idx));
+      const double du = e_.unit_value - e_.nominal;
+      const Eigen::VectorXd s = sub(unit_.pred, idx) - sub(nominal_.pred, idx);
+      const Eigen::VectorXd r = sub(d.measured, idx) - sub(nominal_.pred, idx);
+      const double info = s.dot(ldlt.solve(s));
+      const double u0 = info > 0 ? s.dot(ldlt.solve(r)) / info : 0.0;
+      const double su = info > 0 ? 1 / std::sqrt(info) : 1.0;
+      const double half = 3 * std::abs(u0) + 20 * su;
+      double lo = e_.nominal + du * (u0 - half), hi = e_.nominal + du * (u0 + half);
+      if (lo > hi) std::swap(lo, hi);
+      lo = std::clamp(lo, e_.lower, e_.upper), hi = std::clamp(hi, e_.lower, e_.upper);
+      if (!(hi > lo)) lo = e_.lower, hi = e_.upper;  // the estimate lies outside the physical range
+      for (int k = 0; k <= 60; ++k) xs.push_back(lo + (hi - lo) * k / 60.0);
+    } else {
+      xs = values_;
+      if (xs.empty()) return {e_.nominal, INFINITY};
+    }
+    std::vector<double> ls;
+    for (double x : xs) ls.push_back(L(x));
+    // Refinement in [x_{b-1}, x_{b+1}] by successive parabolic interpolation (safeguarded by
+    // golden steps): where the prediction is near linear in p across a grid step, -2 ln L is
+    // near quadratic and a step or two lands on the minimum.
+    const auto refine = [&](std::size_t b) {
+      double best = xs[b], lbest = ls[b];
+      double lo = xs[b - 1], hi = xs[b + 1], flo = ls[b - 1], fhi = ls[b + 1];
+      const double tol = 1e-4 * (hi - lo);
+      for (int it = 0; it < 12; ++it) {
+        const double dl = best - lo, dh = best - hi;
+        const double den = dl * (lbest - fhi) - dh * (lbest - flo);
+        double x = den != 0 ? best - 0.5 * (dl * dl * (lbest - fhi) - dh * dh * (lbest - flo)) / den : NAN;
+        if (!(x > lo + tol && x < hi - tol)) x = best - lo > hi - best ? best - 0.382 * (best - lo) : best + 0.382 * (hi - best);
+        if (std::abs(x - best) < tol) break;
+        const double fx = L(x);
+        if (fx < lbest) {
+          if (x < best) hi = best, fhi = lbest;
+          else lo = best, flo = lbest;
+          best = x, lbest = fx;
+        } else {
+          if (x < best) lo = x, flo = fx;
+          else hi = x, fhi = fx;
+        }
+      }
+      return std::make_pair(best, lbest);
+    };
+    // The grid's interior local minima, best first: the three best are refined (a narrow valley
+    // between grid points, such as a resonance's, can refine below a broader one that looked
+    // better on the grid).
+    std::vector<std::size_t> minima;
+    for (std::size_t k = 1; k + 1 < xs.size(); ++k)
+      if (ls[k] <= ls[k - 1] && ls[k] <= ls[k + 1]) minima.push_back(k);
+    std::sort(minima.begin(), minima.end(), [&](std::size_t a, std::size_t b) { return ls[a] < ls[b]; });
+    const std::size_t g = static_cast<std::size_t>(std::min_element(ls.begin(), ls.end()) - ls.begin());
+    double best = xs[g], lbest = ls[g], sigma = INFINITY;
+    std::size_t at = g;
+    for (std::size_t m = 0; m < std::min<std::size_t>(3, minima.size()); ++m) {
+      const auto [x, l] = refine(minima[m]);
+      if (l < lbest || minima[m] == g) best = x, lbest = l, at = minima[m];
+    }
+    if (at > 0 && at + 1 < xs.size()) {  // the curvature at the minimum
+      const double h = 0.25 * (xs[at + 1] - xs[at - 1]);
+      const double curv = (L(best + h) - 2 * lbest + L(best - h)) / (h * h);  // d2(-2 log L)/dp2
+      if (curv > 0) sigma = std::sqrt(2 / curv);
+    }
+    return {best, sigma};
+  }
+
+ private:
+  const EffectModel& e_;
+  const Table& nominal_;
+  const PlantConfig& plant_;
+  const std::vector<RunRecord>& runs_;
+  ResponseCache& cache_;
+  const Absorbed& absorbed_;
+  Table unit_;
+  std::vector<Table> grid_;
+  std::vector<double> values_;  // the grid's values the plant can take
+  mutable std::map<double, Table> extra_;
+};
+
+std::string fmt_peak(const RunRecord& run, const std::string& dir, const std::string& orient, double z) {
+  std::ostringstream o;
+  o.precision(3);
+  o << run.id << " (" << run.frequency_Hz << " Hz, " << run.amplitude_g << " g along " << dir << ", static " << orient
+    << ", z = " << z << ")";
+  return o.str();
+}
+
+// chi^2 with n degrees of freedom as a normal deviate (Wilson-Hilferty).
+double chi2_as_sigma(double chi2, int n) {
+  const double v = 2.0 / (9.0 * n);
+  return (std::cbrt(chi2 / n) - (1 - v)) / std::sqrt(v);
+}
+
+}  // namespace
+
+TableMotion table_motion(const RunRecord& r) {
+  TableMotion m;
+  m.sine = r.vibration();
+  m.commanded_amplitude_g = r.amplitude_g;
+  m.static_gravity_g = r.orientation_g;
+  return m;
+}
+
+std::shared_ptr<const vibration::Excitation> TableMotion::excitation() const {
+  auto tone = std::make_shared<vibration::SineExcitation>(sine);
+  std::shared_ptr<const vibration::Excitation> motion = tone;
+  if (!harmonics.empty()) motion = std::make_shared<vibration::HarmonicDistortion>(tone, harmonics);
+  if (rocking_rad_per_g != 0) {
+    // Gravity and the table's motion turn with the fixture; the lever arm adds a tangential
+    // acceleration along PA (~ f^2) and a centripetal one along -IA (~ f^2 alpha^2).
+    vibration::RockingSpec rs;
+    rs.axis = Vec3::UnitZ();
+    rs.amplitude_rad = std::abs(rocking_rad_per_g) * commanded_amplitude_g;
+    rs.phase_rad = rocking_rad_per_g < 0 ? std::numbers::pi : 0.0;
+    rs.static_gravity_g = static_gravity_g;
+    rs.lever_arm_m = Vec3(kRockingLeverArm_m, 0, 0);
+    rs.g_m_per_s2 = 9.80665;
+    motion = std::make_shared<vibration::Rocking>(motion, tone, rs);
+  }
+  return motion;
+}
+
+vibration::SineVibration RunRecord::vibration() const {
+  vibration::SineVibration v;
+  for (int i = 0; i < 3; ++i) {
+    v.amplitude_g[i] = amplitude_g * std::abs(direction[i]);
+    v.phase_rad[i] = direction[i] < 0 ? std::numbers::pi : 0.0;
+  }
+  v.frequency_Hz = frequency_Hz;
+  return v;
+}
+
+const std::vector<EffectModel>& effect_library() {
+  static const std::vector<EffectModel> lib = make_library();
+  return lib;
+}
+
+const EffectModel* find_effect(const std::string& name) {
+  for (const auto& e : effect_library())
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
+Coefficients taken_up_by_static_test(const EffectModel& e, const PlantConfig& plant, const std::vector<Position>& positions,
+                                     const std::vector<double>& weights, const FixedSet& fixed) {
+  if (!e.linear) throw std::logic_error("diagnose: " + e.name + " acts at rest but is not linear");
+  PlantConfig with = plant;
+  TableMotion unused;
+  e.apply(e.unit_value, with, unused);
+  // Least squares is linear in the readings: the difference of the fits to the plant's
+  // settled readings with and without the effect.
+  std::vector<Reading> base, moved;
+  const double K1 = plant.coefficients[plant::K1];
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    base.push_back({static_cast<int>(i), K1 * plant::settled_output_g(plant, positions[i].nominal_g)});
+    moved.push_back({static_cast<int>(i), K1 * plant::settled_output_g(with, positions[i].nominal_g)});
+  }
+  const Coefficients b = least_squares(positions, base, weights, fixed).estimate.value;
+  const Coefficients m = least_squares(positions, moved, weights, fixed).estimate.value;
+  Coefficients diff;
+  for (int i = 0; i < plant::kNumCoefficients; ++i) diff[i] = (m[i] - b[i]) / (e.unit_value - e.nominal);
+  return diff;
+}
+
+double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const EffectModel* e, double p) {
+  PlantConfig cfg = nominal;
+  TableMotion m = table_motion(r);
+  if (e) e->apply(p, cfg, m);
+  cfg = rectification::amplitude_linearised(cfg, m.sine);
+  std::map<double, rectification::LoopResponse> responses;
+  const rectification::ResponseAt h = [&](double f) {
+    auto it = responses.find(f);
+    if (it == responses.end()) it = responses.emplace(f, rectification::loop_response(cfg, f)).first;
+    return it->second;
+  };
+  return rectification::periodic_rectification(cfg, r.orientation_g, periodic_input(m, r.frequency_Hz), h).total_g();
+}
+
+Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
+  if (c.statics.empty()) throw std::invalid_argument("diagnose: the campaign has no static readings");
+  if (c.runs.empty()) throw std::invalid_argument("diagnose: the campaign has no usable shaker runs");
+  Diagnosis d;
+  // 1. Identification from the static readings, weighted by their sigma.
+  std::vector<Position> positions;
+  std::vector<Reading> readings;
+  std::vector<double> weights;
+  ReadingBudget budget;
+  for (std::size_t i = 0; i < c.statics.size(); ++i) {
+    positions.push_back(vector_position(c.statics[i].orientation_g.normalized()));
+    readings.push_back({static_cast<int>(i), c.statics[i].output});
+    const double var = std::max(c.statics[i].sigma_output * c.statics[i].sigma_output, 1e-30);
+    weights.push_back(1 / var);
+    budget.variance.push_back(var);
+    budget.bias.push_back(0.0);
+  }
+  const LeastSquaresResult ls = least_squares(positions, readings, weights, c.fixed);
+  if (!ls.identifiability.full_rank()) {
+    std::string msg = "the static readings do not determine the free coefficients (rank " +
+                      std::to_string(ls.identifiability.rank) + " of " + std::to_string(ls.identifiability.parameters) + ")";
+    for (const auto& w : ls.identifiability.confounded) msg += "; " + w;
+    throw std::invalid_argument(msg + ": hold more coefficients in the manifest's [identification] fixed, or add positions");
+  }
+  d.identified = ls.estimate.value;
+  const Estimator est = [&](const std::vector<Reading>& r) { return least_squares(positions, r, weights, c.fixed).estimate; };
+  d.identified_uncertainty = propagate_first_order(est, readings, budget);
+
+  PlantConfig plant;
+  plant.coefficients = d.identified;
+  plant.dynamics = c.dynamics;
+  const int n = static_cast<int>(c.runs.size());
+  Data data;
+  data.measured.resize(n), data.sigma2.resize(n);
+  for (int k = 0; k < n; ++k) {
+    data.measured(k) = c.runs[static_cast<std::size_t>(k)].measured_g;
+    data.sigma2(k) = std::pow(c.runs[static_cast<std::size_t>(k)].sigma_g, 2);
+  }
+  data.Sigma.resize(plant::kNumCoefficients, plant::kNumCoefficients);
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    for (int j = 0; j < plant::kNumCoefficients; ++j) data.Sigma(i, j) = d.identified_uncertainty.covariance[i][j];
+
+  // What the static test takes up of each effect that acts at rest: the identification of the
+  // change the effect (at its unit value) makes to the readings, at the campaign's own
+  // positions and weights (least squares is linear in the readings: the difference of two fits).
+  Absorbed absorbed;
+  for (const EffectModel& e : effect_library())
+    if (e.acts_at_rest) absorbed[e.name] = taken_up_by_static_test(e, plant, positions, weights, c.fixed);
+
+  // 2. The nominal simulation: gap, significance, where.
+  ResponseCache cache;
+  const Table nominal = tabulate(plant, c.runs, nullptr, 0, cache, absorbed);
+  for (int k = 0; k < n; ++k) data.sigma2(k) += std::pow(s.model_accuracy * nominal.pred(k), 2);
+  std::vector<int> all(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) all[static_cast<std::size_t>(k)] = k;
+  const Eigen::MatrixXd V = covariance(data, nominal.G, all);
+  const Eigen::LDLT<Eigen::MatrixXd> Vl(V);
+  const Eigen::VectorXd r = data.measured - nominal.pred;
+  const Eigen::MatrixXd Vinv = Vl.solve(Eigen::MatrixXd::Identity(n, n));
+  d.chi2_nominal = r.dot(Vinv * r);
+  const double chi2_sigma = chi2_as_sigma(d.chi2_nominal, n);
+  d.runs.resize(static_cast<std::size_t>(n));
+  // Where: each run's gap that the static test's coefficient errors cannot take up (r - G dc*,
+  // dc* from all runs and the static prior), in units of the run's own sigma (measurement and
+  // simulation accuracy). The raw gap is dominated by the coefficient errors at several g
+  // and would point everywhere.
+  const Eigen::VectorXd adj = adjusted_residual(data, nominal.pred, nominal.G, all, all);
+  const auto vec_name = [](const Vec3& v) {
+    char b[64];
+    std::snprintf(b, sizeof b, "[%.2g, %.2g, %.2g]", v[0], v[1], v[2]);
+    return std::string(b);
+  };
+  std::set<std::string> dirs;
+  double f_lo = INFINITY, f_hi = 0, a_lo = INFINITY, a_hi = 0;
+  // ln |adj| against ln A within each (direction, frequency, orientation), and against ln f
+  // within each (direction, amplitude, orientation): one intercept per group.
+  std::map<std::string, std::vector<std::pair<double, double>>> over_amplitude, over_frequency;
+  std::map<std::string, std::pair<double, int>> z2_by_direction;
+  for (int k = 0; k < n; ++k) {
+    RunDiagnosis& rd = d.runs[static_cast<std::size_t>(k)];
+    const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
+    rd.predicted_g = nominal.pred(k);
+    rd.sigma_predicted_g = std::sqrt(std::max(0.0, (nominal.G.row(k) * data.Sigma * nominal.G.row(k).transpose())(0, 0)));
+    rd.gap_g = r(k);
+    rd.sigma_g = std::sqrt(V(k, k));
+    rd.adjusted_gap_g = adj(k);
+    rd.z = adj(k) / std::sqrt(data.sigma2(k));
+    const std::string dir = vec_name(run.direction), orient = vec_name(run.orientation_g);
+    z2_by_direction[dir].first += rd.z * rd.z, ++z2_by_direction[dir].second;
+    if (std::abs(rd.z) > d.max_abs_z) {
+      d.max_abs_z = std::abs(rd.z);
+      d.peak = fmt_peak(run, dir, orient, rd.z);
+    }
+    if (std::abs(rd.z) >= s.significance_sigma) {
+      ++d.significant_runs;
+      dirs.insert(dir);
+      f_lo = std::min(f_lo, run.frequency_Hz), f_hi = std::max(f_hi, run.frequency_Hz);
+      a_lo = std::min(a_lo, run.amplitude_g), a_hi = std::max(a_hi, run.amplitude_g);
+      const double y = std::log(std::abs(adj(k)));
+      over_amplitude[dir + orient + std::to_string(run.frequency_Hz)].emplace_back(std::log(run.amplitude_g), y);
+      over_frequency[dir + orient + std::to_string(run.amplitude_g)].emplace_back(std::log(run.frequency_Hz), y);
+    }
+  }
+  for (const auto& [dir, z2] : z2_by_direction) d.rms_z_by_direction.emplace_back(dir, std::sqrt(z2.first / z2.second));
+  // Odd or even in the static a_IA: runs alike but for the sign of a_IA, where either is
+  // significant; the share of the pairs' gap power in (z1 - z2) / 2.
+  {
+    double odd = 0, even = 0;
+    for (int k = 0; k < n; ++k)
+      for (int j = k + 1; j < n; ++j) {
+        const RunRecord &a = c.runs[static_cast<std::size_t>(k)], &b = c.runs[static_cast<std::size_t>(j)];
+        const Vec3 mirrored(-a.orientation_g[0], a.orientation_g[1], a.orientation_g[2]);
+        if (a.frequency_Hz != b.frequency_Hz || a.amplitude_g != b.amplitude_g || (a.direction - b.direction).norm() > 1e-6 ||
+            (mirrored - b.orientation_g).norm() > 1e-3 || std::abs(a.orientation_g[0]) < 0.1)
+          continue;
+        const double za = d.runs[static_cast<std::size_t>(k)].z, zb = d.runs[static_cast<std::size_t>(j)].z;
+        if (std::max(std::abs(za), std::abs(zb)) < s.significance_sigma) continue;
+        odd += std::pow((za - zb) / 2, 2), even += std::pow((za + zb) / 2, 2);
+      }
+    d.odd_in_a_IA_fraction = odd + even > 0 ? odd / (odd + even) : NAN;
+  }
+  d.gap_significant = d.significant_runs > 0 || chi2_sigma >= s.significance_sigma;
+  {
+    // The slope of ln |gap| within groups, pooled.
+    const auto pooled_slope = [](const std::map<std::string, std::vector<std::pair<double, double>>>& groups) {
+      double sxy = 0, sxx = 0;
+      for (const auto& [key, pts] : groups) {
+        if (pts.size() < 2) continue;
+        double mx = 0, my = 0;
+        for (auto [x, y] : pts) mx += x, my += y;
+        mx /= static_cast<double>(pts.size()), my /= static_cast<double>(pts.size());
+        for (auto [x, y] : pts) sxy += (x - mx) * (y - my), sxx += (x - mx) * (x - mx);
+      }
+      return sxx > 0 ? sxy / sxx : 0.0;
+    };
+    d.amplitude_power = pooled_slope(over_amplitude);
+    d.frequency_power = pooled_slope(over_frequency);
+    std::ostringstream w;
+    w.precision(3);
+    w << "chi^2 " << d.chi2_nominal << " for " << n << " runs (" << chi2_sigma << " sigma); ";
+    if (d.significant_runs > 0) {
+      w << d.significant_runs << " run(s) with a gap beyond " << s.significance_sigma
+        << " sigma that the coefficients cannot take up: " << f_lo << "-" << f_hi << " Hz, " << a_lo << "-" << a_hi
+        << " g, direction(s)";
+      for (const auto& x : dirs) w << " " << x;
+      w << "; largest at " << d.peak << "; |gap| ~ amplitude^" << d.amplitude_power << ", ~ frequency^"
+        << d.frequency_power << " (pooled within groups); rms z by direction:";
+      for (const auto& [dir, z] : d.rms_z_by_direction) w << " " << dir << " " << z;
+      if (std::isfinite(d.odd_in_a_IA_fraction))
+        w << "; share of the gap odd in the static a_IA: " << d.odd_in_a_IA_fraction;
+    } else {
+      w << "no single run beyond " << s.significance_sigma << " sigma";
+    }
+    d.where = w.str();
+  }
+
+  // 3. Each effect: fits on training runs and the evidence on the held-out ones. Folds: leave
+  // one amplitude out, so every frequency and direction stays in training (a resonance cannot
+  // be located from the other frequencies) and the held-out runs test the effect's scaling
+  // with amplitude, which tells most effects apart; with one amplitude, leave one frequency
+  // out; with neither, no cross-validation (said in d.folds).
+  std::set<double> amplitudes, frequencies;
+  for (const auto& run : c.runs) amplitudes.insert(run.amplitude_g), frequencies.insert(run.frequency_Hz);
+  const bool by_amplitude = amplitudes.size() >= 2, by_frequency = !by_amplitude && frequencies.size() >= 2;
+  d.folds = by_amplitude ? "leave one amplitude out" : by_frequency ? "leave one frequency out" : "none (in-sample: one amplitude, one frequency)";
+  const auto fold_key = [&](int k) {
+    const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
+    return by_amplitude ? run.amplitude_g : by_frequency ? run.frequency_Hz : 0.0;
+  };
+  std::map<double, std::vector<int>> folds;
+  for (int k = 0; k < n; ++k) folds[fold_key(k)].push_back(k);
+  const auto train_of = [&](double key) {
+    std::vector<int> train;
+    for (int k = 0; k < n; ++k)
+      if (fold_key(k) != key) train.push_back(k);
+    return train.empty() ? all : train;
+  };
+  struct Scored {
+    EffectFit fit;
+    Eigen::VectorXd heldout;  // held-out adjusted residual per run
+  };
+  std::vector<Scored> scored;
+  Eigen::VectorXd heldout_nominal = Eigen::VectorXd::Zero(n);
+  for (const auto& [key, test] : folds) {
+    const Eigen::VectorXd a = adjusted_residual(data, nominal.pred, nominal.G, train_of(key), test);
+    for (std::size_t i = 0; i < test.size(); ++i) heldout_nominal(test[i]) = a(static_cast<Eigen::Index>(i));
+  }
+  // -2 ln p(test | train) = -2 ln L(all) + 2 ln L(train): the held-out runs given what the
+  // training runs say about the coefficients (the same conditioning as the shrinkage's).
+  const auto conditional_on = [&](const Data& dd, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G,
+                                  const std::vector<int>& train) {
+    const Likelihood l_all = likelihood(dd, pred, G, all), l_train = likelihood(dd, pred, G, train);
+    return Likelihood{l_all.m2logl - l_train.m2logl, l_all.chi2 - l_train.chi2};
+  };
+  const auto conditional = [&](const Table& t, const std::vector<int>& train) {
+    return conditional_on(data, t.pred, t.G, train);
+  };
+  // Scores a candidate on each fold: -2 ln p(held-out | training) and the held-out chi^2,
+  // with the coefficients and the candidate's parameters uncertain: the parameters, fitted on
+  // the training runs, enter like the coefficients, with their slopes S = d pred / d p as
+  // columns of G and their fitted variances beside Sigma. So an effect whose parameter the
+  // training runs pin only loosely (k6 from 1 and 2 g, extrapolated to 4 g) is judged with
+  // that looseness. (The training runs then count twice for the parameters, which makes the
+  // judgement a little strict.) fit_on(runs) fits the candidate on `runs`.
+  struct Fitted {
+    Table t;
+    Eigen::MatrixXd slopes;    // n x k; k = 0 when a parameter ended on a bound
+    Eigen::VectorXd variance;  // k
+  };
+  const auto score = [&](const std::function<Fitted(const std::vector<int>&)>& fit_on, Scored& sc) {
+    sc.heldout = Eigen::VectorXd::Zero(n);
+    for (const auto& [key, test] : folds) {
+      const std::vector<int> train = train_of(key);
+      const Fitted f = fit_on(train);
+      Likelihood with;
+      if (train.size() == all.size()) {
+        with = likelihood(data, f.t.pred, f.t.G, all);
+      } else {
+        const Eigen::Index k = f.variance.size(), m = plant::kNumCoefficients;
+        Data da = data;
+        da.Sigma = Eigen::MatrixXd::Zero(m + k, m + k);
+        da.Sigma.topLeftCorner(m, m) = data.Sigma;
+        for (Eigen::Index j = 0; j < k; ++j) da.Sigma(m + j, m + j) = f.variance(j);
+        Eigen::MatrixXd Ga(n, m + k);
+        Ga << f.t.G, f.slopes;
+        with = conditional_on(da, f.t.pred, Ga, train);
+      }
+      const Likelihood without =
+          train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all) : conditional(nominal, train);
+      sc.fit.evidence += without.m2logl - with.m2logl;
+      sc.fit.heldout_chi2 += with.chi2;
+      const Eigen::VectorXd a = adjusted_residual(data, f.t.pred, f.t.G, train, test);
+      for (std::size_t i = 0; i < test.size(); ++i) sc.heldout(test[i]) = a(static_cast<Eigen::Index>(i));
+    }
+  };
+  // A fitted effect with its slope (none at a bound).
+  const auto fitted_at = [&](const EffectFitter& fitter, double p, double sp) {
+    Fitted f{fitter.at(p), Eigen::MatrixXd(n, 0), Eigen::VectorXd(0)};
+    if (std::isfinite(sp) && sp > 0) {
+      f.slopes = fitter.slope(p, sp);
+      f.variance = Eigen::VectorXd::Constant(1, sp * sp);
+    }
+    return f;
+  };
+  const auto fitted_one = [&](const EffectFitter& fitter, const Data& dd, const std::vector<int>& runs) {
+    const auto [p, sp] = fitter.fit(dd, runs);
+    return fitted_at(fitter, p, sp);
+  };
+  std::map<std::string, std::unique_ptr<EffectFitter>> fitters;
+  for (const EffectModel& e : effect_library()) {
+    const EffectFitter& fitter = *(fitters[e.name] = std::make_unique<EffectFitter>(e, nominal, plant, c.runs, cache, absorbed));
+    Scored sc;
+    sc.fit.name = e.name, sc.fit.parameter = e.parameter, sc.fit.unit = e.unit;
+    score([&](const std::vector<int>& runs) { return fitted_one(fitter, data, runs); }, sc);
+    const auto [p, sp] = fitter.fit(data, all);
+    sc.fit.value = p, sc.fit.sigma = sp;
+    sc.fit.at_bound = !std::isfinite(sp);
+    scored.push_back(std::move(sc));
+  }
+  std::sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
+  for (const auto& sc : scored) d.effects.push_back(sc.fit);
+
+  // 4. The verdict and the held-out shrinkage of the chosen effect(s).
+  // (Requiring the held-out gap rms to shrink as well was tried and dropped: it turned a
+  // squeeze film called higher_order_k6, whose point prediction made the gap 7x larger, into
+  // "unexplained", but it also failed a right harmonic distortion (h = 0.1265 +- 0.0057 for
+  // 0.1227, held-out chi^2 346 -> 156 for 168 runs) whose adjusted residuals, which leave out
+  // the runs' correlations, grew from 1.4 to 2.2 ug.)
+  const auto explains = [&](const Scored& sc, double rms_after) {
+    return sc.fit.evidence > s.significance_sigma * s.significance_sigma &&
+           (chi2_as_sigma(sc.fit.heldout_chi2, n) < s.significance_sigma ||
+            rms_after <= (1 - s.explained_shrinkage) * d.rms_before_g);
+  };
+  const auto rms = [&](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / n); };
+  const Scored* best = &scored.front();
+  // The targeted test: one effect's held-out evidence (the chi^2 it removes on runs it was
+  // not fitted to) beyond significance^2 is a gap, also where the omnibus chi^2 and the runs'
+  // z miss it because most of its shape trades with the coefficients' errors (a squeeze film,
+  // ~ amplitude^4 like k4). 30 clean campaigns (blind's random truths, seeds 5000-5029) gave
+  // at most 7.
+  if (!d.gap_significant && best->fit.evidence > s.significance_sigma * s.significance_sigma) {
+    d.gap_significant = true;
+    std::ostringstream w;
+    w.precision(3);
+    w << "; " << best->fit.name << " lowers -2 ln L of the held-out runs by " << best->fit.evidence << " (beyond "
+      << s.significance_sigma * s.significance_sigma << ")";
+    d.where += w.str();
+  }
+  double ss_b = 0, zs_b = 0;
+  for (int k = 0; k < n; ++k) {
+    ss_b += heldout_nominal(k) * heldout_nominal(k), zs_b += heldout_nominal(k) * heldout_nominal(k) / data.sigma2(k);
+    d.runs[static_cast<std::size_t>(k)].heldout_before_g = heldout_nominal(k);
+  }
+  d.rms_before_g = std::sqrt(ss_b / n), d.rms_before_sigma = std::sqrt(zs_b / n);
+  std::vector<std::pair<const EffectModel*, double>> chosen = {{find_effect(best->fit.name), best->fit.value}};
+  // Two effects at once, when no one effect explains a significant gap: the best effect A with
+  // a second B, additive to first order (T = T_A(pA) + T_B(pB) - T_0). The candidates for B
+  // are ranked by how much they lower -2 ln L of what A leaves, on the training runs of each
+  // fold (so the held-out runs do not choose them); the best and the next are fitted together
+  // with A by alternating one-parameter fits, each on the data less the other's part, and
+  // scored on the held-out runs like a single effect. A pair is chosen only when its evidence
+  // beats A's by significance_sigma^2 and it explains the gap.
+  Scored pair_best;
+  if (d.gap_significant && !explains(*best, rms(best->heldout)) && s.try_pairs) {
+    // (The two parameters' variances: each conditional on the other, their correlation left out.)
+    const auto fit_pair = [&](const EffectFitter& A, const EffectFitter& B, double pB, const std::vector<int>& idx) {
+      double pA = A.fit(data, idx).first;  // (pB: B's nominal, the start)
+      Fitted fa, fb;
+      for (int round = 0; round < 3; ++round) {
+        Data db = data;
+        db.measured -= A.at(pA).pred - nominal.pred;
+        const auto [pb, sb] = B.fit(db, idx);
+        pB = pb;
+        Data da = data;
+        da.measured -= B.at(pB).pred - nominal.pred;
+        const auto [pa, sa] = A.fit(da, idx);
+        pA = pa;
+        if (round == 2) fa = fitted_at(A, pA, sa), fb = fitted_at(B, pB, sb);
+      }
+      Fitted f{{fa.t.pred + fb.t.pred - nominal.pred, fa.t.G + fb.t.G - nominal.G}, Eigen::MatrixXd(n, fa.slopes.cols() + fb.slopes.cols()),
+               Eigen::VectorXd(fa.variance.size() + fb.variance.size())};
+      f.slopes << fa.slopes, fb.slopes;
+      f.variance << fa.variance, fb.variance;
+      return std::make_tuple(pA, pB, f);
+    };
+    const EffectModel& ea = *find_effect(best->fit.name);
+    const EffectFitter& A = *fitters.at(ea.name);
+    // The seconds ranked on the runs `idx` alone (each fold's training runs when scored): each
+    // other effect fitted to what A (fitted on idx) leaves, by the drop of -2 ln L.
+    std::map<std::vector<int>, std::vector<const EffectModel*>> ranked;
+    const auto seconds = [&](const std::vector<int>& idx) -> const std::vector<const EffectModel*>& {
+      auto it = ranked.find(idx);
+      if (it != ranked.end()) return it->second;
+      Data rest = data;
+      rest.measured -= A.at(A.fit(data, idx).first).pred - nominal.pred;
+      const double l_rest = likelihood(rest, nominal.pred, nominal.G, idx).m2logl;
+      std::vector<std::pair<double, const EffectModel*>> drop;
+      for (const EffectModel& eb : effect_library()) {
+        if (eb.name == ea.name) continue;
+        const EffectFitter& B = *fitters.at(eb.name);
+        const Table tb = B.at(B.fit(rest, idx).first);
+        drop.emplace_back(l_rest - likelihood(rest, tb.pred, tb.G, idx).m2logl, &eb);
+      }
+      std::stable_sort(drop.begin(), drop.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
+      std::vector<const EffectModel*> v;
+      for (const auto& x : drop) v.push_back(x.second);
+      return ranked.emplace(idx, v).first->second;
+    };
+    PairFit chosen_pair;
+    for (std::size_t j = 0; j < std::min<std::size_t>(2, effect_library().size() - 1); ++j) {
+      // Candidate j: A with the j-th best second, that second chosen on each fold's training runs.
+      Scored sc;
+      score([&](const std::vector<int>& train) {
+        const EffectModel& eb = *seconds(train)[j];
+        return std::get<2>(fit_pair(A, *fitters.at(eb.name), eb.nominal, train));
+      }, sc);
+      const EffectModel& eb = *seconds(all)[j];
+      sc.fit.name = ea.name + " + " + eb.name;
+      const auto [pa, pb, t] = fit_pair(A, *fitters.at(eb.name), eb.nominal, all);
+      const PairFit pf{ea.name, eb.name, pa, pb, sc.fit.evidence, sc.fit.heldout_chi2};
+      d.pairs.push_back(pf);
+      if (pair_best.fit.name.empty() || sc.fit.evidence > pair_best.fit.evidence) pair_best = sc, chosen_pair = pf;
+    }
+    std::stable_sort(d.pairs.begin(), d.pairs.end(), [](const PairFit& a, const PairFit& b) { return a.evidence > b.evidence; });
+    // A pair is the more flexible model: it must also remove at least half of the held-out gap
+    // rms (a pair whose parameters the training runs leave loose can pass chi^2 without
+    // predicting anything).
+    if (!pair_best.fit.name.empty() &&
+        pair_best.fit.evidence > best->fit.evidence + s.significance_sigma * s.significance_sigma &&
+        explains(pair_best, rms(pair_best.heldout)) && rms(pair_best.heldout) <= 0.5 * d.rms_before_g) {
+      best = &pair_best;
+      chosen = {{find_effect(chosen_pair.a), chosen_pair.pa}, {find_effect(chosen_pair.b), chosen_pair.pb}};
+    }
+  }
+  double ss_a = 0, zs_a = 0;
+  for (int k = 0; k < n; ++k) {
+    ss_a += best->heldout(k) * best->heldout(k), zs_a += best->heldout(k) * best->heldout(k) / data.sigma2(k);
+    d.runs[static_cast<std::size_t>(k)].heldout_after_g = best->heldout(k);
+  }
+  d.rms_after_g = std::sqrt(ss_a / n), d.rms_after_sigma = std::sqrt(zs_a / n);
+  d.chosen = best->fit.name;
+  if (!d.gap_significant) {
+    d.verdict = "no significant gap";
+  } else if (explains(*best, d.rms_after_g)) {
+    d.explained = true;
+    d.verdict = "explained by " + best->fit.name;
+  } else {
+    d.verdict = "not explained by any known effect";
+  }
+
+  // 5. Confirmation on the ODE plant: the runs with the largest gaps re-simulated with the
+  // coefficients corrected by all runs (under the chosen effect) and the effect added, and
+  // without it.
+  if (s.resimulate_runs > 0 && d.explained) {
+    // The chosen effect(s) applied to a plant and a table motion; less what the static test
+    // took up of those that act at rest.
+    const auto apply_chosen = [&](PlantConfig& cfg, TableMotion& v, bool give_back) {
+      for (const auto& [e, p] : chosen) {
+        e->apply(p, cfg, v);
+        if (give_back && e->acts_at_rest)
+          for (int i = 0; i < plant::kNumCoefficients; ++i)
+            cfg.coefficients[i] -= (p - e->nominal) * absorbed.at(e->name)[i];
+      }
+    };
+    Table t = tabulate(plant, c.runs, chosen[0].first, chosen[0].second, cache, absorbed);
+    for (std::size_t q = 1; q < chosen.size(); ++q) {
+      const Table u = tabulate(plant, c.runs, chosen[q].first, chosen[q].second, cache, absorbed);
+      t.pred += u.pred - nominal.pred, t.G += u.G - nominal.G;
+    }
+    const Eigen::LDLT<Eigen::MatrixXd> vl(covariance(data, t.G, all));
+    const Eigen::VectorXd dc = data.Sigma * t.G.transpose() * vl.solve(data.measured - t.pred);
+    PlantConfig corrected = plant;
+    for (int i = 0; i < plant::kNumCoefficients; ++i) corrected.coefficients[i] += dc(i);
+    std::vector<int> order = all;
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(r(a)) > std::abs(r(b)); });
+    order.resize(std::min<std::size_t>(order.size(), static_cast<std::size_t>(s.resimulate_runs)));
+    double sb = 0, sa = 0;
+    int done = 0;
+    for (int k : order) {
+      const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
+      const vibration::SineVibration commanded = run.vibration();
+      PlantConfig with = corrected;
+      TableMotion table = table_motion(run);
+      apply_chosen(with, table, true);
+      try {
+        const double ode_with = rectification::shake_sine(with, run.orientation_g, commanded, {}, {}, table.excitation().get()).measured_g;
+        const double ode_without = rectification::shake_sine(corrected, run.orientation_g, commanded).measured_g;
+        sb += std::pow(run.measured_g - ode_without, 2), sa += std::pow(run.measured_g - ode_with, 2);
+        ++done;
+      } catch (const std::exception& x) {  // a solver failure: said, and the other runs still count
+        d.resimulation_failures.push_back(run.id + ": " + x.what());
+      }
+    }
+    d.resimulated_runs = done;
+    if (done > 0) {
+      d.resimulated_rms_before_g = std::sqrt(sb / done);
+      d.resimulated_rms_after_g = std::sqrt(sa / done);
+    }
+  }
+  return d;
+}
+
+}  // namespace vrelab::validation

@@ -1,0 +1,198 @@
+#pragma once
+// validation/diagnosis/diagnose.hpp -- the sim-to-real gap: where it lies, which effect causes it, how
+// far it shrinks (issue 5; docs/diagnose.md).
+//
+// Takes: a campaign (a lab's static readings and shaker-run summaries, in memory; the lab
+//        data format of docs/data-format.md is read by the app) and the nominal dynamics.
+// Gives: the identified coefficients; per run the prediction of the nominal simulation (the
+//        frequency-dependent eq. (3) of the plant built from the identified coefficients and
+//        the nominal dynamics), the gap and its significance; each candidate effect of the
+//        library fitted and scored on held-out runs (leave one frequency out); the verdict
+//        (no significant gap / explained by <effect> / not explained by any known effect);
+//        the held-out gap rms before and after the chosen effect.
+//
+// The statistics: the predictions share the static test's coefficient errors, so the gap
+// vector r has covariance V = diag(sigma_run^2 + (f_model pred)^2) + G Sigma G^T (G: the
+// prediction's gradient in the coefficients, Sigma their covariance from the static test,
+// f_model the simulation's own relative accuracy). Fits and chi^2 use V.
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "plant/accelerometer.hpp"
+#include "validation/identification/dividing_head.hpp"
+#include "validation/identification/identification.hpp"
+#include "validation/identification/uncertainty.hpp"
+#include "vibration/decorators.hpp"
+#include "vibration/profile.hpp"
+
+namespace vrelab::validation {
+
+// One static reading: the orientation (gravity in sensor axes, g), the mean output (output
+// units) and its standard uncertainty.
+struct StaticRecord {
+  Vec3 orientation_g = Vec3::Zero();
+  double output = 0, sigma_output = 0;
+  std::string where;  // file:line, for messages
+};
+
+// One shaker run, summarised: a sine of amplitude_g peak along `direction` (unit, sensor
+// axes, in phase) at frequency_Hz, the sensor statically at orientation_g; the measured
+// vibration error (g) and its standard uncertainty.
+struct RunRecord {
+  std::string id;
+  double frequency_Hz = 0, amplitude_g = 0;
+  Vec3 direction = Vec3::UnitX(), orientation_g = Vec3::UnitX();
+  double measured_g = 0, sigma_g = 0;
+  std::string where;
+  vibration::SineVibration vibration() const;
+};
+
+// A run's raw record (the virtual lab's, when asked for): time (s) and output (output units),
+// the rest at t < 0 then the vibration, with the windows a lab would measure over.
+struct RawRecord {
+  std::vector<double> t_s, output;
+  double rest_from_s = 0, rest_to_s = 0, on_from_s = 0, on_to_s = 0;
+};
+
+struct Campaign {
+  std::string name;
+  std::vector<RawRecord> raw;  // one per run when the runs were recorded raw; else empty
+  plant::Dynamics dynamics;  // nominal
+  FixedSet fixed{};          // coefficients the identification holds
+  std::vector<StaticRecord> statics;
+  std::vector<RunRecord> runs;
+  std::vector<std::string> skipped;  // runs the reader could not use, each with why
+};
+
+// The table's motion in one run as the simulation models it, in sensor axes: the sine the
+// shaker makes (the commanded one, with any transverse part), its harmonic distortion, and the
+// fixture's rocking. The effects that live in the shaker set these.
+struct TableMotion {
+  vibration::SineVibration sine;
+  std::vector<vibration::Harmonic> harmonics;  // vibration/decorators.hpp's HarmonicDistortion
+  // Rocking of the fixture about OA, rad per g of commanded amplitude, in phase with the
+  // table (negative: in antiphase); the sensor 30 mm from the axis along IA.
+  double rocking_rad_per_g = 0;
+  double commanded_amplitude_g = 0;
+  Vec3 static_gravity_g = Vec3::Zero();  // what the rocking turns
+  static constexpr double kRockingLeverArm_m = 0.03;
+  bool pure_sine() const { return harmonics.empty() && rocking_rad_per_g == 0; }
+  // The acceleration the plant's case feels (the decorators of vibration/decorators.hpp).
+  std::shared_ptr<const vibration::Excitation> excitation() const;
+};
+TableMotion table_motion(const RunRecord& r);  // the commanded sine, no imperfection
+
+// A candidate effect: a physical parameter that changes the nominal simulation (the plant
+// or the shaker's motion). `nominal` is the value without the effect.
+struct EffectModel {
+  std::string name, parameter, unit, physics;
+  double nominal = 0;
+  bool linear = false;          // the prediction is linear in the parameter
+  bool changes_dynamics = false;  // the loop's linear response depends on the parameter
+  std::vector<double> grid;     // values tried (nonlinear effects)
+  double unit_value = 1;        // the parameter value used for the signature (linear effects)
+  // The physical range of the fit: hypotheses [-0.5, 1.5]; other linear effects
+  // nominal +- 100 |unit_value - nominal| (set by effect_library()).
+  double lower = -INFINITY, upper = INFINITY;
+  // Acts at rest too (linear effects only): the static test took up part of it into the
+  // identified coefficients; diagnose gives that part back (docs/diagnose.md).
+  bool acts_at_rest = false;
+  // Lives in the shaker runs' data acquisition only: a lab reads its static test apart.
+  bool shaker_runs_only = false;
+  // Applies parameter p to the nominal plant and to the table's motion.
+  std::function<void(double p, plant::PlantConfig&, TableMotion&)> apply;
+};
+const std::vector<EffectModel>& effect_library();
+const EffectModel* find_effect(const std::string& name);
+
+// What a static test at `positions` (weights, held coefficients) takes up into the identified
+// coefficients of an effect that acts at rest, per unit of its parameter (linear effects).
+plant::Coefficients taken_up_by_static_test(const EffectModel& e, const plant::PlantConfig& plant,
+                                     const std::vector<Position>& positions, const std::vector<double>& weights,
+                                     const FixedSet& fixed);
+
+// The simulation's prediction of one run: eq. (3) through the plant's dynamics, with an
+// effect (name, parameter) applied when given. g.
+double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, const EffectModel* e = nullptr, double p = 0);
+
+struct DiagnoseSettings {
+  double model_accuracy = 0.002;      // relative accuracy of the simulation (f_model)
+  // A run's gap is significant beyond this many sigma; the campaign's gap is when a run's is,
+  // when chi^2 as a normal deviate is, or when one effect's held-out evidence exceeds its square.
+  double significance_sigma = 5.0;
+  // A gap is explained by the best effect when its evidence exceeds significance_sigma^2 and
+  // either its held-out chi^2, as a normal deviate, stays below significance_sigma (the test
+  // that found the gap no longer finds one on the held-out runs) or it removes at least
+  // explained_shrinkage of the held-out gap rms (a large effect leaves the first-order
+  // simulation's own error, which chi^2 alone would call unexplained).
+  double explained_shrinkage = 0.9;
+  int resimulate_runs = 12;             // runs (largest gaps first) re-simulated on the ODE; 0: none
+  bool try_pairs = true;                // two effects at once when no one effect explains the gap
+};
+
+struct EffectFit {
+  std::string name, parameter, unit;
+  double value = 0, sigma = 0;   // fitted on all runs
+  double evidence = 0;           // held-out chi^2 reduction, summed over folds
+  double heldout_chi2 = 0;       // held-out chi^2 with the effect (given the training runs), summed over folds
+  bool at_bound = false;         // the fit ended on the edge of its range (no curvature: no sigma)
+};
+
+// Two effects fitted together (additive to first order), when no one effect explains the gap.
+struct PairFit {
+  std::string a, b;
+  double pa = 0, pb = 0;         // their parameters, fitted on all runs
+  double evidence = 0, heldout_chi2 = 0;
+};
+
+struct RunDiagnosis {
+  double predicted_g = 0, sigma_predicted_g = 0;  // nominal simulation
+  double gap_g = 0, sigma_g = 0;                  // measured - predicted; sigma from V's diagonal
+  double adjusted_gap_g = 0;  // the gap the static test's coefficient errors cannot take up (all runs)
+  double z = 0;               // adjusted_gap_g over the run's own sigma (measurement, simulation accuracy)
+  double heldout_before_g = 0;                    // the gap the coefficient errors cannot take up (nominal), held out
+  double heldout_after_g = 0;                     // the same with the chosen effect, fitted without this run's fold
+};
+
+struct Diagnosis {
+  plant::Coefficients identified;
+  Propagation identified_uncertainty;
+  std::vector<RunDiagnosis> runs;
+  double chi2_nominal = 0;
+  int significant_runs = 0;
+  bool gap_significant = false;
+  double max_abs_z = 0;
+  // Where: the significant runs' span, and the gap's scaling with amplitude (power p of
+  // |gap| ~ A^p, least squares on the significant runs; 0 when fewer than 3).
+  // Also: the run with the largest |z| (peak), the power q of |gap| ~ f^q pooled within
+  // (direction, amplitude, orientation) groups, the rms z per direction, and the share of the
+  // gap odd in the static a_IA (runs alike but for its sign, where either is significant;
+  // NaN without such pairs).
+  std::string where, peak;
+  double amplitude_power = 0, frequency_power = 0;
+  std::vector<std::pair<std::string, double>> rms_z_by_direction;
+  double odd_in_a_IA_fraction = NAN;
+  std::vector<EffectFit> effects;  // best first (evidence)
+  std::vector<PairFit> pairs;      // tried when no one effect explains a significant gap; best first
+  std::string chosen;              // the best effect, or "A + B" when a pair explains the gap
+  std::string folds;               // the cross-validation used
+  bool explained = false;
+  std::string verdict;             // "no significant gap", "explained by <name>" (or "<A> + <B>"), "not explained by any known effect"
+  double rms_before_g = 0, rms_after_g = 0;          // held-out, over all runs
+  double rms_before_sigma = 0, rms_after_sigma = 0;  // the same in units of each run's sigma
+  // The confirmation on the ODE plant (the runs with the largest gaps; coefficients corrected
+  // by all runs under the chosen effect): rms of measured - ODE without and with the effect.
+  // Only when the gap is explained; runs whose simulation failed are listed (id: why) and left out.
+  int resimulated_runs = 0;
+  double resimulated_rms_before_g = 0, resimulated_rms_after_g = 0;
+  std::vector<std::string> resimulation_failures;
+};
+
+Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {});
+
+}  // namespace vrelab::validation

@@ -1,0 +1,92 @@
+#pragma once
+// validation/identification/dividing_head.hpp -- the virtual static test on a dividing head.
+//
+// Takes: the true model (1) coefficients, a set of test positions, the error sources of
+//        the test (each switchable), and a seeded random generator.
+// Gives: the nominal orientation of each position (gravity in sensor axes, g), the
+//        simulated readings U (output units), and the first-order sensitivity of every
+//        reading to the error sources (the paper's Delta U expression).
+//
+// Position convention (paper-notes.md; docs/dividing-head.md has the table): in series s
+// the two sensor axes that lie in the vertical plane take (-cos phi, -sin phi) g:
+//   series 1 (rotation about OA): (a_IA, a_PA) = (-cos phi, -sin phi), a_OA = 0
+//   series 2 (rotation about PA): (a_IA, a_OA) = (-cos phi, -sin phi), a_PA = 0
+//   series 3 (rotation about IA): (a_PA, a_OA) = (-cos phi, -sin phi), a_IA = 0
+// The paper's test is 8 positions per series, phi = (j - 1) * 45 deg, j = 1..8.
+//
+// Error sources:
+//  - initial orientation error: a fixed small rotation alpha (rad, about [IA, PA, OA]) of
+//    the sensor frame relative to the head, the same in every position:
+//    a_sensor = R(alpha)^T a_head;
+//  - set-angle error: each visit of a position sets phi + N(0, sigma); for a position given
+//    as an explicit vector, a rotation with N(0, sigma) about each sensor axis;
+//  - reading noise: each reading (one visit's mean output) gets N(0, (K1 sigma_g)^2);
+//  - repeats: each position is visited `repeats` times, each visit with fresh errors.
+#include <cstdint>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include "plant/model1.hpp"
+
+namespace vrelab::validation {
+
+struct Position {
+  int series = 0;          // 1, 2, 3; 0 for an explicit orientation vector
+  double angle_rad = 0.0;  // set angle phi (series positions)
+  Vec3 nominal_g = Vec3::Zero();
+};
+
+// Gravity in sensor axes for series s at angle phi, g (convention above).
+Vec3 series_orientation(int series, double angle_rad);
+// N equally spaced positions per series, phi = (j - 1) 360/N deg, for the given series.
+std::vector<Position> equally_spaced_positions(int per_series, const std::vector<int>& series = {1, 2, 3});
+Position series_position(int series, double angle_rad);
+Position vector_position(const Vec3& a_g);  // unit vector expected
+// True when `p` is the paper's 3 x 8 set in the paper's order.
+bool is_paper_set(const std::vector<Position>& p);
+
+struct StaticTestErrors {
+  Vec3 initial_error_rad = Vec3::Zero();
+  double angle_sigma_rad = 0.0;
+  double noise_sigma_g = 0.0;  // per reading, input-equivalent
+  int repeats = 1;
+};
+
+struct Reading {
+  int position = 0;     // index into the position set
+  double output = 0.0;  // U, output units
+};
+
+// The orientation actually realised: nominal position, systematic rotation, angle error
+// (for series positions the angle error `d_angle[0]` is about the head axis; for vector
+// positions `d_angle` is a small rotation about the sensor axes).
+Vec3 realised_orientation(const Position& p, const Vec3& initial_error_rad, const Vec3& d_angle_rad);
+
+// What the instrument reads (output units, noise-free) in a realised orientation (g).
+using OutputSource = std::function<double(const Vec3& a_g)>;
+// Model (1) with the given coefficients as the source.
+OutputSource model1_source(const plant::Coefficients& truth);
+
+// One complete test: positions.size() * repeats readings, position-major. K1 scales the
+// reading noise (given in g).
+std::vector<Reading> simulate_static_test(const OutputSource& source, double K1,
+                                          const std::vector<Position>& positions,
+                                          const StaticTestErrors& errors, std::mt19937_64& rng);
+inline std::vector<Reading> simulate_static_test(const plant::Coefficients& truth,
+                                                 const std::vector<Position>& positions,
+                                                 const StaticTestErrors& errors, std::mt19937_64& rng) {
+  return simulate_static_test(model1_source(truth), truth[plant::K1], positions, errors, rng);
+}
+
+// First-order error budget of each reading of `readings`, for coefficients `c` (in a lab,
+// the estimated ones): the variance from noise and set-angle errors (output units^2) and
+// the bias from the initial orientation error (output units).
+struct ReadingBudget {
+  std::vector<double> variance;
+  std::vector<double> bias;
+};
+ReadingBudget reading_budget(const plant::Coefficients& c, const std::vector<Position>& positions,
+                             const std::vector<Reading>& readings, const StaticTestErrors& errors);
+
+}  // namespace vrelab::validation

@@ -1,0 +1,47 @@
+#pragma once
+// validation/identification/uncertainty.hpp -- how the test's errors reach the identified coefficients.
+//
+// Takes: an estimator (readings -> coefficients), the readings of one test, and the
+//        first-order error budget of each reading (dividing_head.hpp: reading_budget).
+// Gives: first-order propagation: sigma_k = sqrt(sum_i J_ki^2 var_i) and the bias
+//        sum_i J_ki bias_i, with J = d(estimate)/d(reading) by central differences;
+//        Monte Carlo: the mean error and the scatter of each coefficient over N simulated
+//        tests (fresh set-angle errors and noise, the same initial orientation error).
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "plant/model1.hpp"
+#include "validation/identification/dividing_head.hpp"
+#include "validation/identification/identification.hpp"
+
+namespace vrelab::validation {
+
+using CoefArray = std::array<double, plant::kNumCoefficients>;
+using Estimator = std::function<Estimate(const std::vector<Reading>&)>;
+
+struct Propagation {
+  CoefArray sigma{};  // standard uncertainty, coefficient units
+  CoefArray bias{};   // first-order effect of the initial orientation error
+  // Covariance of the estimates (coefficient units squared), from the same Jacobian: what a
+  // prediction that combines several coefficients (eq. (3)) needs.
+  std::array<CoefArray, plant::kNumCoefficients> covariance{};
+};
+
+Propagation propagate_first_order(const Estimator& estimator, const std::vector<Reading>& readings,
+                                  const ReadingBudget& budget);
+
+struct MonteCarloStats {
+  int n = 0;
+  CoefArray mean_error{};  // mean of (estimate - truth)
+  CoefArray std{};         // sample standard deviation of the estimate
+};
+
+// Runs `n` simulated tests from `seed`; one MonteCarloStats per estimator.
+std::vector<MonteCarloStats> monte_carlo(const std::vector<Estimator>& estimators,
+                                         const plant::Coefficients& truth, const OutputSource& source,
+                                         const std::vector<Position>& positions,
+                                         const StaticTestErrors& errors, int n, std::uint64_t seed);
+
+}  // namespace vrelab::validation

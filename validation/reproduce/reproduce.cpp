@@ -1,0 +1,291 @@
+#include "validation/reproduce/reproduce.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <stdexcept>
+#include <thread>
+
+#include <Eigen/Dense>
+
+#include "rectification/prediction/eq3.hpp"
+#include "rectification/prediction/frequency.hpp"
+#include "rectification/simulation/sweep.hpp"
+
+namespace vrelab::validation {
+namespace {
+
+using plant::Coefficients;
+constexpr int kRectifying[] = {plant::k1_asym, plant::k2,   plant::k3,   plant::k4,  plant::k_IP,
+                               plant::k_IO,    plant::k_PO, plant::k_PP, plant::k_OO};
+
+vibration::SineVibration sine_of(const Vec3& direction, double amplitude_g, double frequency_Hz) {
+  rectification::SweepCondition c;
+  c.direction = direction, c.amplitude_g = amplitude_g, c.frequency_Hz = frequency_Hz;
+  return c.vibration();
+}
+
+using Model = std::function<double(const Coefficients&)>;
+
+}  // namespace
+
+void predict_run(RunResult& r, const plant::PlantConfig& nominal,
+                 const std::array<CoefArray, plant::kNumCoefficients>& cov) {
+  const Coefficients& c = nominal.coefficients;
+  const vibration::SineVibration v = sine_of(r.direction_unit, r.amplitude_g, r.frequency_Hz);
+  const Vec3 a = r.orientation_g;
+  const Model quasi_static = [&](const Coefficients& k) { return rectification::sine_rectification(k, a, v).total_g(); };
+  const Model at_frequency = [&](const Coefficients& k) {
+    plant::PlantConfig p = nominal;
+    p.coefficients = k;
+    return rectification::sine_rectification_at_frequency(p, a, v).terms.total_g();
+  };
+  r.predicted = predict_with_uncertainty(quasi_static, c, cov);
+  r.printed_g = rectification::sine_rectification_as_printed(c, a, v);
+  r.at_frequency = predict_with_uncertainty(at_frequency, c, cov);
+}
+
+Prediction predicted_change(const RunResult& r, const RunResult& ref, const plant::PlantConfig& nominal,
+                            const std::array<CoefArray, plant::kNumCoefficients>& cov) {
+  const auto at = [&](const RunResult& x, const Coefficients& k) {
+    plant::PlantConfig p = nominal;
+    p.coefficients = k;
+    return rectification::sine_rectification_at_frequency(p, x.orientation_g,
+                                                          sine_of(x.direction_unit, x.amplitude_g, x.frequency_Hz))
+        .terms.total_g();
+  };
+  return predict_with_uncertainty([&](const Coefficients& k) { return at(r, k) - at(ref, k); }, nominal.coefficients, cov);
+}
+
+namespace {
+
+// Runs the grid on the plant and returns one RunResult per condition (grid order), with
+// the measurement filled in. A failed condition throws (the reproduction needs them all).
+std::vector<RunResult> shake_grid(const plant::PlantConfig& plant, const rectification::ShakeSettings& shake,
+                                  const rectification::SweepGrid& grid, const std::vector<NamedVector>& directions,
+                                  const std::vector<NamedVector>& orientations, int threads) {
+  std::vector<RunResult> runs(grid.size());
+  std::vector<std::string> failures;
+  rectification::run_sweep(plant, plant.coefficients, shake, grid, {}, threads, [&](const rectification::SweepRow& row) {
+    const rectification::SweepCondition& c = row.condition;
+    if (!row.ok) {
+      failures.push_back(row.error);
+      return;
+    }
+    RunResult& r = runs[c.index];
+    const std::size_t per_direction = grid.frequencies_Hz.size() * grid.amplitudes_g.size();
+    const std::size_t d = (c.index / per_direction) % grid.directions.size();
+    const std::size_t o = c.index / (per_direction * grid.directions.size());
+    r.direction = directions[d].name, r.orientation = orientations[o].name;
+    r.direction_unit = c.direction, r.orientation_g = c.orientation_g;
+    r.frequency_Hz = c.frequency_Hz, r.amplitude_g = c.amplitude_g;
+    r.measured_g = row.measured_g, r.sigma_measured_g = row.sigma_g;
+    r.true_eq3_g = row.predicted_eq3_g;
+    r.true_at_frequency_g =
+        rectification::sine_rectification_at_frequency(plant, c.orientation_g, c.vibration()).total_g();
+  });
+  if (!failures.empty()) throw std::runtime_error("reproduce: a shaker run failed: " + failures.front());
+  return runs;
+}
+
+rectification::SweepGrid grid_of(const std::vector<double>& frequencies_Hz, const std::vector<double>& amplitudes_g,
+                                  const std::vector<NamedVector>& directions,
+                                  const std::vector<NamedVector>& orientations) {
+  rectification::SweepGrid g;
+  g.frequencies_Hz = frequencies_Hz;
+  g.amplitudes_g = amplitudes_g;
+  for (const auto& d : directions) g.directions.push_back(d.v.normalized());
+  for (const auto& o : orientations) g.orientations_g.push_back(o.v);
+  return g;
+}
+
+}  // namespace
+
+double RunResult::combined_sigma_g() const {
+  return std::sqrt(sigma_measured_g * sigma_measured_g + predicted.sigma_g * predicted.sigma_g);
+}
+
+CoefArray prediction_gradient(const Model& f, const Coefficients& c) {
+  Coefficients zero = c;
+  for (int i : kRectifying) zero[i] = 0.0;
+  const double f0 = f(zero);
+  CoefArray g{};
+  // The predictions are linear in these coefficients; the step only has to stay small
+  // enough for the plant (a model (1) term of 1e-6 per g^n is a small nonlinearity).
+  constexpr double h = 1e-6;
+  for (int i : kRectifying) {
+    Coefficients one = zero;
+    one[i] = h;
+    g[i] = (f(one) - f0) / h;
+  }
+  return g;
+}
+
+Prediction predict_with_uncertainty(const Model& f, const Coefficients& c,
+                                    const std::array<CoefArray, plant::kNumCoefficients>& covariance) {
+  const CoefArray g = prediction_gradient(f, c);
+  double var = 0;
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    for (int j = 0; j < plant::kNumCoefficients; ++j) var += g[i] * covariance[i][j] * g[j];
+  return {f(c), std::sqrt(std::max(var, 0.0))};
+}
+
+ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const ReproduceSettings& s,
+                          const std::function<void(const std::string&)>& log) {
+  auto say = [&](const std::string& m) {
+    if (log) log(m);
+  };
+  if (s.amplitudes_g.empty() || s.directions.empty() || s.orientations.empty())
+    throw std::invalid_argument("reproduce: the amplitude study needs amplitudes, directions and orientations");
+  const int threads = s.threads > 0 ? s.threads : std::max(1u, std::thread::hardware_concurrency());
+  ReproduceResult out;
+
+  // 1. The static test on the plant, settled in each position.
+  say("static test: the plant settled in each position of the dividing head");
+  StaticTestSettings st;
+  st.fixed = s.fixed;
+  st.seed = s.seed;
+  st.source = [&truth_plant](const Vec3& a) {
+    return truth_plant.coefficients[plant::K1] * plant::settled_output_g(truth_plant, a);
+  };
+  out.static_test = run_static_test(truth_plant.coefficients, s.positions, s.errors, st);
+  const MethodResult& ls = out.static_test.methods.back();  // least squares is always last
+  out.identified = ls.estimate.value;
+  out.identified_uncertainty = ls.first_order;
+  const auto& cov = ls.first_order.covariance;
+  // The simulation a lab would build: identified coefficients, nominal dynamics, no effects.
+  out.nominal = truth_plant;
+  out.nominal.coefficients = out.identified;
+  out.nominal.effects.clear();
+  const plant::PlantConfig& nominal = out.nominal;
+
+  // 2. The confirmation run: the sampled record kept for the figure.
+  say("confirmation run");
+  {
+    ConfirmationRecord& c = out.confirmation;
+    rectification::ShakeSettings cs = s.shake;
+    cs.min_measure_s = s.confirmation_record_s;
+    c.K1 = truth_plant.coefficients[plant::K1];
+    const vibration::SineVibration v =
+        sine_of(s.confirmation_direction.v.normalized(), s.confirmation_amplitude_g, s.frequency_Hz);
+    c.shake = rectification::shake_sine(truth_plant, s.confirmation_orientation.v, v, cs,
+                                        [&c](double t, const Vec3&, double u) {
+                                          c.t_s.push_back(t);
+                                          c.output.push_back(u);
+                                        });
+    double rest = 0;
+    long n_rest = 0;
+    for (std::size_t i = 0; i < c.t_s.size() && c.t_s[i] < 0; ++i, ++n_rest) rest += c.output[i] / c.K1;
+    c.rest_mean_g = n_rest > 0 ? rest / static_cast<double>(n_rest) : c.shake.baseline_g;
+    c.t_measure_start_s = c.shake.settle_s;
+    c.t_end_s = c.t_s.empty() ? 0.0 : c.t_s.back();
+    // The running integral (rectangle rule at the sampling step) and its fit.
+    const std::size_t n = c.t_s.size();
+    c.integral_g_s.assign(n, 0.0);
+    for (std::size_t i = 1; i < n; ++i)
+      c.integral_g_s[i] = c.integral_g_s[i - 1] + (c.output[i] / c.K1 - c.rest_mean_g) * (c.t_s[i] - c.t_s[i - 1]);
+    constexpr int kHarmonics = 3;
+    const double w = 2 * std::numbers::pi * s.frequency_Hz;
+    auto row = [&](double t) {
+      Eigen::RowVectorXd r(2 + 2 * kHarmonics);
+      r(0) = 1, r(1) = t;
+      for (int h = 1; h <= kHarmonics; ++h) r(2 * h) = std::cos(h * w * t), r(2 * h + 1) = std::sin(h * w * t);
+      return r;
+    };
+    std::vector<std::size_t> fit;
+    for (std::size_t i = 0; i < n; ++i)
+      if (c.t_s[i] >= c.t_measure_start_s) fit.push_back(i);
+    c.integral_without_oscillation_g_s = c.integral_g_s;
+    if (fit.size() > 4 * (2 + 2 * kHarmonics)) {
+      Eigen::MatrixXd A(static_cast<Eigen::Index>(fit.size()), 2 + 2 * kHarmonics);
+      Eigen::VectorXd y(A.rows());
+      for (Eigen::Index k = 0; k < A.rows(); ++k) {
+        A.row(k) = row(c.t_s[fit[static_cast<std::size_t>(k)]]);
+        y(k) = c.integral_g_s[fit[static_cast<std::size_t>(k)]];
+      }
+      const Eigen::VectorXd beta = A.colPivHouseholderQr().solve(y);
+      c.integral_slope_g = beta(1);
+      c.oscillation_amplitude_g_s = std::hypot(beta(2), beta(3));
+      // Taken off from t = 0 on, as p(t) - p(0): the swing starts with the vibration.
+      const auto p = [&](double t) { return row(t).segment(2, 2 * kHarmonics).dot(beta.segment(2, 2 * kHarmonics)); };
+      const double p0 = p(0.0);
+      for (std::size_t i = 0; i < n; ++i)
+        if (c.t_s[i] >= 0) c.integral_without_oscillation_g_s[i] -= p(c.t_s[i]) - p0;
+    }
+    RunResult r;
+    r.orientation_g = s.confirmation_orientation.v, r.direction_unit = s.confirmation_direction.v.normalized();
+    r.amplitude_g = s.confirmation_amplitude_g, r.frequency_Hz = s.frequency_Hz;
+    predict_run(r, nominal, cov);
+    c.predicted = r.predicted;
+  }
+
+  // 3. The amplitude study.
+  const rectification::SweepGrid grid = grid_of({s.frequency_Hz}, s.amplitudes_g, s.directions, s.orientations);
+  say("amplitude study: " + std::to_string(grid.size()) + " shaker runs");
+  // Each section draws its readout noise from its own seed range (run i of section k:
+  // seed + k * 1000003 + i), so no two runs share a noise record.
+  const auto section = [&s](int k) {
+    rectification::ShakeSettings x = s.shake;
+    x.readout.seed = s.shake.readout.seed + static_cast<std::uint64_t>(k) * 1000003u;
+    return x;
+  };
+  out.amplitude_runs = shake_grid(truth_plant, section(1), grid, s.directions, s.orientations, threads);
+  for (RunResult& r : out.amplitude_runs) predict_run(r, nominal, cov);
+
+  // 4. The departure in frequency.
+  if (!s.departure_frequencies_Hz.empty()) {
+    say("frequency departure: " + std::to_string(s.departure_frequencies_Hz.size()) + " shaker runs");
+    const rectification::SweepGrid fg = grid_of(s.departure_frequencies_Hz, {s.confirmation_amplitude_g},
+                                                {s.confirmation_direction}, {s.confirmation_orientation});
+    out.frequency_runs =
+        shake_grid(truth_plant, section(2), fg, {s.confirmation_direction}, {s.confirmation_orientation}, threads);
+    std::sort(out.frequency_runs.begin(), out.frequency_runs.end(),
+              [](const RunResult& a, const RunResult& b) { return a.frequency_Hz < b.frequency_Hz; });
+    for (RunResult& r : out.frequency_runs) predict_run(r, nominal, cov);
+  }
+
+  // 5. The instrument no static test can tell from the first.
+  if (s.invisible_shift_per_g != 0) {
+    InvisibleResult& inv = out.invisible;
+    inv.c_per_g = s.invisible_shift_per_g;
+    plant::PlantConfig other = truth_plant;
+    other.coefficients[plant::k0] += inv.c_per_g;
+    for (int i : {plant::k2, plant::k_PP, plant::k_OO}) other.coefficients[i] -= inv.c_per_g;
+    for (const Position& p : s.positions)
+      inv.max_static_difference_g =
+          std::max(inv.max_static_difference_g,
+                   std::abs(plant::settled_output_g(other, p.nominal_g) - plant::settled_output_g(truth_plant, p.nominal_g)));
+    const std::vector<NamedVector> axes = {{"IA", Vec3(1, 0, 0)}, {"PA", Vec3(0, 1, 0)}, {"OA", Vec3(0, 0, 1)}};
+    say("invisible shift: 3 x " + std::to_string(s.amplitudes_g.size()) + " shaker runs on the second instrument");
+    const rectification::SweepGrid ig = grid_of({s.frequency_Hz}, s.amplitudes_g, axes, {s.confirmation_orientation});
+    inv.runs = shake_grid(other, section(3), ig, axes, {s.confirmation_orientation}, threads);
+    // Generalised least squares for c in residual = -c |w|^2 / 2: the runs share the
+    // prediction's coefficient errors, so V = diag(sigma_m^2) + G Sigma G^T.
+    const int n = static_cast<int>(inv.runs.size());
+    Eigen::MatrixXd G(n, plant::kNumCoefficients), S(plant::kNumCoefficients, plant::kNumCoefficients);
+    Eigen::VectorXd x(n), res(n), sm2(n);
+    for (int i = 0; i < plant::kNumCoefficients; ++i)
+      for (int j = 0; j < plant::kNumCoefficients; ++j) S(i, j) = cov[i][j];
+    for (int k = 0; k < n; ++k) {
+      RunResult& r = inv.runs[static_cast<std::size_t>(k)];
+      predict_run(r, nominal, cov);
+      const vibration::SineVibration v = sine_of(r.direction_unit, r.amplitude_g, r.frequency_Hz);
+      const CoefArray g = prediction_gradient(
+          [&](const Coefficients& c) { return rectification::sine_rectification(c, r.orientation_g, v).total_g(); },
+          out.identified);
+      for (int i = 0; i < plant::kNumCoefficients; ++i) G(k, i) = g[i];
+      x(k) = -r.amplitude_g * r.amplitude_g / 2;
+      res(k) = r.residual_g();
+      sm2(k) = r.sigma_measured_g * r.sigma_measured_g;
+    }
+    const Eigen::MatrixXd V = Eigen::MatrixXd(sm2.asDiagonal()) + G * S * G.transpose();
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(V);
+    const double info = x.dot(ldlt.solve(x));
+    inv.c_fit_per_g = x.dot(ldlt.solve(res)) / info;
+    inv.c_fit_sigma_per_g = 1 / std::sqrt(info);
+  }
+  return out;
+}
+
+}  // namespace vrelab::validation

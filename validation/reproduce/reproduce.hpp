@@ -1,0 +1,144 @@
+#pragma once
+// validation/reproduce/reproduce.hpp -- the paper's experiment, end to end, on the virtual instrument.
+//
+// Takes: the ODE plant (the "true" instrument), the static test (positions, error sources,
+//        fixed coefficients), the shaker runs (one frequency; amplitudes x directions x
+//        static orientations), the confirmation run, the frequency departure grid, the
+//        invisible shift c, and the measurement settings (with the lab's readout).
+// Gives:
+//  1. the static test: readings from the plant settled in each position, the identified
+//     coefficients per method, with first-order uncertainty and covariance;
+//  2. the confirmation run: the sampled record (rest, then vibration), the measured error,
+//     the running integral's slope and eq. (3) from the identified coefficients;
+//  3. the amplitude study: per run, the measured error and eq. (3) (corrected, and as
+//     printed) from the least-squares coefficients, each with its standard uncertainty; the
+//     prediction's uncertainty is g^T Sigma g, g the gradient of eq. (3) in the coefficients
+//     (eq. (3) is linear in them) and Sigma their covariance from the static test;
+//  4. the departure in frequency: the confirmation condition measured over frequency
+//     (sorted), with the quasi-static and the frequency-dependent eq. (3) (plant built from
+//     the identified coefficients and the nominal dynamics);
+//  5. what no static test can see: a second instrument whose (k0, k2, k_PP, k_OO) differ by
+//     c (1, -1, -1, -1) reads the same in every static position; it is shaken along IA, PA
+//     and OA, and c is fitted back from the residuals, which should be -c |w|^2 / 2.
+// All errors in g; amplitudes in g peak; frequencies in Hz; times in s. With a readout, run i
+// of section k (1 amplitude, 2 frequency, 3 invisible) draws its noise from seed
+// readout.seed + k * 1000003 + i; the confirmation run from readout.seed.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "plant/accelerometer.hpp"
+#include "rectification/simulation/shake.hpp"
+#include "validation/identification/static_test.hpp"
+
+namespace vrelab::validation {
+
+struct NamedVector {
+  std::string name;  // e.g. "IA", "oblique", "IA up"
+  Vec3 v = Vec3::Zero();
+};
+
+struct ReproduceSettings {
+  // Static test (readings: the plant settled in each position).
+  std::vector<Position> positions;
+  StaticTestErrors errors;
+  FixedSet fixed{};
+  std::uint64_t seed = 1;
+  // Shaker runs: measurement (its readout seed is offset per run) and the grid.
+  rectification::ShakeSettings shake;
+  double frequency_Hz = 20.0;
+  std::vector<double> amplitudes_g;
+  std::vector<NamedVector> directions;    // unit vectors, sensor axes (in phase)
+  std::vector<NamedVector> orientations;  // gravity in sensor axes, g
+  // The confirmation run: orientation, direction, amplitude; measured over record_s seconds.
+  NamedVector confirmation_orientation, confirmation_direction;
+  double confirmation_amplitude_g = 3.0;
+  double confirmation_record_s = 2.0;
+  // The departure in frequency (the confirmation condition); empty: skipped.
+  std::vector<double> departure_frequencies_Hz;
+  // The invisible shift c (1/g); 0: skipped.
+  double invisible_shift_per_g = 0.0;
+  int threads = 0;  // 0: all cores
+};
+
+struct Prediction {
+  double value_g = 0, sigma_g = 0;
+};
+
+struct RunResult {
+  std::string orientation, direction;
+  Vec3 orientation_g = Vec3::Zero(), direction_unit = Vec3::Zero();
+  double frequency_Hz = 0, amplitude_g = 0;
+  double measured_g = 0, sigma_measured_g = 0;
+  Prediction predicted;   // corrected eq. (3), least-squares coefficients
+  double printed_g = 0;   // eq. (3) as printed, same coefficients
+  Prediction at_frequency;  // frequency-dependent eq. (3), same coefficients, nominal dynamics
+  double true_eq3_g = 0;  // corrected eq. (3) with the true coefficients (for the record)
+  double true_at_frequency_g = 0;  // frequency-dependent, the true plant (its effects included)
+  double residual_g() const { return measured_g - predicted.value_g; }
+  double combined_sigma_g() const;
+  double z() const { return residual_g() / combined_sigma_g(); }
+};
+
+// The confirmation run's record and the paper's integral. The running integral of
+// (output/K1 - mean at rest) swings by w_IA/omega at the vibration frequency; a straight
+// line fitted to it is biased by that swing (shake.integral_slope_g). The slope here is
+// fitted with the swing: a line plus the first three harmonics of the vibration frequency
+// over the measured interval; `integral_without_oscillation_g_s` is the integral with those
+// fitted harmonics taken off from t = 0 on (as p(t) - p(0), p the fitted periodic part).
+struct ConfirmationRecord {
+  std::vector<double> t_s, output;  // output in output units; rest at t < 0
+  std::vector<double> integral_g_s, integral_without_oscillation_g_s;  // g*s
+  double K1 = 1, rest_mean_g = 0;
+  double t_measure_start_s = 0, t_end_s = 0;
+  double integral_slope_g = 0;  // line + harmonics fit over the measured interval, g
+  double oscillation_amplitude_g_s = 0;  // of the fitted fundamental in the integral
+  rectification::ShakeResult shake;
+  Prediction predicted;
+};
+
+struct InvisibleResult {
+  double c_per_g = 0;
+  double max_static_difference_g = 0;  // between the two instruments' settled static outputs
+  std::vector<RunResult> runs;         // residual expected: -c |w|^2 / 2
+  double c_fit_per_g = 0, c_fit_sigma_per_g = 0;
+};
+
+struct ReproduceResult {
+  StaticTestReport static_test;
+  plant::Coefficients identified;  // least squares
+  plant::PlantConfig nominal;      // identified coefficients, nominal dynamics, no effects
+  Propagation identified_uncertainty;
+  ConfirmationRecord confirmation;
+  std::vector<RunResult> amplitude_runs;
+  std::vector<RunResult> frequency_runs;
+  InvisibleResult invisible;
+};
+
+// Progress messages (one line each) go to `log` when given.
+ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const ReproduceSettings& s,
+                          const std::function<void(const std::string&)>& log = {});
+
+// Fills the predictions of a run (orientation, direction, amplitude, frequency given) from
+// the coefficients of `nominal` and their covariance.
+void predict_run(RunResult& r, const plant::PlantConfig& nominal,
+                 const std::array<CoefArray, plant::kNumCoefficients>& covariance);
+
+// The change of the frequency-dependent eq. (3) from run `ref` to run `r` (same condition,
+// another frequency), with its standard uncertainty: the coefficient errors do not cancel in
+// it (terms scale differently with frequency), so it has its own sigma.
+Prediction predicted_change(const RunResult& r, const RunResult& ref, const plant::PlantConfig& nominal,
+                            const std::array<CoefArray, plant::kNumCoefficients>& covariance);
+
+// The gradient of a prediction that is linear in the rectifying coefficients (k1_asym, k2,
+// k3, k4, k_IP, k_IO, k_PO, k_PP, k_OO): g_i = f(c with only coefficient i = h) / h - f(0).
+// Other entries are 0.
+CoefArray prediction_gradient(const std::function<double(const plant::Coefficients&)>& f,
+                              const plant::Coefficients& c);
+// f(c) with the standard uncertainty sqrt(g^T Sigma g).
+Prediction predict_with_uncertainty(const std::function<double(const plant::Coefficients&)>& f,
+                                    const plant::Coefficients& c,
+                                    const std::array<CoefArray, plant::kNumCoefficients>& covariance);
+
+}  // namespace vrelab::validation
