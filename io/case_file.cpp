@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <numbers>
 #include <set>
+#include <span>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -473,8 +474,10 @@ bool boolean(Table& t, std::string_view key, bool fallback) {
   return n->as_boolean()->get();
 }
 
-// The effects beyond model (1): one entry per [plant.effects.<name>] table. Adding an
-// effect is a class in plant/effects/effects.hpp and an entry here.
+// The plant modules beyond model (1) a case can switch on: one entry per
+// [plant.effects.<name>] table, with its own keys (a plant module's construction parameters,
+// not the diagnosis' effect parameters of validation/diagnosis/effect.hpp, hence a reader of
+// its own). Adding a plant module a case can use is a class in plant/effects/ and an entry here.
 using EffectReader = std::function<std::shared_ptr<const plant::Effect>(Table&)>;
 const std::map<std::string, EffectReader>& effect_readers() {
   static const std::map<std::string, EffectReader> readers{
@@ -796,14 +799,16 @@ void read_campaign(Table t, Case& c) {
       Table et(*e, "campaign.hidden", "");
       validation::HiddenEffect h;
       h.name = et.string("name", "");
-      if (!validation::find_effect(h.name) && !validation::is_out_of_library(h.name)) {
+      if (!validation::find_effect(h.name)) {
         std::string names;
-        for (const auto& m : validation::effect_library()) names += " " + m.name;
-        t.fail(&x, "hidden", "unknown effect '" + h.name + "'; known:" + names + " readout_clipping shaker_third_harmonic");
+        for (const auto& m : validation::effect_registry()) names += " " + m.name;
+        t.fail(&x, "hidden", "unknown effect '" + h.name + "'; known:" + names);
       }
       const toml::node* p = e->get("parameter");
       if (!p || !p->is_number()) t.fail(&x, "hidden", "each hidden effect needs a numeric parameter");
       h.parameter = p->value<double>().value();
+      std::string why;  // the registry's check of the effect's values
+      if (!validation::find_effect(h.name)->is_valid(std::span<const double>(&h.parameter, 1), &why)) t.fail(&x, "hidden", why);
       s.hidden.push_back(h);
     }
   }

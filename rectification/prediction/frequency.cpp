@@ -25,9 +25,9 @@ LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
   LoopResponse out;
   const double w_rad = 2 * std::numbers::pi * frequency_Hz;
   for (const auto& e : config.effects)
-    if (const auto* mode = dynamic_cast<const MechanicalMode*>(e.get())) {
-      lin_cfg.effects.push_back(e);  // linear: keep
-      for (int j = 0; j < 3; ++j) out.mechanical[static_cast<std::size_t>(j)] *= mode->transmissibility(j, w_rad);
+    if (e->kept_in_linearisation()) {  // linear (a mechanical mode): keep
+      lin_cfg.effects.push_back(e);
+      for (int j = 0; j < 3; ++j) out.mechanical[static_cast<std::size_t>(j)] *= e->transmissibility(j, w_rad);
     }
   // Linear: the response does not depend on the static orientation (IA up is as good as any).
   const Accelerometer plant(lin_cfg, Vec3(1, 0, 0));
@@ -58,11 +58,11 @@ LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
 }
 
 PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::SineVibration& v) {
-  std::vector<const SqueezeFilmDamping*> films;
+  std::vector<const Effect*> films;  // amplitude-dependent damping (squeeze films)
   PlantConfig out = config;
   out.effects.clear();
   for (const auto& e : config.effects) {
-    if (const auto* f = dynamic_cast<const SqueezeFilmDamping*>(e.get())) films.push_back(f);
+    if (e->amplitude_dependent_damping()) films.push_back(e.get());
     else out.effects.push_back(e);
   }
   if (films.empty()) return config;
@@ -76,7 +76,7 @@ PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::Sin
   for (int i = 0; i < 3; ++i) w[i] = std::polar(v.amplitude_g[i], v.phase_rad[i]);
   const auto zeta_at = [&](double theta) {
     double extra = 0;
-    for (const auto* f : films) extra += f->c0_per_s(d0.angle_gain_rad_per_s2_per_g) * (f->damping_factor(theta) - 1);
+    for (const auto* f : films) extra += f->extra_damping_per_s(theta, d0.angle_gain_rad_per_s2_per_g);
     return zeta0 + extra / two_wp;
   };
   double zeta = zeta0;
@@ -109,8 +109,8 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
   double p2 = 0.0;
   bool geometry = false;
   for (const auto& e : config.effects) {
-    if (const auto* p = dynamic_cast<const PickoffNonlinearity*>(e.get())) p2 += p->p2_per_rad();
-    if (dynamic_cast<const PendulumGeometry*>(e.get())) geometry = true;
+    p2 += e->pickoff_p2_per_rad();
+    geometry = geometry || e->vibropendulous();
   }
   Eigen::Vector3cd W, F;  // the case's vibration, and what the pendulum's base feels
   vibration::SineVibration felt = v;
@@ -162,7 +162,7 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
   std::complex<double> U = current + slope[IA] * F[IA] + slope[PA] * F[PA] + slope[OA] * F[OA];
   const double u0 = plant::output_g(config.coefficients, a);
   for (const auto& e : config.effects) {
-    if (!dynamic_cast<const OutputPolynomial*>(e.get())) continue;
+    if (!e->readout_averaged_in_prediction()) continue;
     constexpr int kN = 32;
     double mean = 0;
     for (int k = 0; k < kN; ++k) mean += e->readout(u0 + std::real(U * std::polar(1.0, 2 * std::numbers::pi * k / kN)));
@@ -226,8 +226,8 @@ FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3
   double p2 = 0.0;
   bool geometry = false;
   for (const auto& e : config.effects) {
-    if (const auto* p = dynamic_cast<const PickoffNonlinearity*>(e.get())) p2 += p->p2_per_rad();
-    if (dynamic_cast<const PendulumGeometry*>(e.get())) geometry = true;
+    p2 += e->pickoff_p2_per_rad();
+    geometry = geometry || e->vibropendulous();
   }
   // Per harmonic: what the pendulum's base feels F, the rebalance current I, the angle Theta,
   // and the output's oscillation U (the current plus the output-placed cross terms' slope).
@@ -287,7 +287,7 @@ FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3
     const plant::Basis bl = plant::basis(loop);
     for (int c = 0; c < kNumCoefficients; ++c) at_input[c] += bf[c] / kM, in_loop[c] += bl[c] / kM;
     for (const auto& e : config.effects)
-      if (dynamic_cast<const OutputPolynomial*>(e.get())) readout_mean += (e->readout(u) - u) / kM;
+      if (e->readout_averaged_in_prediction()) readout_mean += (e->readout(u) - u) / kM;
   }
   for (int c = k1_asym; c < kNumCoefficients; ++c) {
     if (config.coefficients[c] == 0) continue;
@@ -300,7 +300,7 @@ FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3
   }
   out.input_mean_g += dc_gain * in.mean_g[IA];
   for (const auto& e : config.effects)
-    if (dynamic_cast<const OutputPolynomial*>(e.get())) readout_mean -= e->readout(u0) - u0;
+    if (e->readout_averaged_in_prediction()) readout_mean -= e->readout(u0) - u0;
   out.readout_g = readout_mean;
   // Effects beyond (1): quadratic in the angle, so harmonics add (their cross products
   // average out over a period).

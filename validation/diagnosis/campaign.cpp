@@ -6,10 +6,10 @@
 #include <memory>
 #include <numbers>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <thread>
 
-#include "plant/effects/effects.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/excitation.hpp"
@@ -30,45 +30,57 @@ CampaignDesign default_design() {
   return d;
 }
 
-bool is_out_of_library(const std::string& name) { return name == "readout_clipping" || name == "shaker_third_harmonic"; }
+bool is_out_of_library(const std::string& name) {
+  const Effect* e = find_effect(name);
+  return e && !e->in_library;
+}
+
+void validate(const HiddenEffect& h) {
+  const Effect* e = find_effect(h.name);
+  if (!e) throw std::invalid_argument("campaign: unknown hidden effect '" + h.name + "'");
+  std::string why;
+  if (!e->is_valid(std::span<const double>(&h.parameter, 1), &why)) throw std::invalid_argument("campaign: " + why);
+}
+
+HiddenEffect draw_hidden(const Effect& e, std::mt19937_64& rng) {
+  if (!e.draw) throw std::invalid_argument("blind: no parameter range for " + e.name);
+  return {e.name, e.draw(rng).front()};
+}
+
+namespace {
+
+// The virtual lab's truth for one run (zero amplitude: the static test), every hidden
+// effect's truth hook applied in turn.
+VirtualLab truth_lab(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden, const RunRecord* run) {
+  VirtualLab lab;
+  lab.instrument = truth;
+  if (run) {
+    lab.table = run->vibration();
+    lab.commanded_amplitude_g = run->amplitude_g;
+    lab.static_gravity_g = run->orientation_g;
+  }
+  for (const HiddenEffect& h : hidden) find_effect(h.name)->truth(std::span<const double>(&h.parameter, 1), lab);
+  return lab;
+}
+
+}  // namespace
 
 Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
                            const CampaignDesign& design, std::uint64_t seed, int threads) {
-  for (const auto& h : hidden) {
-    if (!find_effect(h.name) && !is_out_of_library(h.name))
-      throw std::invalid_argument("campaign: unknown hidden effect '" + h.name + "'");
-    // These two are hypotheses (present or not), not scalable: the truth takes 0 or 1.
-    if ((h.name == "pendulum_geometry" || h.name == "nonlinearity_at_input") && h.parameter != 0 && h.parameter != 1)
-      throw std::invalid_argument("campaign: " + h.name + " is present (1) or not (0), got " + std::to_string(h.parameter));
-    if ((h.name == "shaker_harmonic_distortion" || h.name == "shaker_third_harmonic") && !(h.parameter >= 0 && h.parameter < 1))
-      throw std::invalid_argument("campaign: " + h.name + " is a harmonic's ratio to the fundamental, in [0, 1), got " + std::to_string(h.parameter));
-    if (h.name == "readout_clipping" && !(h.parameter > 0))
-      throw std::invalid_argument("campaign: readout_clipping is the DAQ's full scale in g, > 0, got " + std::to_string(h.parameter));
-  }
+  for (const auto& h : hidden) validate(h);
   Campaign c;
   c.dynamics = truth.dynamics;
   c.fixed[plant::k_PP] = 0.0;  // the one coefficient a 1 g test cannot separate (its common part)
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n01;
 
-  // The truth plant with its hidden effects (those that live in the plant); the static test
-  // reads it without those that live in the shaker runs' data acquisition.
-  plant::PlantConfig plant = truth, static_plant = truth;
-  for (const auto& h : hidden) {
-    if (h.name == "shaker_third_harmonic") continue;  // the table's motion, below
-    if (h.name == "readout_clipping") {  // the shaker runs' DAQ; the static test is read apart
-      plant.effects.push_back(std::make_shared<plant::ReadoutClipping>(h.parameter));
-      continue;
-    }
-    const EffectModel& e = *find_effect(h.name);
-    TableMotion dummy;
-    e.apply(h.parameter, plant, dummy);
-    if (!e.shaker_runs_only) e.apply(h.parameter, static_plant, dummy);
-  }
+  // The truth instrument with its hidden effects, as the static test reads it (the shaker
+  // runs' data acquisition is not in it).
+  const plant::PlantConfig static_plant = truth_lab(truth, hidden, nullptr).instrument;
 
   // Static test: the plant settled in each position.
   const std::vector<Position> positions = equally_spaced_positions(design.positions_per_series);
-  const double K1 = plant.coefficients[plant::K1];
+  const double K1 = static_plant.coefficients[plant::K1];
   const OutputSource source = [&static_plant, K1](const Vec3& a) { return K1 * plant::settled_output_g(static_plant, a); };
   const std::vector<Reading> readings = simulate_static_test(source, K1, positions, design.errors, rng);
   // The readings' sigma as a lab states it: noise and set-angle error through the scale
@@ -101,15 +113,10 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
     for (std::size_t k = next++; k < c.runs.size(); k = next++) {
       RunRecord& r = c.runs[k];
       const vibration::SineVibration commanded = r.vibration();
-      TableMotion table = table_motion(r);
-      for (const auto& h : hidden) {
-        if (h.name == "shaker_third_harmonic") table.harmonics.push_back({3, h.parameter, 0.0});
-        if (is_out_of_library(h.name)) continue;
-        plant::PlantConfig unused = truth;
-        find_effect(h.name)->apply(h.parameter, unused, table);  // the shaker's own motion
-      }
-      const std::shared_ptr<const vibration::Excitation> motion = table.excitation();
       try {
+        const VirtualLab lab = truth_lab(truth, hidden, &r);
+        const plant::PlantConfig run_plant = lab.run_plant();
+        const std::shared_ptr<const vibration::Excitation> motion = lab.excitation();
         if (raw) {
           rectification::ShakeSettings ss;
           ss.readout.sample_rate_Hz = std::max(design.raw_sample_rate_Hz, 20 * r.frequency_Hz);
@@ -119,7 +126,7 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
           ss.blocks = 8;
           RawRecord& rec = c.raw[k];
           const rectification::ShakeResult s = rectification::shake_sine(
-              plant, r.orientation_g, commanded, ss,
+              run_plant, r.orientation_g, commanded, ss,
               [&rec](double t, const Vec3&, double u) {
                 rec.t_s.push_back(t);
                 rec.output.push_back(u);
@@ -131,7 +138,7 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
           rec.on_from_s = s.settle_s - dt / 2, rec.on_to_s = rec.t_s.back();  // [from, to): the last sample out
           r.measured_g = s.measured_g, r.sigma_g = s.sigma_g;
         } else {
-          const rectification::ShakeResult s = rectification::shake_sine(plant, r.orientation_g, commanded, {}, {}, motion.get());
+          const rectification::ShakeResult s = rectification::shake_sine(run_plant, r.orientation_g, commanded, {}, {}, motion.get());
           r.measured_g = s.measured_g + r.sigma_g * noise[k];
         }
       } catch (const std::exception& e) {

@@ -2,10 +2,9 @@
 // validation/diagnosis/campaign.hpp -- the virtual lab: a whole test campaign simulated from a "truth"
 // instrument that may carry hidden effects (issue 5).
 //
-// Takes: the truth plant (coefficients, dynamics), the hidden effects (names of
-//        validation/diagnosis/diagnose.hpp's library with their parameter, or the out-of-library
-//        "readout_clipping" with the shaker runs' DAQ full scale in g and
-//        "shaker_third_harmonic" with the table's 3rd-harmonic ratio), the campaign design (the
+// Takes: the truth plant (coefficients, dynamics), the hidden effects (names in the effect
+//        registry, validation/diagnosis/effect.hpp, with their parameter: the library's and
+//        the out-of-library "readout_clipping" and "shaker_third_harmonic"), the campaign design (the
 //        static positions and errors; the shaker runs: frequencies x amplitudes x directions
 //        x static orientations; each run's measurement sigma), a seed.
 // Gives: a Campaign as a lab would hand it over: static readings (the ODE plant settled in
@@ -13,7 +12,10 @@
 //        and per run the measured vibration error (the ODE on the virtual shaker with the
 //        hidden effects, plus Gaussian noise of the run's sigma). The nominal dynamics are
 //        the truth's without its hidden effects. Nothing of the truth is in the Campaign.
+// The truth is built by each effect's truth hook (plant modules and shaker decorators), not
+// by the hypothesis the diagnosis fits (docs/diagnose.md, "Truth and hypothesis").
 #include <cstdint>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -25,8 +27,13 @@ namespace vrelab::validation {
 
 struct HiddenEffect {
   std::string name;
-  double parameter = 0;
+  double parameter = 0;  // the effect's first parameter (each of today's effects has one)
 };
+
+// A blind campaign's draw of the effect's parameter (Effect::draw: the ranges where its gap is
+// several sigma in the default design). The same rng calls for a given seed as before the
+// registry, so blind seeds draw the same truths.
+HiddenEffect draw_hidden(const Effect& e, std::mt19937_64& rng);
 
 struct CampaignDesign {
   int positions_per_series = 12;  // 30 deg steps: rank 12 of 13, only k_PP must be held
@@ -48,6 +55,9 @@ CampaignDesign default_design();
 
 // Out-of-library effects the virtual lab can hide (diagnose must call them unexplained).
 bool is_out_of_library(const std::string& name);
+// The registry's validity check of a hidden effect (known name, values its check accepts);
+// std::invalid_argument "campaign: ..." otherwise.
+void validate(const HiddenEffect& h);
 
 Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
                            const CampaignDesign& design, std::uint64_t seed, int threads = 1);

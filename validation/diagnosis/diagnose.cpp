@@ -15,7 +15,6 @@
 
 #include <Eigen/Dense>
 
-#include "plant/effects/effects.hpp"
 #include "rectification/prediction/frequency.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "vibration/excitation.hpp"
@@ -26,258 +25,6 @@ namespace {
 
 using plant::Coefficients;
 using plant::PlantConfig;
-
-std::vector<double> geometric(double from, double to, int n) {
-  std::vector<double> v;
-  for (int k = 0; k < n; ++k) v.push_back(from * std::pow(to / from, k / (n - 1.0)));
-  return v;
-}
-
-// A sine whose axes move in phase or in antiphase as one signed amplitude vector (g), and
-// back (the shaker effects that redistribute the table's motion over the axes).
-Vec3 signed_in_phase(const vibration::SineVibration& v) {
-  Vec3 a;
-  for (int i = 0; i < 3; ++i) a[i] = v.amplitude_g[i] * std::cos(v.phase_rad[i]);
-  return a;
-}
-void set_in_phase(vibration::SineVibration& v, const Vec3& a) {
-  for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(a[i]), v.phase_rad[i] = a[i] < 0 ? M_PI : 0.0;
-}
-
-// 0 and +-from .. +-to in n geometric steps, sorted: the grid of a signed parameter.
-std::vector<double> symmetric_geometric(double from, double to, int n) {
-  std::vector<double> v = {0};
-  for (double x : geometric(from, to, n)) v.push_back(x), v.push_back(-x);
-  std::sort(v.begin(), v.end());
-  return v;
-}
-
-std::vector<EffectModel> make_library() {
-  std::vector<EffectModel> lib;
-  {
-    EffectModel e;
-    e.name = "pickoff_nonlinearity";
-    e.parameter = "p2", e.unit = "1/rad";
-    e.physics = "the pickoff reads theta + p2 theta^2: under vibration <theta> = -p2 <theta^2>, an output shift "
-                "growing with the pendulum's angle amplitude (quadratic in amplitude, rising towards the pendulum's "
-                "and the loop's resonances)";
-    e.linear = true, e.unit_value = 10;
-    e.apply = [](double p, PlantConfig& c, TableMotion&) {
-      if (p != 0) c.effects.push_back(std::make_shared<plant::PickoffNonlinearity>(p));
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "pendulum_geometry";
-    e.parameter = "fraction", e.unit = "1";  // a hypothesis: 1 = present; the fit says how much of it the data show
-    e.lower = -0.5, e.upper = 1.5;
-    e.physics = "vibropendulous coupling: the input axis turns with the pendulum, so vibration along IA and PA in "
-                "phase rectifies as -<a_PA theta>; with a static a_IA also -a_IA <theta^2> / 4, which alone looks like "
-                "the pickoff nonlinearity";
-    e.linear = true, e.unit_value = 1;
-    e.apply = [](double p, PlantConfig& c, TableMotion&) {
-      if (p != 0) c.effects.push_back(std::make_shared<plant::PendulumGeometry>());
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "quadratic_cross_axis";
-    e.parameter = "k_PP", e.unit = "1/g";
-    e.physics = "k_PP a_PA^2 (and the common part of k_PP, k_OO, k2 with k0): invisible to any static test in 1 g, "
-                "so held at 0 by the identification; rectifies k_PP |w|^2 / 2 whatever the direction (its k2 part "
-                "through the loop, like k2; flat in frequency along PA and OA)";
-    e.linear = true, e.unit_value = 1e-6;
-    e.apply = [](double p, PlantConfig& c, TableMotion&) {
-      // The static test identified (k0 + p, k2 - p, 0, k_OO - p): give the part back.
-      c.coefficients[plant::k0] -= p;
-      for (int i : {plant::k2, plant::k_PP, plant::k_OO}) c.coefficients[i] += p;
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "nonlinearity_at_input";
-    e.parameter = "fraction", e.unit = "1";
-    e.lower = -0.5, e.upper = 1.5;  // a hypothesis: 0 (in the loop) or 1 (at the input)
-    e.physics = "the input-axis nonlinearity (k1', k2, k3, k4) acts on the mechanical input, not in the torquer: it "
-                "sees the vibration itself, not the rebalance current, so it stays flat with frequency where the "
-                "loop-placed one peaks near the crossover and falls above it";
-    e.linear = true, e.unit_value = 1;
-    e.apply = [](double p, PlantConfig& c, TableMotion&) {
-      if (p >= 0.5)
-        for (int i : {plant::k1_asym, plant::k2, plant::k3, plant::k4}) c.location[i] = plant::Location::input;
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "servo_dynamics";
-    e.changes_dynamics = true;
-    e.parameter = "bandwidth_ratio", e.unit = "1";
-    e.physics = "the servo loop's crossover differs from nominal: the rebalance current's resonance, and with it "
-                "the loop-placed terms' rectification, moves in frequency; no effect at low frequency";
-    e.nominal = 1;
-    e.grid = geometric(0.5, 2.0, 41);
-    e.apply = [](double p, PlantConfig& c, TableMotion&) {
-      c.dynamics.loop_bandwidth_Hz *= p;
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "servo_phase_margin";
-    e.changes_dynamics = true;
-    e.parameter = "phase_margin_change_deg", e.unit = "deg";
-    e.physics = "the servo's phase margin differs from nominal (lead network, torquer or pickoff phase): the "
-                "closed loop's peaking at the crossover, and with it the rectification of the loop-placed terms "
-                "there, grows as the margin falls; no effect at low frequency or far above the crossover";
-    e.nominal = 0;
-    for (int k = -8; k <= 8; ++k) e.grid.push_back(4.0 * k);  // -32 .. +32 deg (the plant takes 10 .. 85)
-    e.apply = [](double p, PlantConfig& c, TableMotion&) {
-      c.dynamics.phase_margin_deg = std::clamp(c.dynamics.phase_margin_deg + p, 10.0, 85.0);
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "mechanical_mode";
-    e.changes_dynamics = true;
-    e.parameter = "frequency_Hz", e.unit = "Hz";
-    e.physics = "a second mechanical mode (flexure or mount, along IA, damping 0.05) amplifies the IA vibration "
-                "that reaches the pendulum near its frequency: a resonance in the gap over frequency, along IA";
-    e.nominal = 0;  // 0: no mode
-    e.grid = geometric(100, 5000, 41);
-    e.apply = [](double p, PlantConfig& c, TableMotion&) {
-      if (p > 0) c.effects.push_back(std::make_shared<plant::MechanicalMode>(p, 0.05, Vec3(1, 0, 0)));
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "shaker_transverse_motion";
-    e.parameter = "ratio_at_1kHz", e.unit = "1";
-    e.physics = "the shaker moves transversely, in phase, by ratio x (f / 1 kHz) of the commanded amplitude, on the "
-                "next sensor axis (IA -> PA -> OA -> IA): the cross terms and the other axis's quadratic terms "
-                "rectify, growing with frequency";
-    e.linear = false;
-    e.grid = {-0.2, -0.15, -0.1, -0.07, -0.05, -0.03, -0.02, -0.01, -0.005, 0, 0.005, 0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2};
-    e.apply = [](double p, PlantConfig&, TableMotion& m) {
-      if (p == 0) return;
-      const double r = p * m.sine.frequency_Hz / 1000;
-      const Vec3 a = signed_in_phase(m.sine);
-      set_in_phase(m.sine, a + r * Vec3(a[2], a[0], a[1]));
-    };
-    lib.push_back(e);
-  }
-  for (int n : {5, 6}) {
-    EffectModel e;
-    e.name = "higher_order_k" + std::to_string(n);
-    e.parameter = "k" + std::to_string(n), e.unit = "1/g^" + std::to_string(n - 1);
-    e.physics = n == 5 ? "an input-axis term k5 a^5 beyond the identified k4: in 1 g the static test folds it into K1 "
-                         "and k3 (and leaves its cos 5 phi part as misfit); under vibration it rectifies "
-                         "5 a0^3 |I|^2 + (15/8) a0 |I|^4 beyond what k3 predicts, as amplitude^4 at a static a_IA"
-                       : "an input-axis term k6 a^6 beyond the identified k4: folded into k0, k2, k4 by the static "
-                         "test; under vibration it rectifies (5/16) |I|^6 + ..., as amplitude^6, along IA";
-    e.linear = true, e.unit_value = n == 5 ? 1e-8 : 1e-9;
-    e.acts_at_rest = true;
-    e.apply = [n, name = e.name](double p, PlantConfig& c, TableMotion&) {
-      std::array<double, 7> poly{};
-      poly[static_cast<std::size_t>(n)] = p;
-      if (p != 0) c.effects.push_back(std::make_shared<plant::OutputPolynomial>(name, poly));
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "readout_nonlinearity";
-    e.parameter = "q2", e.unit = "1/g";
-    e.physics = "the data acquisition that records the shaker runs reads u + q2 u^2 (integral nonlinearity of its "
-                "ADC or amplifier, in g of input); the static test, read with another instrument, does not see "
-                "it. It rectifies q2 |U|^2 / 2: the shape of a loop-placed k2 error, along IA only";
-    e.linear = true, e.unit_value = 1e-6;
-    e.shaker_runs_only = true;
-    e.apply = [](double p, PlantConfig& c, TableMotion&) {
-      if (p != 0) c.effects.push_back(std::make_shared<plant::OutputPolynomial>("readout_nonlinearity", std::array<double, 7>{0, 0, p, 0, 0, 0, 0}));
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "mounting_misalignment";
-    e.parameter = "angle_about_OA_rad", e.unit = "rad";
-    e.physics = "the shaker fixture holds the sensor turned by the angle about OA from where the static test "
-                "held it: the table's IA motion puts angle x w on PA and its PA motion -angle x w on IA, so the "
-                "cross term k_IP rectifies angle k_IP (w_IA^2 - w_PA^2) / 2 and k2 sees angle^2 w_PA^2; flat in "
-                "frequency where the terms are at the input, opposite in sign along IA and PA, nothing along OA";
-    e.nominal = 0;
-    e.grid = symmetric_geometric(0.002, 0.2, 12);
-    e.apply = [](double p, PlantConfig&, TableMotion& m) {
-      if (p == 0) return;
-      const Vec3 a = signed_in_phase(m.sine);  // turned about OA by p
-      set_in_phase(m.sine, Vec3(std::cos(p) * a[0] - std::sin(p) * a[1], std::sin(p) * a[0] + std::cos(p) * a[1], a[2]));
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "squeeze_film_damping";
-    e.changes_dynamics = true;
-    e.parameter = "inverse_gap_angle", e.unit = "1/rad";
-    e.physics = "the gas film's damping rises as the pendulum nears the case, c0 / (1 - (theta / theta_gap)^2)^(3/2); "
-                "the parameter is 1 / theta_gap (0: no film nonlinearity). It does not rectify by itself (its torque "
-                "is c0 theta' times a function of theta, mean zero over a period) but the damping grows with the "
-                "angle amplitude, which changes the loop's response and so the loop-placed terms' rectification: "
-                "~ amplitude^4, near the pendulum's and the loop's resonances";
-    e.nominal = 0;
-    e.grid = {0};
-    for (double x : geometric(30, 3000, 16)) e.grid.push_back(x);
-    e.apply = [](double p, PlantConfig& c, TableMotion&) {
-      if (p <= 0) return;
-      const plant::Dynamics& d = c.dynamics;
-      const double c0 = 2 * d.pendulum_damping_ratio * 2 * std::numbers::pi * d.pendulum_frequency_Hz;
-      c.effects.push_back(std::make_shared<plant::SqueezeFilmDamping>(1 / p, c0, d.angle_gain_rad_per_s2_per_g));
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "shaker_harmonic_distortion";
-    e.parameter = "second_harmonic_ratio", e.unit = "1";
-    e.physics = "the table's motion carries a 2nd harmonic, ratio h of the fundamental on every axis, as "
-                "w (sin t + h sin 2t): the quadratic terms see (1 + h^2) w^2 / 2, the cubic and quartic ones "
-                "cross products of the two tones, each tone through the loop at its own frequency; grows as "
-                "h^2 in the quadratic terms, along every direction the instrument is nonlinear in";
-    e.nominal = 0;
-    e.grid = {0};
-    for (double h : geometric(0.01, 0.5, 22)) e.grid.push_back(h);
-    e.apply = [](double p, PlantConfig&, TableMotion& m) {
-      if (p > 0) m.harmonics.push_back({2, p, 0.0});
-    };
-    lib.push_back(e);
-  }
-  {
-    EffectModel e;
-    e.name = "fixture_rocking";
-    e.parameter = "rocking_rad_per_g", e.unit = "rad/g";
-    e.physics = "the fixture rocks about OA in phase with the table, by the parameter per g of amplitude, the "
-                "sensor 30 mm from the axis along IA: a tangential acceleration along PA growing as f^2, "
-                "rectified with the IA motion through k_IP and by itself through k_PP, the centripetal "
-                "acceleration (-r <alpha'^2>, along -IA, as f^2 alpha^2) and gravity turning with the fixture";
-    e.nominal = 0;
-    e.grid = symmetric_geometric(0.03e-6, 5e-6, 12);
-    e.apply = [](double p, PlantConfig&, TableMotion& m) { m.rocking_rad_per_g = p; };
-    lib.push_back(e);
-  }
-  for (EffectModel& e : lib)
-    if (e.linear && !std::isfinite(e.lower)) {
-      const double span = 100 * std::abs(e.unit_value - e.nominal);
-      e.lower = e.nominal - span, e.upper = e.nominal + span;
-    }
-  return lib;
-}
-
 
 // The table's motion as the prediction takes it: a pure sine exactly, else one period of
 // the excitation resolved into harmonics.
@@ -321,7 +68,7 @@ class ResponseCache {
 // (taken_up_by_static_test): subtracted from the identified coefficients under the effect.
 using Absorbed = std::map<std::string, Coefficients>;
 
-Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const EffectModel* e, double p,
+Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e, double p,
                ResponseCache& cache, const Absorbed& absorbed) {
   const int n = static_cast<int>(runs.size());
   Table t{Eigen::VectorXd(n), Eigen::MatrixXd(n, plant::kNumCoefficients)};
@@ -346,7 +93,7 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
       Coefficients z = nominal.coefficients;
       for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] = cfg.coefficients[i] - nominal.coefficients[i];
       if (e && e->acts_at_rest) {
-        for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] -= (p - e->nominal) * absorbed.at(e->name)[i];
+        for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] -= (p - e->fitted().nominal) * absorbed.at(e->name)[i];
       }
       return z;
     }();
@@ -404,16 +151,16 @@ Eigen::VectorXd adjusted_residual(const Data& d, const Eigen::VectorXd& pred, co
 // parameter on a set of runs, the model at any parameter value.
 class EffectFitter {
  public:
-  EffectFitter(const EffectModel& e, const Table& nominal, const PlantConfig& plant, const std::vector<RunRecord>& runs,
+  EffectFitter(const Effect& e, const Table& nominal, const PlantConfig& plant, const std::vector<RunRecord>& runs,
                ResponseCache& cache, const Absorbed& absorbed)
       : e_(e), nominal_(nominal), plant_(plant), runs_(runs), cache_(cache), absorbed_(absorbed) {
-    if (e.linear) {
-      unit_ = tabulate(plant, runs, &e, e.unit_value, cache, absorbed);
+    if (e.fitted().linear) {
+      unit_ = tabulate(plant, runs, &e, e.fitted().unit_value, cache, absorbed);
     } else {
       // Values the plant cannot take (a servo the loop design refuses) leave the grid.
-      for (double p : e.grid) {
+      for (double p : e.fitted().grid) {
         try {
-          grid_.push_back(p == e.nominal ? nominal : tabulate(plant, runs, &e, p, cache, absorbed));
+          grid_.push_back(p == e.fitted().nominal ? nominal : tabulate(plant, runs, &e, p, cache, absorbed));
           values_.push_back(p);
         } catch (const std::invalid_argument&) {
         }
@@ -421,8 +168,8 @@ class EffectFitter {
     }
   }
   Table at(double p) const {
-    if (e_.linear) {
-      const double u = (p - e_.nominal) / (e_.unit_value - e_.nominal);
+    if (e_.fitted().linear) {
+      const double u = (p - e_.fitted().nominal) / (e_.fitted().unit_value - e_.fitted().nominal);
       return {nominal_.pred + u * (unit_.pred - nominal_.pred), nominal_.G + u * (unit_.G - nominal_.G)};
     }
     // Nonlinear: the grid's tables, or the simulation at p itself (kept: the folds' fits
@@ -437,7 +184,7 @@ class EffectFitter {
   // d pred / d p at p: exact for linear effects, central over +-h for the others (a value the
   // plant refuses: one-sided).
   Eigen::VectorXd slope(double p, double h) const {
-    if (e_.linear) return (unit_.pred - nominal_.pred) / (e_.unit_value - e_.nominal);
+    if (e_.fitted().linear) return (unit_.pred - nominal_.pred) / (e_.fitted().unit_value - e_.fitted().nominal);
     const auto pred_at = [&](double x) -> std::optional<Eigen::VectorXd> {
       try {
         return at(x).pred;
@@ -463,24 +210,24 @@ class EffectFitter {
       }
     };
     std::vector<double> xs;
-    if (e_.linear) {
+    if (e_.fitted().linear) {
       // A bracket from the fixed-covariance (nominal V) estimate, then a scan and a refinement.
       const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, nominal_.G, idx));
-      const double du = e_.unit_value - e_.nominal;
+      const double du = e_.fitted().unit_value - e_.fitted().nominal;
       const Eigen::VectorXd s = sub(unit_.pred, idx) - sub(nominal_.pred, idx);
       const Eigen::VectorXd r = sub(d.measured, idx) - sub(nominal_.pred, idx);
       const double info = s.dot(ldlt.solve(s));
       const double u0 = info > 0 ? s.dot(ldlt.solve(r)) / info : 0.0;
       const double su = info > 0 ? 1 / std::sqrt(info) : 1.0;
       const double half = 3 * std::abs(u0) + 20 * su;
-      double lo = e_.nominal + du * (u0 - half), hi = e_.nominal + du * (u0 + half);
+      double lo = e_.fitted().nominal + du * (u0 - half), hi = e_.fitted().nominal + du * (u0 + half);
       if (lo > hi) std::swap(lo, hi);
-      lo = std::clamp(lo, e_.lower, e_.upper), hi = std::clamp(hi, e_.lower, e_.upper);
-      if (!(hi > lo)) lo = e_.lower, hi = e_.upper;  // the estimate lies outside the physical range
+      lo = std::clamp(lo, e_.fitted().lower, e_.fitted().upper), hi = std::clamp(hi, e_.fitted().lower, e_.fitted().upper);
+      if (!(hi > lo)) lo = e_.fitted().lower, hi = e_.fitted().upper;  // the estimate lies outside the physical range
       for (int k = 0; k <= 60; ++k) xs.push_back(lo + (hi - lo) * k / 60.0);
     } else {
       xs = values_;
-      if (xs.empty()) return {e_.nominal, INFINITY};
+      if (xs.empty()) return {e_.fitted().nominal, INFINITY};
     }
     std::vector<double> ls;
     for (double x : xs) ls.push_back(L(x));
@@ -532,7 +279,7 @@ class EffectFitter {
   }
 
  private:
-  const EffectModel& e_;
+  const Effect& e_;
   const Table& nominal_;
   const PlantConfig& plant_;
   const std::vector<RunRecord>& runs_;
@@ -568,25 +315,6 @@ TableMotion table_motion(const RunRecord& r) {
   return m;
 }
 
-std::shared_ptr<const vibration::Excitation> TableMotion::excitation() const {
-  auto tone = std::make_shared<vibration::SineExcitation>(sine);
-  std::shared_ptr<const vibration::Excitation> motion = tone;
-  if (!harmonics.empty()) motion = std::make_shared<vibration::HarmonicDistortion>(tone, harmonics);
-  if (rocking_rad_per_g != 0) {
-    // Gravity and the table's motion turn with the fixture; the lever arm adds a tangential
-    // acceleration along PA (~ f^2) and a centripetal one along -IA (~ f^2 alpha^2).
-    vibration::RockingSpec rs;
-    rs.axis = Vec3::UnitZ();
-    rs.amplitude_rad = std::abs(rocking_rad_per_g) * commanded_amplitude_g;
-    rs.phase_rad = rocking_rad_per_g < 0 ? std::numbers::pi : 0.0;
-    rs.static_gravity_g = static_gravity_g;
-    rs.lever_arm_m = Vec3(kRockingLeverArm_m, 0, 0);
-    rs.g_m_per_s2 = 9.80665;
-    motion = std::make_shared<vibration::Rocking>(motion, tone, rs);
-  }
-  return motion;
-}
-
 vibration::SineVibration RunRecord::vibration() const {
   vibration::SineVibration v;
   for (int i = 0; i < 3; ++i) {
@@ -597,23 +325,12 @@ vibration::SineVibration RunRecord::vibration() const {
   return v;
 }
 
-const std::vector<EffectModel>& effect_library() {
-  static const std::vector<EffectModel> lib = make_library();
-  return lib;
-}
-
-const EffectModel* find_effect(const std::string& name) {
-  for (const auto& e : effect_library())
-    if (e.name == name) return &e;
-  return nullptr;
-}
-
-Coefficients taken_up_by_static_test(const EffectModel& e, const PlantConfig& plant, const std::vector<Position>& positions,
+Coefficients taken_up_by_static_test(const Effect& e, const PlantConfig& plant, const std::vector<Position>& positions,
                                      const std::vector<double>& weights, const FixedSet& fixed) {
-  if (!e.linear) throw std::logic_error("diagnose: " + e.name + " acts at rest but is not linear");
+  if (!e.fitted().linear) throw std::logic_error("diagnose: " + e.name + " acts at rest but is not linear");
   PlantConfig with = plant;
   TableMotion unused;
-  e.apply(e.unit_value, with, unused);
+  e.apply(e.fitted().unit_value, with, unused);
   // Least squares is linear in the readings: the difference of the fits to the plant's
   // settled readings with and without the effect.
   std::vector<Reading> base, moved;
@@ -625,11 +342,11 @@ Coefficients taken_up_by_static_test(const EffectModel& e, const PlantConfig& pl
   const Coefficients b = least_squares(positions, base, weights, fixed).estimate.value;
   const Coefficients m = least_squares(positions, moved, weights, fixed).estimate.value;
   Coefficients diff;
-  for (int i = 0; i < plant::kNumCoefficients; ++i) diff[i] = (m[i] - b[i]) / (e.unit_value - e.nominal);
+  for (int i = 0; i < plant::kNumCoefficients; ++i) diff[i] = (m[i] - b[i]) / (e.fitted().unit_value - e.fitted().nominal);
   return diff;
 }
 
-double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const EffectModel* e, double p) {
+double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effect* e, double p) {
   PlantConfig cfg = nominal;
   TableMotion m = table_motion(r);
   if (e) e->apply(p, cfg, m);
@@ -689,7 +406,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   // change the effect (at its unit value) makes to the readings, at the campaign's own
   // positions and weights (least squares is linear in the readings: the difference of two fits).
   Absorbed absorbed;
-  for (const EffectModel& e : effect_library())
+  for (const Effect& e : effect_library())
     if (e.acts_at_rest) absorbed[e.name] = taken_up_by_static_test(e, plant, positions, weights, c.fixed);
 
   // 2. The nominal simulation: gap, significance, where.
@@ -892,10 +609,10 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
     return fitted_at(fitter, p, sp);
   };
   std::map<std::string, std::unique_ptr<EffectFitter>> fitters;
-  for (const EffectModel& e : effect_library()) {
+  for (const Effect& e : effect_library()) {
     const EffectFitter& fitter = *(fitters[e.name] = std::make_unique<EffectFitter>(e, nominal, plant, c.runs, cache, absorbed));
     Scored sc;
-    sc.fit.name = e.name, sc.fit.parameter = e.parameter, sc.fit.unit = e.unit;
+    sc.fit.name = e.name, sc.fit.parameter = e.fitted().name, sc.fit.unit = e.fitted().unit;
     score([&](const std::vector<int>& runs) { return fitted_one(fitter, data, runs); }, sc);
     const auto [p, sp] = fitter.fit(data, all);
     sc.fit.value = p, sc.fit.sigma = sp;
@@ -937,7 +654,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
     d.runs[static_cast<std::size_t>(k)].heldout_before_g = heldout_nominal(k);
   }
   d.rms_before_g = std::sqrt(ss_b / n), d.rms_before_sigma = std::sqrt(zs_b / n);
-  std::vector<std::pair<const EffectModel*, double>> chosen = {{find_effect(best->fit.name), best->fit.value}};
+  std::vector<std::pair<const Effect*, double>> chosen = {{find_effect(best->fit.name), best->fit.value}};
   // Two effects at once, when no one effect explains a significant gap: the best effect A with
   // a second B, additive to first order (T = T_A(pA) + T_B(pB) - T_0). The candidates for B
   // are ranked by how much they lower -2 ln L of what A leaves, on the training runs of each
@@ -968,26 +685,26 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
       f.variance << fa.variance, fb.variance;
       return std::make_tuple(pA, pB, f);
     };
-    const EffectModel& ea = *find_effect(best->fit.name);
+    const Effect& ea = *find_effect(best->fit.name);
     const EffectFitter& A = *fitters.at(ea.name);
     // The seconds ranked on the runs `idx` alone (each fold's training runs when scored): each
     // other effect fitted to what A (fitted on idx) leaves, by the drop of -2 ln L.
-    std::map<std::vector<int>, std::vector<const EffectModel*>> ranked;
-    const auto seconds = [&](const std::vector<int>& idx) -> const std::vector<const EffectModel*>& {
+    std::map<std::vector<int>, std::vector<const Effect*>> ranked;
+    const auto seconds = [&](const std::vector<int>& idx) -> const std::vector<const Effect*>& {
       auto it = ranked.find(idx);
       if (it != ranked.end()) return it->second;
       Data rest = data;
       rest.measured -= A.at(A.fit(data, idx).first).pred - nominal.pred;
       const double l_rest = likelihood(rest, nominal.pred, nominal.G, idx).m2logl;
-      std::vector<std::pair<double, const EffectModel*>> drop;
-      for (const EffectModel& eb : effect_library()) {
+      std::vector<std::pair<double, const Effect*>> drop;
+      for (const Effect& eb : effect_library()) {
         if (eb.name == ea.name) continue;
         const EffectFitter& B = *fitters.at(eb.name);
         const Table tb = B.at(B.fit(rest, idx).first);
         drop.emplace_back(l_rest - likelihood(rest, tb.pred, tb.G, idx).m2logl, &eb);
       }
       std::stable_sort(drop.begin(), drop.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
-      std::vector<const EffectModel*> v;
+      std::vector<const Effect*> v;
       for (const auto& x : drop) v.push_back(x.second);
       return ranked.emplace(idx, v).first->second;
     };
@@ -996,12 +713,12 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
       // Candidate j: A with the j-th best second, that second chosen on each fold's training runs.
       Scored sc;
       score([&](const std::vector<int>& train) {
-        const EffectModel& eb = *seconds(train)[j];
-        return std::get<2>(fit_pair(A, *fitters.at(eb.name), eb.nominal, train));
+        const Effect& eb = *seconds(train)[j];
+        return std::get<2>(fit_pair(A, *fitters.at(eb.name), eb.fitted().nominal, train));
       }, sc);
-      const EffectModel& eb = *seconds(all)[j];
+      const Effect& eb = *seconds(all)[j];
       sc.fit.name = ea.name + " + " + eb.name;
-      const auto [pa, pb, t] = fit_pair(A, *fitters.at(eb.name), eb.nominal, all);
+      const auto [pa, pb, t] = fit_pair(A, *fitters.at(eb.name), eb.fitted().nominal, all);
       const PairFit pf{ea.name, eb.name, pa, pb, sc.fit.evidence, sc.fit.heldout_chi2};
       d.pairs.push_back(pf);
       if (pair_best.fit.name.empty() || sc.fit.evidence > pair_best.fit.evidence) pair_best = sc, chosen_pair = pf;
@@ -1044,7 +761,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
         e->apply(p, cfg, v);
         if (give_back && e->acts_at_rest)
           for (int i = 0; i < plant::kNumCoefficients; ++i)
-            cfg.coefficients[i] -= (p - e->nominal) * absorbed.at(e->name)[i];
+            cfg.coefficients[i] -= (p - e->fitted().nominal) * absorbed.at(e->name)[i];
       }
     };
     Table t = tabulate(plant, c.runs, chosen[0].first, chosen[0].second, cache, absorbed);

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "plant/accelerometer.hpp"
+#include "validation/diagnosis/effect.hpp"
 #include "validation/identification/dividing_head.hpp"
 #include "validation/identification/identification.hpp"
 #include "validation/identification/uncertainty.hpp"
@@ -69,56 +70,19 @@ struct Campaign {
   std::vector<std::string> skipped;  // runs the reader could not use, each with why
 };
 
-// The table's motion in one run as the simulation models it, in sensor axes: the sine the
-// shaker makes (the commanded one, with any transverse part), its harmonic distortion, and the
-// fixture's rocking. The effects that live in the shaker set these.
-struct TableMotion {
-  vibration::SineVibration sine;
-  std::vector<vibration::Harmonic> harmonics;  // vibration/decorators.hpp's HarmonicDistortion
-  // Rocking of the fixture about OA, rad per g of commanded amplitude, in phase with the
-  // table (negative: in antiphase); the sensor 30 mm from the axis along IA.
-  double rocking_rad_per_g = 0;
-  double commanded_amplitude_g = 0;
-  Vec3 static_gravity_g = Vec3::Zero();  // what the rocking turns
-  static constexpr double kRockingLeverArm_m = 0.03;
-  bool pure_sine() const { return harmonics.empty() && rocking_rad_per_g == 0; }
-  // The acceleration the plant's case feels (the decorators of vibration/decorators.hpp).
-  std::shared_ptr<const vibration::Excitation> excitation() const;
-};
-TableMotion table_motion(const RunRecord& r);  // the commanded sine, no imperfection
-
-// A candidate effect: a physical parameter that changes the nominal simulation (the plant
-// or the shaker's motion). `nominal` is the value without the effect.
-struct EffectModel {
-  std::string name, parameter, unit, physics;
-  double nominal = 0;
-  bool linear = false;          // the prediction is linear in the parameter
-  bool changes_dynamics = false;  // the loop's linear response depends on the parameter
-  std::vector<double> grid;     // values tried (nonlinear effects)
-  double unit_value = 1;        // the parameter value used for the signature (linear effects)
-  // The physical range of the fit: hypotheses [-0.5, 1.5]; other linear effects
-  // nominal +- 100 |unit_value - nominal| (set by effect_library()).
-  double lower = -INFINITY, upper = INFINITY;
-  // Acts at rest too (linear effects only): the static test took up part of it into the
-  // identified coefficients; diagnose gives that part back (docs/diagnose.md).
-  bool acts_at_rest = false;
-  // Lives in the shaker runs' data acquisition only: a lab reads its static test apart.
-  bool shaker_runs_only = false;
-  // Applies parameter p to the nominal plant and to the table's motion.
-  std::function<void(double p, plant::PlantConfig&, TableMotion&)> apply;
-};
-const std::vector<EffectModel>& effect_library();
-const EffectModel* find_effect(const std::string& name);
+// The table's motion of a run as the prediction takes it: the commanded sine, no imperfection.
+TableMotion table_motion(const RunRecord& r);
 
 // What a static test at `positions` (weights, held coefficients) takes up into the identified
 // coefficients of an effect that acts at rest, per unit of its parameter (linear effects).
-plant::Coefficients taken_up_by_static_test(const EffectModel& e, const plant::PlantConfig& plant,
+plant::Coefficients taken_up_by_static_test(const Effect& e, const plant::PlantConfig& plant,
                                      const std::vector<Position>& positions, const std::vector<double>& weights,
                                      const FixedSet& fixed);
 
 // The simulation's prediction of one run: eq. (3) through the plant's dynamics, with an
 // effect (name, parameter) applied when given. g.
-double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, const EffectModel* e = nullptr, double p = 0);
+// (e must be in the library; p is its first parameter, the others nominal.)
+double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, const Effect* e = nullptr, double p = 0);
 
 struct DiagnoseSettings {
   double model_accuracy = 0.002;      // relative accuracy of the simulation (f_model)

@@ -1,0 +1,33 @@
+#include "plant/effects/squeeze_film_damping.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace vrelab::plant {
+
+SqueezeFilmDamping::SqueezeFilmDamping(double gap, double c0, double b) : gap_rad_(gap), c0_(c0), b_(b) {
+  if (!(gap > 0) || !std::isfinite(gap)) throw std::invalid_argument("squeeze film gap_angle_rad must be positive");
+  if (!(c0 >= 0) || !std::isfinite(c0)) throw std::invalid_argument("squeeze film c0_per_s must be >= 0");
+  if (!(b > 0) || !std::isfinite(b)) throw std::invalid_argument("squeeze film angle_gain must be positive");
+}
+
+double SqueezeFilmDamping::extra_input_g(double theta, double omega, double, const Vec3&) const {
+  const double x = std::min(std::abs(theta) / gap_rad_, 0.95);
+  const double factor = 1 / std::pow(1 - x * x, 1.5) - 1;
+  return -c0_ * factor * omega / b_;  // the plant multiplies by b
+}
+
+double SqueezeFilmDamping::damping_factor(double theta_amplitude) const {
+  constexpr int kN = 128;  // trapezoid over a period: spectral for the smooth law below 0.95 theta_gap
+  double sum = 0;
+  for (int k = 0; k < kN; ++k) {
+    const double phi = 2 * std::numbers::pi * k / kN;
+    const double x = std::min(std::abs(theta_amplitude * std::sin(phi)) / gap_rad_, 0.95);
+    sum += std::cos(phi) * std::cos(phi) / std::pow(1 - x * x, 1.5);
+  }
+  return 2 * sum / kN;
+}
+
+}  // namespace vrelab::plant

@@ -1,0 +1,120 @@
+#pragma once
+// validation/diagnosis/effect.hpp -- one effect as the diagnosis and the virtual lab know it.
+//
+// An Effect is one physical cause of a gap between the simulation and a shaker campaign: its
+// name, its physics in words (docs and reports), its parameters (name, unit, the value
+// without it, the fit's range and how the fit explores it), where it acts, and four hooks:
+//  - hypothesis: the diagnosis' model of it, applied to the nominal plant and the table's
+//    motion that the first-order prediction takes (validation/diagnosis/diagnose.hpp);
+//  - truth: the virtual lab's, built from its physical description with the plant's modules
+//    (plant/effects/) and the shaker's decorators (vibration/decorators.hpp), never through
+//    the hypothesis, so that a wrong sign or axis in a hypothesis shows in `blind`;
+//  - draw: a value for a blind campaign, where its gap is several sigma in the default design;
+//  - check: the values a campaign may hide (beyond finiteness).
+// Each effect is one file in validation/diagnosis/effects/; the registry (effect_registry())
+// lists them all. The hooks take one value per parameter.
+#include <cmath>
+#include <functional>
+#include <memory>
+#include <optional>
+#include <random>
+#include <span>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "plant/accelerometer.hpp"
+#include "vibration/decorators.hpp"
+#include "vibration/profile.hpp"
+
+namespace vrelab::validation {
+
+// The table's motion in one run as the diagnosis' prediction models it, in sensor axes: the
+// sine the shaker makes (the commanded one, with any transverse part), its harmonic
+// distortion, and the fixture's rocking. The hypotheses of the effects that live in the
+// shaker set these.
+struct TableMotion {
+  vibration::SineVibration sine;
+  std::vector<vibration::Harmonic> harmonics;  // vibration/decorators.hpp's HarmonicDistortion
+  // Rocking of the fixture about OA, rad per g of commanded amplitude, in phase with the
+  // table (negative: in antiphase); the sensor 30 mm from the axis along IA.
+  double rocking_rad_per_g = 0;
+  double commanded_amplitude_g = 0;
+  Vec3 static_gravity_g = Vec3::Zero();  // what the rocking turns
+  static constexpr double kRockingLeverArm_m = 0.03;
+  bool pure_sine() const { return harmonics.empty() && rocking_rad_per_g == 0; }
+  // The acceleration the plant's case feels (the decorators of vibration/decorators.hpp).
+  std::shared_ptr<const vibration::Excitation> excitation() const;
+};
+
+// The virtual lab's truth for the static test or one shaker run, as the effects' truth hooks
+// build it up: the instrument, the shaker runs' data acquisition, and the table's motion.
+struct VirtualLab {
+  plant::PlantConfig instrument;  // the sensor: the static test and the shaker runs read it
+  // The shaker runs' data acquisition (readout modules after the instrument's); the static
+  // test is read with another instrument.
+  std::vector<std::shared_ptr<const plant::Effect>> run_acquisition;
+  // The run (zero amplitude for the static test): the commanded sine turned into what the
+  // table does in sensor axes by the shaker's and the fixture's linear imperfections, then
+  // the shaker's distortion and the fixture's rocking about the commanded tone.
+  vibration::SineVibration table;
+  double commanded_amplitude_g = 0;
+  Vec3 static_gravity_g = Vec3::Zero();
+  std::vector<vibration::Harmonic> harmonics;
+  std::optional<vibration::RockingSpec> rocking;
+
+  plant::PlantConfig run_plant() const;  // the instrument read by the run's acquisition
+  std::shared_ptr<const vibration::Excitation> excitation() const;
+};
+
+enum class ActsOn { instrument, table_motion, data_acquisition };
+const char* to_string(ActsOn a);
+
+struct EffectParameter {
+  EffectParameter() = default;
+  EffectParameter(std::string name_, std::string unit_) : name(std::move(name_)), unit(std::move(unit_)) {}
+  std::string name, unit;
+  double nominal = 0;  // the value without the effect
+  // The fit's physical range; for linear parameters left infinite, the registry sets
+  // nominal +- 100 |unit_value - nominal|.
+  double lower = -INFINITY, upper = INFINITY;
+  bool linear = false;       // the prediction is linear in it: fitted from one signature
+  double unit_value = 1;     // the value of that signature (linear)
+  std::vector<double> grid;  // values tried (nonlinear)
+};
+
+using ParameterValues = std::span<const double>;  // one value per Effect::parameters entry
+
+struct Effect {
+  std::string name, physics;
+  std::vector<EffectParameter> parameters;  // at least one; the diagnosis fits the first
+  ActsOn acts_on = ActsOn::instrument;
+  bool in_library = true;         // false: only the virtual lab knows it (diagnose must call it unexplained)
+  int rank = 1000;                // the registry's order (the diagnosis' order: ties, output); a new effect takes the next
+  bool changes_dynamics = false;  // the loop's linear response depends on the parameter
+  // Acts at rest too (linear effects only): the static test took up part of it into the
+  // identified coefficients; diagnose gives that part back (docs/diagnose.md).
+  bool acts_at_rest = false;
+  // Lives in the shaker runs' data acquisition only: a lab reads its static test apart.
+  bool shaker_runs_only = false;
+
+  std::function<void(ParameterValues, plant::PlantConfig&, TableMotion&)> hypothesis;  // null: not in the library
+  std::function<void(ParameterValues, VirtualLab&)> truth;
+  std::function<std::vector<double>(std::mt19937_64&)> draw;
+  std::function<bool(ParameterValues, std::string* why)> check;  // null: any finite values
+
+  const EffectParameter& fitted() const { return parameters.front(); }
+  // The hypothesis at one value of the first parameter (the others nominal).
+  void apply(double p, plant::PlantConfig& plant, TableMotion& motion) const;
+  // The right number of finite values that `check` accepts; why says otherwise.
+  bool is_valid(ParameterValues values, std::string* why = nullptr) const;
+};
+using EffectModel = Effect;  // the diagnosis' earlier name for it
+
+// Every effect, the library's first in the diagnosis' order, then those outside it.
+const std::vector<Effect>& effect_registry();
+// The library's effects (in_library), in the diagnosis' order.
+const std::vector<Effect>& effect_library();
+const Effect* find_effect(const std::string& name);  // any registered effect; null if none
+
+}  // namespace vrelab::validation
