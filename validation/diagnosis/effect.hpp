@@ -81,6 +81,8 @@ struct EffectParameter {
   bool linear = false;       // the prediction is linear in it: fitted from one signature
   double unit_value = 1;     // the value of that signature (linear)
   std::vector<double> grid;  // values tried (nonlinear)
+  // A value where the effect is clearly seen in a 4 g run (the tests' value; docs).
+  double example = NAN;
 };
 
 using ParameterValues = std::span<const double>;  // one value per Effect::parameters entry

@@ -15,6 +15,7 @@ Effect effect_fixture_rocking() {
               "rectified with the IA motion through k_IP and by itself through k_PP, the centripetal "
               "acceleration (-r <alpha'^2>, along -IA, as f^2 alpha^2) and gravity turning with the fixture";
   EffectParameter p("rocking_rad_per_g", "rad/g");
+  p.example = -1e-6;
   p.nominal = 0;
   p.grid = effects::symmetric_geometric(0.03e-6, 5e-6, 12);
   e.parameters = {p};

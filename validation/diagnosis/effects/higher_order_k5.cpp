@@ -17,6 +17,7 @@ Effect effect_higher_order_k5() {
               "and k3 (and leaves its cos 5 phi part as misfit); under vibration it rectifies "
               "5 a0^3 |I|^2 + (15/8) a0 |I|^4 beyond what k3 predicts, as amplitude^4 at a static a_IA";
   EffectParameter p("k5", "1/g^4");
+  p.example = 3e-8;
   p.linear = true, p.unit_value = 1e-8;
   e.parameters = {p};
   const auto term = [](double k) {

@@ -16,6 +16,7 @@ Effect effect_higher_order_k6() {
   e.physics = "an input-axis term k6 a^6 beyond the identified k4: folded into k0, k2, k4 by the static "
               "test; under vibration it rectifies (5/16) |I|^6 + ..., as amplitude^6, along IA";
   EffectParameter p("k6", "1/g^5");
+  p.example = 3e-9;
   p.linear = true, p.unit_value = 1e-9;
   e.parameters = {p};
   const auto term = [](double k) {

@@ -19,6 +19,7 @@ Effect effect_mechanical_mode() {
   e.physics = "a second mechanical mode (flexure or mount, along IA, damping 0.05) amplifies the IA vibration "
               "that reaches the pendulum near its frequency: a resonance in the gap over frequency, along IA";
   EffectParameter p("frequency_Hz", "Hz");
+  p.example = 700;
   p.nominal = 0;  // 0: no mode
   p.grid = effects::geometric(100, 5000, 41);
   e.parameters = {p};

@@ -15,6 +15,7 @@ Effect effect_mounting_misalignment() {
               "cross term k_IP rectifies angle k_IP (w_IA^2 - w_PA^2) / 2 and k2 sees angle^2 w_PA^2; flat in "
               "frequency where the terms are at the input, opposite in sign along IA and PA, nothing along OA";
   EffectParameter p("angle_about_OA_rad", "rad");
+  p.example = 0.05;
   p.nominal = 0;
   p.grid = effects::symmetric_geometric(0.002, 0.2, 12);
   e.parameters = {p};

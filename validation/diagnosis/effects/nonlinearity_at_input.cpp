@@ -12,6 +12,7 @@ Effect effect_nonlinearity_at_input() {
               "sees the vibration itself, not the rebalance current, so it stays flat with frequency where the "
               "loop-placed one peaks near the crossover and falls above it";
   EffectParameter p("fraction", "1");
+  p.example = 1;
   p.lower = -0.5, p.upper = 1.5;  // a hypothesis: 0 (in the loop) or 1 (at the input)
   p.linear = true, p.unit_value = 1;
   e.parameters = {p};

@@ -15,6 +15,7 @@ Effect effect_pendulum_geometry() {
               "phase rectifies as -<a_PA theta>; with a static a_IA also -a_IA <theta^2> / 4, which alone looks like "
               "the pickoff nonlinearity";
   EffectParameter p("fraction", "1");  // a hypothesis: 1 = present; the fit says how much of it the data show
+  p.example = 1;
   p.lower = -0.5, p.upper = 1.5;
   p.linear = true, p.unit_value = 1;
   e.parameters = {p};

@@ -15,6 +15,7 @@ Effect effect_pickoff_nonlinearity() {
               "growing with the pendulum's angle amplitude (quadratic in amplitude, rising towards the pendulum's "
               "and the loop's resonances)";
   EffectParameter p("p2", "1/rad");
+  p.example = 20;
   p.linear = true, p.unit_value = 10;
   e.parameters = {p};
   e.hypothesis = [](ParameterValues v, plant::PlantConfig& c, TableMotion&) {

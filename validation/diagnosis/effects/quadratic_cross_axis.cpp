@@ -12,6 +12,7 @@ Effect effect_quadratic_cross_axis() {
               "so held at 0 by the identification; rectifies k_PP |w|^2 / 2 whatever the direction (its k2 part "
               "through the loop, like k2; flat in frequency along PA and OA)";
   EffectParameter p("k_PP", "1/g");
+  p.example = 2e-6;
   p.linear = true, p.unit_value = 1e-6;
   e.parameters = {p};
   e.hypothesis = [](ParameterValues v, plant::PlantConfig& c, TableMotion&) {

@@ -17,6 +17,7 @@ Effect effect_readout_clipping() {
               "peak output it clips one side more than the other when the sensor has a static a_IA, and the mean "
               "shifts; a lab sees it in the raw record (outside the diagnosis' library)";
   EffectParameter p("full_scale_g", "g");
+  p.example = 4.5;
   p.nominal = INFINITY;
   e.parameters = {p};
   e.truth = [](ParameterValues v, VirtualLab& lab) { lab.run_acquisition.push_back(std::make_shared<plant::ReadoutClipping>(v[0])); };

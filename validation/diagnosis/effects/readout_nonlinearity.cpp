@@ -17,6 +17,7 @@ Effect effect_readout_nonlinearity() {
               "ADC or amplifier, in g of input); the static test, read with another instrument, does not see "
               "it. It rectifies q2 |U|^2 / 2: the shape of a loop-placed k2 error, along IA only";
   EffectParameter p("q2", "1/g");
+  p.example = 2e-6;
   p.linear = true, p.unit_value = 1e-6;
   e.parameters = {p};
   e.hypothesis = [](ParameterValues v, plant::PlantConfig& c, TableMotion&) {

@@ -12,6 +12,7 @@ Effect effect_servo_dynamics() {
   e.physics = "the servo loop's crossover differs from nominal: the rebalance current's resonance, and with it "
               "the loop-placed terms' rectification, moves in frequency; no effect at low frequency";
   EffectParameter p("bandwidth_ratio", "1");
+  p.example = 0.7;
   p.nominal = 1;
   p.grid = effects::geometric(0.5, 2.0, 41);
   e.parameters = {p};

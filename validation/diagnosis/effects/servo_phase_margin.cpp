@@ -15,6 +15,7 @@ Effect effect_servo_phase_margin() {
               "closed loop's peaking at the crossover, and with it the rectification of the loop-placed terms "
               "there, grows as the margin falls; no effect at low frequency or far above the crossover";
   EffectParameter p("phase_margin_change_deg", "deg");
+  p.example = -15;
   p.nominal = 0;
   for (int k = -8; k <= 8; ++k) p.grid.push_back(4.0 * k);  // -32 .. +32 deg (the plant takes 10 .. 85)
   e.parameters = {p};

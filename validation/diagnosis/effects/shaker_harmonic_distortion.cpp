@@ -13,6 +13,7 @@ Effect effect_shaker_harmonic_distortion() {
               "cross products of the two tones, each tone through the loop at its own frequency; grows as "
               "h^2 in the quadratic terms, along every direction the instrument is nonlinear in";
   EffectParameter p("second_harmonic_ratio", "1");
+  p.example = 0.2;
   p.nominal = 0;
   p.grid = {0};
   for (double h : effects::geometric(0.01, 0.5, 22)) p.grid.push_back(h);

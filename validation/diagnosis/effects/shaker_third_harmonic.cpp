@@ -13,6 +13,7 @@ Effect effect_shaker_third_harmonic() {
               "w (sin t + h sin 3t): the odd terms see cross products of the two tones (outside the diagnosis' "
               "library, whose distortion is the 2nd harmonic)";
   EffectParameter p("third_harmonic_ratio", "1");
+  p.example = 0.2;
   p.nominal = 0;
   e.parameters = {p};
   e.truth = [](ParameterValues v, VirtualLab& lab) {

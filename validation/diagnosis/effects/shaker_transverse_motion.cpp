@@ -12,6 +12,7 @@ Effect effect_shaker_transverse_motion() {
               "next sensor axis (IA -> PA -> OA -> IA): the cross terms and the other axis's quadratic terms "
               "rectify, growing with frequency";
   EffectParameter p("ratio_at_1kHz", "1");
+  p.example = 0.05;
   p.grid = {-0.2, -0.15, -0.1, -0.07, -0.05, -0.03, -0.02, -0.01, -0.005, 0, 0.005, 0.01, 0.02, 0.03, 0.05, 0.07, 0.1, 0.15, 0.2};
   e.parameters = {p};
   e.hypothesis = [](ParameterValues v, plant::PlantConfig&, TableMotion& m) {

@@ -27,6 +27,7 @@ Effect effect_squeeze_film_damping() {
               "angle amplitude, which changes the loop's response and so the loop-placed terms' rectification: "
               "~ amplitude^4, near the pendulum's and the loop's resonances";
   EffectParameter p("inverse_gap_angle", "1/rad");
+  p.example = 700;
   p.nominal = 0;
   p.grid = {0};
   for (double x : effects::geometric(30, 3000, 16)) p.grid.push_back(x);
