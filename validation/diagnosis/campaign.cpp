@@ -1,15 +1,14 @@
 #include "validation/diagnosis/campaign.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <memory>
 #include <numbers>
 #include <random>
 #include <span>
 #include <stdexcept>
-#include <thread>
 
+#include "core/parallel.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/excitation.hpp"
@@ -107,49 +106,44 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
   for (double& x : noise) x = n01(rng);
   const bool raw = design.raw_sample_rate_Hz > 0;
   if (raw) c.raw.resize(c.runs.size());
-  std::atomic<std::size_t> next{0};
   std::vector<std::string> failures(c.runs.size());
-  auto worker = [&] {
-    for (std::size_t k = next++; k < c.runs.size(); k = next++) {
-      RunRecord& r = c.runs[k];
-      const vibration::SineVibration commanded = r.vibration();
-      try {
-        const VirtualLab lab = truth_lab(truth, hidden, &r);
-        const plant::PlantConfig run_plant = lab.run_plant();
-        const std::shared_ptr<const vibration::Excitation> motion = lab.excitation();
-        if (raw) {
-          rectification::ShakeSettings ss;
-          ss.readout.sample_rate_Hz = std::max(design.raw_sample_rate_Hz, 20 * r.frequency_Hz);
-          ss.readout.noise_sigma_g = design.raw_noise_sigma_g;
-          ss.readout.seed = seed * 1000003u + k;
-          ss.min_measure_s = design.raw_record_s;
-          ss.blocks = 8;
-          RawRecord& rec = c.raw[k];
-          const rectification::ShakeResult s = rectification::shake_sine(
-              run_plant, r.orientation_g, commanded, ss,
-              [&rec](double t, const Vec3&, double u) {
-                rec.t_s.push_back(t);
-                rec.output.push_back(u);
-              },
-              motion.get());
-          // Windows half a sample clear of the samples they hold ([from, to), as SeriesMeasurer).
-          const double dt = 1 / s.sample_rate_Hz;
-          rec.rest_from_s = rec.t_s.front() - dt / 2, rec.rest_to_s = -dt / 2;
-          rec.on_from_s = s.settle_s - dt / 2, rec.on_to_s = rec.t_s.back();  // [from, to): the last sample out
-          r.measured_g = s.measured_g, r.sigma_g = s.sigma_g;
-        } else {
-          const rectification::ShakeResult s = rectification::shake_sine(run_plant, r.orientation_g, commanded, {}, {}, motion.get());
-          r.measured_g = s.measured_g + r.sigma_g * noise[k];
-        }
-      } catch (const std::exception& e) {
-        failures[k] = e.what();
+  // Each run's own failure is kept and the others still run; all are reported after.
+  const auto run = [&](std::size_t k) {
+    RunRecord& r = c.runs[k];
+    const vibration::SineVibration commanded = r.vibration();
+    try {
+      const VirtualLab lab = truth_lab(truth, hidden, &r);
+      const plant::PlantConfig run_plant = lab.run_plant();
+      const std::shared_ptr<const vibration::Excitation> motion = lab.excitation();
+      if (raw) {
+        rectification::ShakeSettings ss;
+        ss.readout.sample_rate_Hz = std::max(design.raw_sample_rate_Hz, 20 * r.frequency_Hz);
+        ss.readout.noise_sigma_g = design.raw_noise_sigma_g;
+        ss.readout.seed = seed * 1000003u + k;
+        ss.min_measure_s = design.raw_record_s;
+        ss.blocks = 8;
+        RawRecord& rec = c.raw[k];
+        const rectification::ShakeResult s = rectification::shake_sine(
+            run_plant, r.orientation_g, commanded, ss,
+            [&rec](double t, const Vec3&, double u) {
+              rec.t_s.push_back(t);
+              rec.output.push_back(u);
+            },
+            motion.get());
+        // Windows half a sample clear of the samples they hold ([from, to), as SeriesMeasurer).
+        const double dt = 1 / s.sample_rate_Hz;
+        rec.rest_from_s = rec.t_s.front() - dt / 2, rec.rest_to_s = -dt / 2;
+        rec.on_from_s = s.settle_s - dt / 2, rec.on_to_s = rec.t_s.back();  // [from, to): the last sample out
+        r.measured_g = s.measured_g, r.sigma_g = s.sigma_g;
+      } else {
+        const rectification::ShakeResult s = rectification::shake_sine(run_plant, r.orientation_g, commanded, {}, {}, motion.get());
+        r.measured_g = s.measured_g + r.sigma_g * noise[k];
       }
+    } catch (const std::exception& e) {
+      failures[k] = e.what();
     }
   };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < std::max(1, threads); ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  core::parallel_for(c.runs.size(), std::max(1, threads), run);  // threads <= 0: one
   for (std::size_t k = 0; k < failures.size(); ++k)
     if (!failures[k].empty()) throw std::runtime_error("campaign: " + c.runs[k].id + ": " + failures[k]);
   return c;
