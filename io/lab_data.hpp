@@ -28,13 +28,18 @@ struct LabManifest {
   std::string output_unit = "mA";
   double g_m_per_s2 = 9.80665;
   bool dynamics_given = false;  // the manifest has a [dynamics] table
+  // The optional [diagnose] table: DiagnoseSettings' fields by name (model_accuracy,
+  // significance_sigma, explained_shrinkage, resimulate_runs, try_pairs); defaults elsewhere.
+  validation::DiagnoseSettings diagnose;
+  bool diagnose_given = false;
 };
 
 validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest = nullptr);
 
 // Writes manifest.toml, static.csv and runs.csv (summaries). `raw_series`, when non-empty,
 // gives per run a recorded series already written under DIR (file name, rest and on
-// windows) to reference instead of the summary.
+// windows) to reference instead of the summary; else, when the campaign holds raw records
+// (Campaign::raw), they are written as DIR/records/<run id>.csv and referenced.
 struct RawSeriesRef {
   std::string file;
   double rest_from_s = 0, rest_to_s = 0, on_from_s = 0, on_to_s = 0;
