@@ -2,7 +2,8 @@
 // io/lab_data.hpp -- the lab data format (docs/data-format.md): a campaign directory.
 //
 //   DIR/manifest.toml  instrument, units, gravity, nominal dynamics, identification's held
-//                      coefficients, the names of the two files below
+//                      coefficients, the names of the two files below, diagnose's
+//                      settings ([diagnose], optional)
 //   DIR/static.csv     the static readings: orientation (a_IA_g, a_PA_g, a_OA_g) or
 //                      (series, angle_deg); output_<unit>; sigma_<unit> (one reading's);
 //                      count (readings averaged; optional, 1)
