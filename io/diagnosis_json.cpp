@@ -88,7 +88,9 @@ json to_json(const validation::DiagnoseSettings& s) {
           {"try_pairs", s.try_pairs}};
 }
 
-json to_json(const validation::BlindSettings& s) { return {{"n", s.n}, {"seed", s.seed}, {"threads", s.threads}}; }
+json to_json(const validation::BlindSettings& s) {
+  return {{"n", s.n}, {"seed", s.seed}, {"threads", s.threads}, {"diagnose", to_json(s.diagnose)}};
+}
 
 json to_json(const plant::Dynamics& d) {
   return {{"pendulum_frequency_Hz", d.pendulum_frequency_Hz},

@@ -94,6 +94,9 @@ TEST(Blind, SettingsAreCheckedBeforeAnyCampaign) {
   EXPECT_FALSE(s.IsValid(&why));
   EXPECT_NE(why.find("n = 0"), std::string::npos);
   EXPECT_THROW(validation::run_blind(s), std::invalid_argument);
+  s.n = 1, s.diagnose.significance_sigma = 0;
+  EXPECT_FALSE(s.IsValid(&why));
+  EXPECT_NE(why.find("diagnose.significance_sigma"), std::string::npos) << why;
 }
 
 // The confusion matrix: rows the truth, columns what was called; any "A + B" verdict counts
@@ -111,5 +114,6 @@ TEST(Blind, ConfusionCsvCountsPairVerdictsAsTwoEffects) {
   r.settings.n = 3, r.settings.seed = 11;
   const nlohmann::json j = io::to_json(r);
   EXPECT_EQ(j["settings"]["n"], 3);
+  EXPECT_EQ(j["settings"]["diagnose"]["significance_sigma"], 5.0);
   EXPECT_EQ(j["seed"], 11);
 }

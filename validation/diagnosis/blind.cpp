@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "core/parallel.hpp"
+#include "validation/diagnosis/diagnosis_report.hpp"
 
 namespace vrelab::validation {
 namespace {
@@ -87,14 +88,14 @@ BlindCampaign draw_campaign(int i, std::uint64_t seed, const std::vector<std::st
 }
 
 // Simulates campaign k from its truth and hidden effects, diagnoses it without the key.
-void simulate_and_diagnose(BlindCampaign& k) {
+void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
   const auto t0 = Clock::now();
   try {
     std::mt19937_64 rng(k.seed + 17);
     const plant::PlantConfig truth = random_truth(rng);
     const Campaign camp = simulate_campaign(truth, k.hidden, default_design(), k.seed, 1);
     k.simulate_s = seconds_since(t0);
-    k.diagnosis = diagnose(camp);  // the key (k.hidden) is not passed
+    k.diagnosis = diagnose(camp, settings);  // the key (k.hidden) is not passed
     if (k.category == "single") {
       const EffectModel* e = find_effect(k.hidden[0].name);
       for (const RunRecord& r : camp.runs) {
@@ -165,6 +166,7 @@ bool BlindSettings::IsValid(std::string* why) const {
   std::string w;
   if (n < 1) w = fmt::format("n = {}: at least one campaign", n);
   else if (threads < 0) w = fmt::format("threads = {}: must not be negative (0: all cores)", threads);
+  else if (std::string d; !is_valid(diagnose, &d)) w = "diagnose." + d;
   if (why) *why = w;
   return w.empty();
 }
@@ -181,7 +183,7 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
   std::size_t done = 0;
   const auto n = static_cast<std::size_t>(settings.n);
   core::parallel_for(
-      n, r.threads, [&](std::size_t i) { simulate_and_diagnose(r.campaigns[i]); },
+      n, r.threads, [&](std::size_t i) { simulate_and_diagnose(r.campaigns[i], settings.diagnose); },
       [&](std::size_t) {
         if (progress) progress(++done, n);
       });

@@ -2,7 +2,7 @@
 // validation/diagnosis/blind.hpp -- the blind test of the diagnosis (issue 5; docs/diagnose.md):
 // campaigns simulated with random hidden effects, diagnosed without their keys, then scored.
 //
-// Takes: BlindSettings (how many campaigns, the seed of the draw, threads).
+// Takes: BlindSettings (how many campaigns, the seed of the draw, threads, the diagnosis' settings).
 // Gives: BlindResult: per campaign its key (category, hidden effects), what diagnose called it
 //        and the diagnosis; the scores against the keys (top-1 attribution of single
 //        in-library effects, false alarms on clean campaigns, out-of-library effects called
@@ -30,6 +30,7 @@ struct BlindSettings {
   int n = 40;               // campaigns
   std::uint64_t seed = 7;   // of the draw
   int threads = 0;          // 0: all cores
+  DiagnoseSettings diagnose;  // each campaign's diagnosis
   bool IsValid(std::string* why) const;
 };
 
