@@ -8,6 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "io/diagnosis.hpp"
+#include "validation/diagnosis/blind.hpp"
+
 namespace vrelab::app {
 
 struct IdentifyOptions {
@@ -78,14 +81,14 @@ void run_campaign(const CampaignOptions& o, std::ostream& out);
 
 struct DiagnoseOptions {
   std::string dir, json_path, report_dir;
+  io::DiagnoseOverrides settings;  // over the manifest's [diagnose]
 };
 void run_diagnose(const DiagnoseOptions& o, std::ostream& out);
 
 struct BlindOptions {
-  int n = 40;
-  std::uint64_t seed = 7;
+  validation::BlindSettings settings;
   std::string out_dir = "out/blind";
-  int threads = 0;  // 0: all cores
+  bool progress = true;  // on stderr
 };
 void run_blind(const BlindOptions& o, std::ostream& out);
 

@@ -97,13 +97,21 @@ int main(int argc, char** argv) {
   diagnose->add_option("dir", dg.dir, "Campaign folder (docs/data-format.md)")->required();
   diagnose->add_option("--json", dg.json_path, "Write the diagnosis as JSON");
   diagnose->add_option("--report", dg.report_dir, "Write report.md, report.html and diagnosis.json to this folder");
+  // DiagnoseSettings over the manifest's [diagnose] (docs/data-format.md).
+  diagnose->add_option("--significance-sigma", dg.settings.significance_sigma, "A gap is significant beyond this many sigma (5)");
+  diagnose->add_option("--model-accuracy", dg.settings.model_accuracy, "The simulation's relative accuracy (0.002)");
+  diagnose->add_option("--explained-shrinkage", dg.settings.explained_shrinkage,
+                       "Held-out gap rms share an effect must remove to explain the gap (0.9)");
+  diagnose->add_option("--resimulate-runs", dg.settings.resimulate_runs, "Runs re-simulated on the ODE plant (12; 0: none)");
+  diagnose->add_flag_callback("--no-pairs", [&dg] { dg.settings.try_pairs = false; }, "Do not try two effects at once");
 
   BlindOptions bl;
   auto* blind = app.add_subcommand("blind", "Campaigns with random hidden effects, diagnosed without their keys, then scored");
-  blind->add_option("--n", bl.n, "Number of campaigns")->capture_default_str();
-  blind->add_option("--seed", bl.seed, "Seed of the draw")->capture_default_str();
+  blind->add_option("--n", bl.settings.n, "Number of campaigns")->capture_default_str();
+  blind->add_option("--seed", bl.settings.seed, "Seed of the draw")->capture_default_str();
   blind->add_option("--out", bl.out_dir, "Output folder (scores.json, confusion.csv)")->capture_default_str();
-  blind->add_option("--threads", bl.threads, "Threads (0: all cores)");
+  blind->add_option("--threads", bl.settings.threads, "Threads (0: all cores)");
+  blind->add_flag_callback("--no-progress", [&bl] { bl.progress = false; }, "No progress bar");
 
   try {
     app.parse(argc, argv);

@@ -15,6 +15,7 @@
 #include "io/case_file.hpp"
 #include "io/output.hpp"
 #include "rectification/measurement/series.hpp"
+#include "validation/diagnosis/diagnosis_report.hpp"
 #include "validation/identification/dividing_head.hpp"
 
 namespace vrelab::io {
@@ -155,6 +156,38 @@ int coefficient_index(const std::string& name) {
   return -1;
 }
 
+// The manifest's [diagnose]: DiagnoseSettings by field name, checked.
+void read_diagnose_settings(const toml::table& t, const std::string& file, LabManifest& m) {
+  check_keys(t, "diagnose", {"model_accuracy", "significance_sigma", "explained_shrinkage", "resimulate_runs", "try_pairs"}, file);
+  m.diagnose_given = true;
+  validation::DiagnoseSettings& s = m.diagnose;
+  s.model_accuracy = toml_number(t, "diagnose", "model_accuracy", s.model_accuracy, file);
+  s.significance_sigma = toml_number(t, "diagnose", "significance_sigma", s.significance_sigma, file);
+  s.explained_shrinkage = toml_number(t, "diagnose", "explained_shrinkage", s.explained_shrinkage, file);
+  if (const toml::node* n = t.get("resimulate_runs")) {
+    const auto v = n->value<std::int64_t>();
+    if (!n->is_integer() || *v < 0 || *v > 1000000)
+      throw InputError(fmt::format("{}:{}: [diagnose] resimulate_runs: expected a whole number of runs, 0 to 1000000", file,
+                                   n->source().begin.line));
+    s.resimulate_runs = static_cast<int>(*v);
+  }
+  if (const toml::node* n = t.get("try_pairs")) {
+    if (!n->is_boolean())
+      throw InputError(fmt::format("{}:{}: [diagnose] try_pairs: expected true or false", file, n->source().begin.line));
+    s.try_pairs = n->value<bool>().value();
+  }
+  std::string why;
+  if (!validation::is_valid(s, &why)) throw InputError(file + ": [diagnose] " + why);
+}
+
+// A run's raw record as a CSV of time and output.
+std::string raw_record_csv(const std::string& id, const validation::RawRecord& rec, const std::string& unit) {
+  std::string text =
+      fmt::format("# {} raw record: time in s, output in {}; at rest for t < 0\ntime_s,output_{}\n", id, unit, unit);
+  for (std::size_t i = 0; i < rec.t_s.size(); ++i) text += fmt::format("{:.9g},{:.12g}\n", rec.t_s[i], rec.output[i]);
+  return text;
+}
+
 }  // namespace
 
 validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest_out) {
@@ -166,7 +199,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
   } catch (const toml::parse_error& e) {
     throw InputError(fmt::format("{}:{}: {}", mpath, e.source().begin.line, e.description()));
   }
-  check_keys(root, "", {"campaign", "instrument", "dynamics", "identification", "files"}, mpath);
+  check_keys(root, "", {"campaign", "instrument", "dynamics", "identification", "files", "diagnose"}, mpath);
   validation::Campaign c;
   LabManifest m;
   if (auto* t = root["campaign"].as_table()) {
@@ -209,6 +242,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
         c.fixed[i] = v.value<double>().value();
       }
   }
+  if (auto* t = root["diagnose"].as_table()) read_diagnose_settings(*t, mpath, m);
   std::string static_file = "static.csv", runs_file = "runs.csv";
   if (auto* t = root["files"].as_table()) {
     check_keys(*t, "files", {"static", "runs"}, mpath);
@@ -392,7 +426,15 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
 }
 
 void write_campaign(const std::string& dir, const validation::Campaign& c, const LabManifest& m,
-                    const std::vector<RawSeriesRef>& raw) {
+                    const std::vector<RawSeriesRef>& raw_series) {
+  std::vector<RawSeriesRef> raw = raw_series;
+  if (raw.empty())
+    for (std::size_t k = 0; k < c.raw.size(); ++k) {
+      const validation::RawRecord& rec = c.raw[k];
+      const std::string file = "records/" + c.runs[k].id + ".csv";
+      write_atomic(dir + "/" + file, raw_record_csv(c.runs[k].id, rec, m.output_unit));
+      raw.push_back({file, rec.rest_from_s, rec.rest_to_s, rec.on_from_s, rec.on_to_s});
+    }
   const plant::Dynamics& d = c.dynamics;
   std::string fixed;
   for (int i = 0; i < plant::kNumCoefficients; ++i)

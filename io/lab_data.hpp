@@ -2,7 +2,8 @@
 // io/lab_data.hpp -- the lab data format (docs/data-format.md): a campaign directory.
 //
 //   DIR/manifest.toml  instrument, units, gravity, nominal dynamics, identification's held
-//                      coefficients, the names of the two files below
+//                      coefficients, the names of the two files below, diagnose's
+//                      settings ([diagnose], optional)
 //   DIR/static.csv     the static readings: orientation (a_IA_g, a_PA_g, a_OA_g) or
 //                      (series, angle_deg); output_<unit>; sigma_<unit> (one reading's);
 //                      count (readings averaged; optional, 1)
@@ -28,13 +29,18 @@ struct LabManifest {
   std::string output_unit = "mA";
   double g_m_per_s2 = 9.80665;
   bool dynamics_given = false;  // the manifest has a [dynamics] table
+  // The optional [diagnose] table: DiagnoseSettings' fields by name (model_accuracy,
+  // significance_sigma, explained_shrinkage, resimulate_runs, try_pairs); defaults elsewhere.
+  validation::DiagnoseSettings diagnose;
+  bool diagnose_given = false;
 };
 
 validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest = nullptr);
 
 // Writes manifest.toml, static.csv and runs.csv (summaries). `raw_series`, when non-empty,
 // gives per run a recorded series already written under DIR (file name, rest and on
-// windows) to reference instead of the summary.
+// windows) to reference instead of the summary; else, when the campaign holds raw records
+// (Campaign::raw), they are written as DIR/records/<run id>.csv and referenced.
 struct RawSeriesRef {
   std::string file;
   double rest_from_s = 0, rest_to_s = 0, on_from_s = 0, on_to_s = 0;

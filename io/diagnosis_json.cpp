@@ -1,0 +1,214 @@
+#include "io/diagnosis_json.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "io/output.hpp"
+
+namespace vrelab::io {
+
+using nlohmann::json;
+
+namespace {
+
+json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+json effects_json(const validation::Diagnosis& d) {
+  json effects = json::array();
+  for (const auto& e : d.effects)
+    effects.push_back({{"name", e.name},
+                       {"parameter", e.value},
+                       {"parameter_name", e.parameter},
+                       {"unit", e.unit},
+                       {"sigma", finite_or_null(e.sigma)},
+                       {"evidence", e.evidence},
+                       {"heldout_chi2", e.heldout_chi2},
+                       {"at_bound", e.at_bound}});
+  return effects;
+}
+
+json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
+  json runs = json::array();
+  for (std::size_t k = 0; k < c.runs.size(); ++k) {
+    const auto& r = c.runs[k];
+    const auto& x = d.runs[k];
+    runs.push_back({{"id", r.id},
+                    {"frequency_Hz", r.frequency_Hz},
+                    {"amplitude_g", r.amplitude_g},
+                    {"direction", vec_json(r.direction)},
+                    {"orientation_g", vec_json(r.orientation_g)},
+                    {"measured_g", r.measured_g},
+                    {"sigma_measured_g", r.sigma_g},
+                    {"predicted_g", x.predicted_g},
+                    {"sigma_predicted_g", x.sigma_predicted_g},
+                    {"gap_g", x.gap_g},
+                    {"adjusted_gap_g", x.adjusted_gap_g},
+                    {"z", x.z},
+                    {"heldout_before_g", x.heldout_before_g},
+                    {"heldout_after_g", x.heldout_after_g}});
+  }
+  return runs;
+}
+
+json pairs_json(const validation::Diagnosis& d) {
+  json pairs = json::array();
+  for (const auto& p : d.pairs)
+    pairs.push_back({{"names", {p.a, p.b}},
+                     {"parameters", {p.pa, p.pb}},
+                     {"evidence", p.evidence},
+                     {"heldout_chi2", p.heldout_chi2}});
+  return pairs;
+}
+
+json campaign_row(const validation::BlindCampaign& k) {
+  json h = json::array();
+  for (const auto& x : k.hidden) h.push_back({{"name", x.name}, {"parameter", x.parameter}});
+  json row = {{"index", k.index}, {"seed", k.seed},           {"category", k.category}, {"hidden", h},
+              {"called", k.called}, {"simulate_s", k.simulate_s}, {"wall_s", k.wall_s}};
+  if (k.category == "single") row["effect_max_sigma"] = k.effect_max_sigma;
+  if (k.error.empty()) {
+    row["top"] = k.top;
+    row["top_parameter"] = k.diagnosis.effects.front().value;
+    row["rms_before_g"] = k.diagnosis.rms_before_g, row["rms_after_g"] = k.diagnosis.rms_after_g;
+    row["where"] = k.diagnosis.where;
+  } else {
+    row["error"] = k.error;
+  }
+  return row;
+}
+
+}  // namespace
+
+json to_json(const validation::DiagnoseSettings& s) {
+  return {{"model_accuracy", s.model_accuracy},
+          {"significance_sigma", s.significance_sigma},
+          {"explained_shrinkage", s.explained_shrinkage},
+          {"resimulate_runs", s.resimulate_runs},
+          {"try_pairs", s.try_pairs}};
+}
+
+json to_json(const validation::BlindSettings& s) {
+  return {{"n", s.n}, {"seed", s.seed}, {"threads", s.threads}, {"diagnose", to_json(s.diagnose)}};
+}
+
+json to_json(const plant::Dynamics& d) {
+  return {{"pendulum_frequency_Hz", d.pendulum_frequency_Hz},
+          {"pendulum_damping_ratio", d.pendulum_damping_ratio},
+          {"angle_gain_rad_per_s2_per_g", d.angle_gain_rad_per_s2_per_g},
+          {"loop_bandwidth_Hz", d.loop_bandwidth_Hz},
+          {"phase_margin_deg", d.phase_margin_deg},
+          {"integrator", d.integrator},
+          {"integrator_zero_ratio", d.integrator_zero_ratio}};
+}
+
+json to_json(const validation::Diagnosis& d, const validation::Campaign& c) {
+  json rms_z = json::object();
+  for (const auto& [dir, z] : d.rms_z_by_direction) rms_z[dir] = z;
+  return {{"gap_significant", d.gap_significant},
+          {"verdict", d.verdict},
+          {"chosen", d.chosen},
+          {"pairs", pairs_json(d)},
+          {"explained", d.explained},
+          {"where", d.where},
+          {"folds", d.folds},
+          {"significant_runs", d.significant_runs},
+          {"chi2_nominal", d.chi2_nominal},
+          {"amplitude_power", d.amplitude_power},
+          {"frequency_power", d.frequency_power},
+          {"peak", d.peak},
+          {"rms_z_by_direction", rms_z},
+          {"odd_in_a_IA_fraction", finite_or_null(d.odd_in_a_IA_fraction)},
+          {"effects", effects_json(d)},
+          {"shrinkage",
+           {{"rms_before_g", d.rms_before_g},
+            {"rms_after_g", d.rms_after_g},
+            {"rms_before_sigma", d.rms_before_sigma},
+            {"rms_after_sigma", d.rms_after_sigma},
+            {"fraction_removed", d.rms_before_g > 0 ? 1 - d.rms_after_g / d.rms_before_g : 0.0},
+            {"on", "held-out runs (leave one amplitude out), gap the static test's coefficient errors cannot take up"}}},
+          {"resimulated",
+           {{"runs", d.resimulated_runs},
+            {"rms_without_effect_g", d.resimulated_rms_before_g},
+            {"rms_with_effect_g", d.resimulated_rms_after_g},
+            {"failures", d.resimulation_failures},
+            {"what", "measured - ODE plant (coefficients corrected by all runs under the chosen effect), runs with the "
+                     "largest gaps"}}},
+          {"identified", coefficients_json(d.identified)},
+          {"skipped_runs", c.skipped},
+          {"runs", runs_json(d, c)}};
+}
+
+json to_json(const FolderDiagnosis& f) {
+  const validation::Campaign& c = f.campaign;
+  json j = {{"program", program_record()}, {"command", "diagnose"}, {"data", f.dir}, {"campaign", c.name}};
+  j["nominal_dynamics"] = to_json(c.dynamics);
+  j["nominal_dynamics"]["from"] =
+      f.manifest.dynamics_given ? "the manifest's [dynamics]" : "defaults (the manifest has no [dynamics])";
+  j["settings"] = to_json(f.settings);
+  j["settings"]["from"] = f.settings_from;
+  j["wall_s"] = f.wall_s;
+  j.update(to_json(f.diagnosis, c));
+  j["units"] = {{"gap", "g"}, {"parameter", "see each effect's unit"}};
+  return j;
+}
+
+json to_json(const validation::BlindResult& r) {
+  const validation::BlindScores& s = r.scores;
+  using validation::BlindScores;
+  json rows = json::array();
+  for (const auto& k : r.campaigns) rows.push_back(campaign_row(k));
+  return {{"program", program_record()},
+          {"command", "blind"},
+          {"settings", to_json(r.settings)},
+          {"n", r.settings.n},
+          {"seed", r.settings.seed},
+          {"wall_s", r.wall_s},
+          {"threads", r.threads},
+          {"top1_accuracy", BlindScores::rate(s.single_right, s.single)},
+          {"single_effect_campaigns", s.single},
+          {"single_effect_campaigns_below_5_sigma", s.small},
+          {"single_below_5_sigma_explained_right", s.small_right},
+          {"top_ranked_right_whatever_the_verdict", BlindScores::rate(s.single_top_right, s.single)},
+          {"false_alarm_rate", BlindScores::rate(s.false_alarms, s.clean)},
+          {"clean_campaigns", s.clean},
+          {"unexplained_recognition", BlindScores::rate(s.out_of_library_unexplained, s.out_of_library)},
+          {"out_of_library_campaigns", s.out_of_library},
+          {"two_effect_explained_by_one_of_them", BlindScores::rate(s.two_by_one, s.two)},
+          {"two_effect_explained_by_both", BlindScores::rate(s.two_by_both, s.two)},
+          {"two_effect_campaigns", s.two},
+          {"median_shrinkage", s.median_shrinkage},
+          {"median_shrinkage_in_sigma", s.median_shrinkage_in_sigma},
+          {"wrong", r.wrong},
+          {"confusion", r.confusion},
+          {"campaigns", rows}};
+}
+
+std::string confusion_csv(const validation::BlindResult& r) {
+  std::vector<std::string> called_names = {"clean"};
+  for (const auto& n : r.library) called_names.push_back(n);
+  called_names.push_back("two_effects");  // any "A + B" verdict
+  called_names.push_back("unexplained");
+  std::string csv = "# rows: the hidden truth; columns: what diagnose called it (without the key)\ntruth";
+  for (const auto& n : called_names) csv += "," + n;
+  csv += "\n";
+  std::vector<std::string> truths = {"clean"};
+  for (const auto& n : r.library) truths.push_back(n);
+  truths.push_back("out_of_library");
+  truths.push_back("two");
+  for (const auto& t : truths) {
+    csv += t;
+    const auto row = r.confusion.find(t);
+    for (const auto& n : called_names) {
+      int count = 0;
+      if (row != r.confusion.end())
+        for (const auto& [called, k] : row->second)
+          if (called == n || (n == "two_effects" && called.find(" + ") != std::string::npos)) count += k;
+      csv += fmt::format(",{}", count);
+    }
+    csv += "\n";
+  }
+  return csv;
+}
+
+}  // namespace vrelab::io

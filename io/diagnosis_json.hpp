@@ -1,0 +1,28 @@
+#pragma once
+// io/diagnosis_json.hpp -- the JSON and CSV forms of the diagnosis stage's results, shared by
+// the CLI and the library's other users. Every result carries the settings that made it.
+//
+//   to_json(FolderDiagnosis)   `diagnose --json`: program, data, campaign, nominal dynamics,
+//                              settings, the diagnosis (per effect, pair and run), units
+//   to_json(BlindResult)       `blind`'s scores.json: settings, scores, confusion, campaigns
+//   confusion_csv(BlindResult) `blind`'s confusion.csv: rows the truth, columns what was called
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "io/diagnosis.hpp"
+#include "validation/diagnosis/blind.hpp"
+#include "validation/diagnosis/diagnose.hpp"
+
+namespace vrelab::io {
+
+nlohmann::json to_json(const validation::DiagnoseSettings& s);
+nlohmann::json to_json(const validation::BlindSettings& s);
+nlohmann::json to_json(const plant::Dynamics& d);
+// The diagnosis of campaign c (same runs, same order): gap, effects, pairs, shrinkage, runs.
+nlohmann::json to_json(const validation::Diagnosis& d, const validation::Campaign& c);
+nlohmann::json to_json(const FolderDiagnosis& f);
+nlohmann::json to_json(const validation::BlindResult& r);
+std::string confusion_csv(const validation::BlindResult& r);
+
+}  // namespace vrelab::io

@@ -1,0 +1,90 @@
+#pragma once
+// validation/diagnosis/blind.hpp -- the blind test of the diagnosis (issue 5; docs/diagnose.md):
+// campaigns simulated with random hidden effects, diagnosed without their keys, then scored.
+//
+// Takes: BlindSettings (how many campaigns, the seed of the draw, threads, the diagnosis' settings).
+// Gives: BlindResult: per campaign its key (category, hidden effects), what diagnose called it
+//        and the diagnosis; the scores against the keys (top-1 attribution of single
+//        in-library effects, false alarms on clean campaigns, out-of-library effects called
+//        unexplained, two-effect campaigns, the median held-out shrinkage), the confusion
+//        matrix, and the campaigns scored wrong with why. The draw depends on the seed only:
+//        campaign i is seeded seed * 1000003 + i whatever the threads.
+//
+// The mix, per 10 campaigns: 2 clean, 1 out of library (shaker_third_harmonic, or
+// readout_clipping every other ten), 1 with two library effects, 6 with one library effect.
+// A single effect whose own gap (the first-order simulation with it - without it, on the
+// truth's coefficients) stays below 5 sigma in every run is reported, not scored.
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "validation/diagnosis/campaign.hpp"
+#include "validation/diagnosis/diagnose.hpp"
+
+namespace vrelab::validation {
+
+struct BlindSettings {
+  int n = 40;               // campaigns
+  std::uint64_t seed = 7;   // of the draw
+  int threads = 0;          // 0: all cores
+  DiagnoseSettings diagnose;  // each campaign's diagnosis
+  bool IsValid(std::string* why) const;
+};
+
+// One blind campaign: its key, and what the diagnosis made of it without the key.
+struct BlindCampaign {
+  int index = 0;
+  std::uint64_t seed = 0;
+  std::string category;  // clean, single, two, out_of_library
+  std::vector<HiddenEffect> hidden;
+  Diagnosis diagnosis;
+  std::string error;     // the simulation or diagnosis failed: why ("" otherwise)
+  std::string called;    // clean, <effect>, "<A> + <B>", unexplained, or error
+  std::string top;       // the effect ranked first ("" on error)
+  double simulate_s = 0, wall_s = 0;  // the campaign's simulation; with its diagnosis
+  // A single effect's own gap: the largest |simulation with it - without it| over the runs
+  // (the first-order model on the truth's coefficients), in that run's sigma. Top-1 is scored
+  // on those >= 5 sigma somewhere. (The static test's coefficient errors can still take up
+  // most of such a gap; V's diagonal is the wrong yardstick for it: the diagnosis sees effects
+  // through the runs' correlations.)
+  double effect_max_sigma = 0;
+};
+
+struct BlindScores {
+  int single = 0, single_right = 0;  // scored single in-library effects; called right ("explained by" it)
+  int single_top_right = 0;          // ... ranked first whatever the verdict
+  int small = 0, small_right = 0;    // single effects below 5 sigma in every run (not scored); called right anyway
+  int clean = 0, false_alarms = 0;
+  int out_of_library = 0, out_of_library_unexplained = 0;
+  int two = 0, two_by_one = 0, two_by_both = 0;
+  double median_shrinkage = 0, median_shrinkage_in_sigma = 0;  // held-out gap rms, single effects
+  static double rate(int k, int of) { return of ? static_cast<double>(k) / of : 0.0; }
+};
+
+struct BlindResult {
+  BlindSettings settings;
+  int threads = 1;    // used
+  double wall_s = 0;
+  std::vector<std::string> library;  // the effect library's names (the confusion matrix's order)
+  std::vector<BlindCampaign> campaigns;
+  BlindScores scores;
+  std::map<std::string, std::map<std::string, int>> confusion;  // truth -> called -> count
+  std::vector<std::string> wrong;  // campaigns scored wrong (and single effects not scored), with why
+
+  // "blind --n N --seed S: W s wall on T threads" and the scores (no program name: the CLI
+  // puts it first); FullReport adds the campaigns scored wrong.
+  std::string BriefReport() const;
+  std::string FullReport() const;
+};
+
+// Called after each campaign (under the pool's lock): campaigns done, of total.
+using BlindProgress = std::function<void(std::size_t done, std::size_t total)>;
+
+// Invalid settings throw std::invalid_argument naming the key. A campaign whose simulation or
+// diagnosis fails is kept with its error (called "error").
+BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progress = {});
+
+}  // namespace vrelab::validation

@@ -1,0 +1,56 @@
+#include "validation/diagnosis/diagnosis_report.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+namespace vrelab::validation {
+namespace {
+
+std::string heldout_line(const Diagnosis& d, double wall_s) {
+  return fmt::format("Held-out gap rms: {:.4g} ug ({:.3g} sigma) before, {:.4g} ug ({:.3g} sigma) after {}{}\n",
+                     d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, d.chosen,
+                     wall_s >= 0 ? fmt::format(" ({:.1f} s wall)", wall_s) : "");
+}
+
+}  // namespace
+
+bool is_valid(const DiagnoseSettings& s, std::string* why) {
+  std::string w;
+  if (!(std::isfinite(s.model_accuracy) && s.model_accuracy >= 0 && s.model_accuracy < 1))
+    w = fmt::format("model_accuracy = {}: the simulation's relative accuracy must be in [0, 1)", s.model_accuracy);
+  else if (!(std::isfinite(s.significance_sigma) && s.significance_sigma > 0))
+    w = fmt::format("significance_sigma = {}: must be a positive number of sigma", s.significance_sigma);
+  else if (!(s.explained_shrinkage > 0 && s.explained_shrinkage <= 1))
+    w = fmt::format("explained_shrinkage = {}: a fraction of the held-out gap rms, in (0, 1]", s.explained_shrinkage);
+  else if (s.resimulate_runs < 0)
+    w = fmt::format("resimulate_runs = {}: must not be negative (0: none)", s.resimulate_runs);
+  if (why) *why = w;
+  return w.empty();
+}
+
+std::string brief_report(const Diagnosis& d, const Campaign&) {
+  return "Verdict: " + d.verdict + "\n" + heldout_line(d, -1);
+}
+
+std::string full_report(const Diagnosis& d, const Campaign&, double wall_s) {
+  std::string t = "Gap: " + d.where + "\n";
+  t += "Cross-validation: " + d.folds + "\n";
+  t += "Verdict: " + d.verdict + "\n";
+  t += fmt::format("  {:<26}{:>16}{:>12}{:>12}{:>14}\n", "effect", "parameter", "sigma", "evidence", "held-out chi2");
+  for (const auto& e : d.effects)
+    t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}{:>12.1f}{:>14.1f}  {} ({})\n", e.name, e.value, e.sigma, e.evidence,
+                     e.heldout_chi2, e.parameter, e.unit);
+  for (const auto& p : d.pairs)
+    t += fmt::format("  pair {:<40}{:>12.5g},{:<12.5g}{:>12.1f}{:>14.1f}\n", p.a + " + " + p.b, p.pa, p.pb, p.evidence,
+                     p.heldout_chi2);
+  t += heldout_line(d, wall_s);
+  if (d.resimulated_runs > 0)
+    t += fmt::format("Re-simulated on the ODE plant ({} runs with the largest gaps): rms {:.4g} ug without {}, {:.4g} ug "
+                     "with it\n",
+                     d.resimulated_runs, d.resimulated_rms_before_g * 1e6, d.chosen, d.resimulated_rms_after_g * 1e6);
+  for (const auto& f : d.resimulation_failures) t += "  re-simulation failed: " + f + "\n";
+  return t;
+}
+
+}  // namespace vrelab::validation
