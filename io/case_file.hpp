@@ -63,18 +63,6 @@ struct ShakerSpec {
   bool imperfect() const { return transverse || !harmonics.empty() || rocking; }
 };
 
-// The [reproduce] table: the shaker runs of `vrelab reproduce` (validation/reproduce/reproduce.hpp).
-struct ReproduceSpec {
-  double frequency_Hz = 20.0;
-  std::vector<double> amplitudes_g;
-  std::vector<validation::NamedVector> directions, orientations;
-  std::size_t confirmation_orientation = 0, confirmation_direction = 0;  // indices
-  double confirmation_amplitude_g = 3.0, confirmation_record_s = 2.0;
-  std::vector<double> departure_frequencies_Hz;
-  double invisible_shift_per_g = 0.0;
-  int threads = 0;
-};
-
 // The [campaign] table: what `vrelab campaign` hides in the truth and how the lab tests it.
 struct CampaignSpec {
   std::vector<validation::HiddenEffect> hidden;
@@ -105,7 +93,9 @@ struct Case {
   std::optional<rectification::SweepGrid> sweep;  // [sweep]
   std::optional<rectification::FrequencyStudySettings> frequency_study;  // [frequency_study]
   int sweep_threads = 0;                          // 0: all cores
-  std::optional<ReproduceSpec> reproduce;         // [reproduce]
+  // [reproduce] with the static test ([dividing_head], [identification] fixed), the seed and
+  // [shake]/[readout]: the whole configuration of `vrelab reproduce`.
+  std::optional<validation::ReproduceSettings> reproduce;
   std::optional<CampaignSpec> campaign;           // [campaign]
 };
 

@@ -5,7 +5,7 @@
 //        x directions (unit vectors in sensor axes; the vibration is amplitude * direction,
 //        in phase) x static orientations (gravity in sensor axes, g).
 // Gives: one SweepRow per condition (measured error, sigma, eq. (3) prediction), computed
-//        on `threads` threads; conditions listed in `skip` (already on disk) are not run.
+//        on `threads` threads (0: all cores, core::parallel_for); conditions listed in `skip` (already on disk) are not run.
 //        A solver failure in one condition is recorded in its row (ok = false, message
 //        naming the call and the simulated time); the others go on. With a readout, the
 //        noise of condition i is drawn from seed readout.seed + i (independent runs).
