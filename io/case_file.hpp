@@ -20,6 +20,7 @@
 #include "rectification/simulation/shake.hpp"
 #include "rectification/prediction/frequency_study.hpp"
 #include "rectification/simulation/sweep.hpp"
+#include "rectification/simulation/table_motion.hpp"
 #include "validation/identification/dividing_head.hpp"
 #include "validation/identification/identification.hpp"
 #include "validation/diagnosis/campaign.hpp"
@@ -43,24 +44,18 @@ struct DividingHead {
   bool from_ode = false;    // source = "ode": readings from the ODE plant, else model (1)
 };
 
-// The [vibration] table. type: sine | random | sine_on_random | swept_sine.
-struct VibrationSpec {
-  std::string type;
-  vibration::SineVibration sine;                       // sine, sine_on_random
+// The [vibration] table. type: sine | random | sine_on_random | swept_sine. The request a
+// shaker run builds its table motion from (rectification/simulation/table_motion.hpp), and
+// what eq. (3) needs.
+struct VibrationSpec : rectification::VibrationRequest {
   std::optional<vibration::RandomVibration> gaussian;  // random, sine_on_random (from rms_g or the PSD)
-  std::optional<vibration::RandomProfile> psd;         // PSD tables: needed to shake random profiles
-  std::optional<vibration::SweptSine> swept;
   double duration_s = 10.0;  // measuring time of a non-periodic run
   int line = 0;              // of the [vibration] table, for messages
 };
 
 // The [shaker] table: limits and imperfections, each off unless given.
-struct ShakerSpec {
+struct ShakerSpec : rectification::ShakerImperfections {
   vibration::ShakerLimits limits;
-  std::optional<vibration::TransverseSpec> transverse;
-  std::vector<vibration::Harmonic> harmonics;
-  std::optional<vibration::RockingSpec> rocking;
-  bool imperfect() const { return transverse || !harmonics.empty() || rocking; }
 };
 
 // The [campaign] table: what `vrelab campaign` hides in the truth and how the lab tests it.

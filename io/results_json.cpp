@@ -1,5 +1,7 @@
 #include "io/results_json.hpp"
 
+#include <numbers>
+
 #include "io/output.hpp"
 
 namespace vrelab::io {
@@ -77,6 +79,217 @@ json reproduce_settings_json(const validation::ReproduceSettings& s) {
           {"departure_frequencies_Hz", s.departure_frequencies_Hz},
           {"invisible_shift_per_g", s.invisible_shift_per_g},
           {"threads", s.threads}};
+}
+
+json vibration_json(const VibrationSpec& v) {
+  json j = {{"type", v.type}};
+  if (v.type != "random") {
+    j["amplitude_g"] = vec_json(v.sine.amplitude_g);
+    j["phase_deg"] = vec_json(v.sine.phase_rad * 180 / std::numbers::pi);
+    j["frequency_Hz"] = v.sine.frequency_Hz > 0 ? json(v.sine.frequency_Hz) : json(nullptr);
+  }
+  if (v.gaussian) {
+    j["rms_g"] = vec_json(v.gaussian->rms_g);
+    const Eigen::Matrix3d cov = v.gaussian->covariance_g2();
+    json cj = json::array();
+    for (int i = 0; i < 3; ++i) cj.push_back(vec_json(cov.row(i).transpose()));
+    j["covariance_g2"] = cj;
+  }
+  if (v.psd || v.swept) j["duration_s"] = v.duration_s;
+  return j;
+}
+
+namespace {
+
+json array_json(const validation::CoefArray& a, const validation::CoefFlags& available) {
+  plant::Coefficients k;
+  k.v = a;
+  return coefficients_json(k, &available);
+}
+
+void identify_methods_json(json& j, const plant::Coefficients& truth, const validation::StaticTestReport& r) {
+  j["estimates"] = {{"paper_printed", nullptr}, {"paper_corrected", nullptr}, {"least_squares", nullptr}};
+  j["errors"] = j["estimates"];
+  j["sigma"] = j["estimates"];
+  j["bias_first_order"] = j["estimates"];
+  j["given"] = j["estimates"];
+  for (const auto& m : r.methods) {
+    j["estimates"][m.name] = coefficients_json(m.estimate.value, &m.estimate.available);
+    validation::CoefArray err{}, sigma = m.first_order.sigma, bias = m.first_order.bias;
+    json given = json::array();
+    for (int i = 0; i < kNumCoefficients; ++i) {
+      err[i] = m.estimate.value[i] - truth[i];
+      if (m.estimate.assumed[i]) {
+        sigma[i] = bias[i] = 0.0;
+        given.push_back(std::string(plant::coefficient_name(i)));
+      }
+    }
+    j["errors"][m.name] = array_json(err, m.estimate.available);
+    j["sigma"][m.name] = array_json(sigma, m.estimate.available);
+    j["bias_first_order"][m.name] = array_json(bias, m.estimate.available);
+    j["given"][m.name] = given;
+    if (m.monte_carlo) {
+      j["monte_carlo"][m.name] = {{"trials", m.monte_carlo->n},
+                                  {"std", array_json(m.monte_carlo->std, m.estimate.available)},
+                                  {"mean_error", array_json(m.monte_carlo->mean_error, m.estimate.available)}};
+    }
+  }
+}
+
+json identifiability_json(const Case& c, const IdentifyStudy& s) {
+  const auto& id = s.report.identifiability;
+  json free = json::array(), identifiable = json::object();
+  for (int i = 0; i < kNumCoefficients; ++i)
+    if (id.free[i]) {
+      free.push_back(std::string(plant::coefficient_name(i)));
+      identifiable[std::string(plant::coefficient_name(i))] = static_cast<bool>(id.identifiable[i]);
+    }
+  json fixed = json::object();
+  for (int i = 0; i < kNumCoefficients; ++i)
+    if (c.fixed[i]) fixed[std::string(plant::coefficient_name(i))] = *c.fixed[i];
+  return {{"parameters", id.parameters},
+          {"rank", id.rank},
+          {"condition_number", s.position_set.condition_number},
+          {"condition_number_weighted", id.condition_number},
+          {"free", free},
+          {"fixed", fixed},
+          {"identifiable", identifiable},
+          {"confounded", id.confounded}};
+}
+
+}  // namespace
+
+json identify_json(const Case& c, const IdentifyStudy& s) {
+  const DividingHead& head = *c.dividing_head;
+  const int mc = s.settings.monte_carlo_trials;
+  json j = result_record("identify", c);
+  j["settings"] = {{"monte_carlo_trials", mc},
+                   {"monte_carlo_seed", mc > 0 ? json(c.seed + 1) : json(nullptr)},
+                   {"least_squares_weights", "1 / first-order variance of each reading"},
+                   {"rank_tolerance", 1e-10}};
+  json units = json::object();
+  for (int i = 0; i < kNumCoefficients; ++i) units[std::string(plant::coefficient_name(i))] = unit_of(i, c);
+  j["units"] = units;
+  j["truth"] = coefficients_json(*c.coefficients);
+  identify_methods_json(j, *c.coefficients, s.report);
+  j["identifiability"] = identifiability_json(c, s);
+  j["notes"] = s.report.notes;
+  json readings = json::array();
+  for (const auto& rd : s.report.readings) {
+    const auto& p = head.positions[static_cast<std::size_t>(rd.position)];
+    readings.push_back({{"position", rd.position},
+                        {"series", p.series},
+                        {"angle_deg", p.angle_rad * 180 / std::numbers::pi},
+                        {"a_nominal_g", vec_json(p.nominal_g)},
+                        {"output", rd.output}});
+  }
+  j["readings"] = readings;
+  j["readings_unit"] = c.output_unit;
+  j["readings_source"] = head.from_ode ? "ode" : "model";
+  return j;
+}
+
+json predict_json(const Case& c, const PredictStudy& s) {
+  const auto terms_json = [&](const rectification::Eq3Terms& terms) {
+    json tj = json::object();
+    for (int t = 0; t < rectification::kNumTerms; ++t) {
+      if (t == rectification::t_clipping && !c.range_limit_g) continue;
+      tj[std::string(rectification::term_name(t))] = terms.g[t];
+    }
+    return tj;
+  };
+  json j = result_record("predict", c);
+  j["settings"] = {{"model", "eq3_corrected_quasi_static"},
+                   {"frequency_dependent", s.at_frequency.has_value()},
+                   {"range_limit_g", c.range_limit_g ? json(*c.range_limit_g) : json(nullptr)}};
+  j["model"] = "eq3_corrected_quasi_static";
+  j["orientation_g"] = vec_json(*c.orientation_g);
+  j["vibration"] = vibration_json(*c.vibration);
+  j["range_limit_g"] = c.range_limit_g ? json(*c.range_limit_g) : json(nullptr);
+  j["total_g"] = s.terms.total_g();
+  j["terms"] = terms_json(s.terms);
+  j["omitted_by_paper_g"] = s.terms.omitted_by_paper_g();
+  j["paper_printed_total_g"] = s.printed_g ? json(*s.printed_g) : json(nullptr);
+  if (s.at_frequency) {
+    const rectification::FrequencyPrediction& fp = *s.at_frequency;
+    json ft = terms_json(fp.terms);
+    ft["pickoff_nonlinearity"] = fp.pickoff_g;
+    ft["pendulum_geometry"] = fp.pendulum_geometry_g;
+    j["frequency_dependent"] = {{"frequency_Hz", c.vibration->sine.frequency_Hz},
+                                {"total_g", fp.total_g()},
+                                {"terms", ft},
+                                {"current_amplitude_g", std::abs(fp.current_amplitude_g)},
+                                {"angle_amplitude_rad", std::abs(fp.angle_amplitude_rad)},
+                                {"plant", plant_json(c.plant, c.physical.has_value())}};
+  }
+  j["units"] = {{"total_g", "g"}, {"terms", "g"}};
+  return j;
+}
+
+json shake_json(const Case& c, const ShakeStudy& s) {
+  const rectification::ShakeResult& r = s.result;
+  const vibration::ShakerDemand& demand = s.table.demand;
+  json j = result_record("shake", c);
+  j["measured_g"] = r.measured_g;
+  j["sigma_g"] = r.sigma_g;
+  j["predicted_eq3_g"] = s.predicted_g;
+  j["integral_slope_g"] = r.integral_slope_g;
+  j["baseline_g"] = r.baseline_g;
+  j["plant"] = plant_json(c.plant, c.physical.has_value());
+  j["vibration"] = vibration_json(*c.vibration);
+  j["vibration"]["description"] = s.table.motion->describe();
+  j["shaker_demand"] = {{"acceleration_rms_g", vec_json(demand.acceleration_rms_g)},
+                        {"acceleration_peak_g", vec_json(demand.acceleration_peak_g)},
+                        {"velocity_peak_m_per_s", vec_json(demand.velocity_peak_m_per_s)},
+                        {"displacement_peak_m", vec_json(demand.displacement_peak_m)},
+                        {"stroke_peak_to_peak_m", demand.table_stroke_peak_to_peak_m()}};
+  j["measurement"] = {{"method", r.method},
+                      {"settle_s", r.settle_s},
+                      {"slowest_time_constant_s", r.slowest_time_constant_s},
+                      {"periods", r.periods},
+                      {"samples", r.samples},
+                      {"sample_rate_Hz", r.sample_rate_Hz}};
+  j["settings"] = shake_settings_json(c.shake);
+  j["solver_stats"] = {{"steps", r.steps}, {"rhs_evaluations", r.rhs_evaluations}, {"wall_s", s.wall_s}};
+  j["units"] = {{"measured_g", "g"}, {"sigma_g", "g"}, {"predicted_eq3_g", "g"}};
+  return j;
+}
+
+json measure_json(const MeasureStudy& s) {
+  const rectification::SeriesWindows& w = s.windows;
+  const rectification::SeriesResult& r = s.result;
+  json j;
+  j["program"] = program_record();
+  j["command"] = "measure";
+  j["settings"] = series_windows_json(w);
+  j["series"] = {{"file", s.path}, {"column", s.column}, {"K1", w.K1}};
+  j["windows"] = {{"baseline_s", {w.baseline_from_s, w.baseline_to_s}},
+                  {"on_s", {w.on_from_s, r.on_to_used_s}},
+                  {"frequency_Hz", w.frequency_Hz > 0 ? json(w.frequency_Hz) : json(nullptr)},
+                  {"blocks", w.blocks}};
+  j["measured_g"] = r.measured_g;
+  j["sigma_g"] = r.sigma_g;
+  j["integral_slope_g"] = r.integral_slope_g;
+  j["baseline_g"] = r.baseline_g;
+  j["samples"] = {{"on", r.samples_on}, {"baseline", r.samples_baseline}};
+  j["sample_rate_Hz"] = r.sample_rate_Hz;
+  return j;
+}
+
+json frequency_json(const Case& c, const FrequencyStudy& s) {
+  json table = json::array();
+  for (const auto& m : s.curves)
+    table.push_back({{"mechanism", m.name},
+                     {"eq3_g", m.eq3_g},
+                     {"off_1_percent_Hz", m.off_1_percent_Hz ? json(*m.off_1_percent_Hz) : json(nullptr)},
+                     {"off_10_percent_Hz", m.off_10_percent_Hz ? json(*m.off_10_percent_Hz) : json(nullptr)},
+                     {"worst_ode_deviation", m.worst_ode_deviation}});
+  json j = result_record("frequency", c);
+  j["plant"] = plant_json(c.plant, c.physical.has_value());
+  j["settings"] = frequency_study_settings_json(s.settings);
+  j["table"] = table;
+  j["units"] = {{"eq3_g", "g"}, {"off_1_percent_Hz", "Hz"}};
+  return j;
 }
 
 json run_json(const RunResult& r) {

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/case_file.hpp"
+#include "io/studies.hpp"
 #include "rectification/measurement/series.hpp"
 #include "rectification/prediction/frequency_study.hpp"
 #include "rectification/simulation/shake.hpp"
@@ -22,6 +23,15 @@ nlohmann::json sweep_grid_json(const rectification::SweepGrid& g);
 nlohmann::json frequency_study_settings_json(const rectification::FrequencyStudySettings& s);
 nlohmann::json series_windows_json(const rectification::SeriesWindows& w);
 nlohmann::json reproduce_settings_json(const validation::ReproduceSettings& s);
+
+// ---- the commands' results (each with its "settings")
+nlohmann::json identify_json(const Case& c, const IdentifyStudy& s);
+nlohmann::json predict_json(const Case& c, const PredictStudy& s);
+nlohmann::json shake_json(const Case& c, const ShakeStudy& s);
+nlohmann::json measure_json(const MeasureStudy& s);
+nlohmann::json frequency_json(const Case& c, const FrequencyStudy& s);
+// The [vibration] table as recorded in predict's and shake's results.
+nlohmann::json vibration_json(const VibrationSpec& v);
 
 // ---- reproduce
 nlohmann::json run_json(const validation::RunResult& r);

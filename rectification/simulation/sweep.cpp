@@ -22,6 +22,21 @@ vibration::SineVibration SweepCondition::vibration() const {
   return v;
 }
 
+bool SweepGrid::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (size() == 0) return fail("the grid is empty (frequencies, amplitudes, directions and orientations each need one)");
+  for (double f : frequencies_Hz)
+    if (!(f > 0)) return fail("frequencies must be positive");
+  for (double a : amplitudes_g)
+    if (!(a > 0)) return fail("amplitudes_g: amplitudes must be positive");
+  for (const Vec3& d : directions)
+    if (!(d.norm() > 0)) return fail("directions: a direction must not be zero");
+  return true;
+}
+
 SweepCondition sweep_condition(const SweepGrid& g, std::size_t index) {
   if (index >= g.size()) throw std::out_of_range("sweep condition index");
   SweepCondition c;

@@ -28,6 +28,9 @@ struct SweepGrid {
   std::size_t size() const {
     return frequencies_Hz.size() * amplitudes_g.size() * directions.size() * orientations_g.size();
   }
+  // False (with the reason, naming the list, in *why) for an empty grid, a frequency or an
+  // amplitude that is not positive, or a zero direction.
+  bool IsValid(std::string* why) const;
 };
 
 struct SweepCondition {
