@@ -20,14 +20,9 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
   require(c, c.dividing_head.has_value(), "dividing_head", "reproduce");
   require(c, c.reproduce.has_value(), "reproduce", "reproduce");
   if (c.physical) throw InputError(c.path + ": reproduce takes a plant built from coefficients ([plant] type = \"from_coefficients\")");
-  const validation::Identifiability ident = validation::identifiability(c.dividing_head->positions, c.fixed);
-  if (!ident.full_rank())
-    throw InputError(fmt::format("{}: [dividing_head] with [identification] fixed: rank {} of {}; fix more coefficients "
-                                 "(the paper fixes k1_asym, k_PP and k_OO)",
-                                 c.path, ident.rank, ident.parameters));
   validation::ReproduceSettings s = *c.reproduce;
   if (o.threads >= 0) s.threads = o.threads;
-  if (std::string why; !s.IsValid(&why)) throw InputError(c.path + ": [reproduce]: " + why);
+  if (std::string why; !s.IsValid(&why)) throw InputError(c.path + ": " + why);
   const std::string& dir = o.out_dir;
   const auto start = std::chrono::steady_clock::now();
   out << fmt::format("vrelab {} ({}) reproduce {}  [seed {}] -> {}\n", kProgramVersion, kGitDescribe, c.path, c.seed, dir);

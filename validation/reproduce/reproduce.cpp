@@ -145,20 +145,23 @@ bool ReproduceSettings::IsValid(std::string* why) const {
     return false;
   };
   if (amplitudes_g.empty() || directions.empty() || orientations.empty())
-    return fail("the amplitude study needs amplitudes, directions and orientations");
-  if (positions.empty()) return fail("the static test needs positions");
-  if (!(frequency_Hz > 0)) return fail("frequency_Hz must be positive");
+    return fail("[reproduce] amplitudes_g, directions, orientations_g: the amplitude study needs each");
+  if (!(frequency_Hz > 0)) return fail("[reproduce] frequency_Hz: must be positive");
   for (double a : amplitudes_g)
-    if (!(a > 0)) return fail("amplitudes_g: amplitudes must be positive");
+    if (!(a > 0)) return fail("[reproduce] amplitudes_g: amplitudes must be positive");
   for (double f : departure_frequencies_Hz)
-    if (!(f > 0)) return fail("departure_frequencies_Hz: frequencies must be positive");
-  if (!(confirmation_amplitude_g > 0)) return fail("confirmation amplitude_g must be positive");
-  if (!(confirmation_record_s > 0)) return fail("confirmation record_s must be positive");
-  if (!(confirmation_direction.v.norm() > 0)) return fail("the confirmation direction is not set");
-  if (!std::isfinite(invisible_shift_per_g)) return fail("invisible_shift_per_g must be finite");
-  if (threads < 0) return fail("threads must not be negative");
-  std::string shake_why;
-  if (!shake.IsValid(&shake_why)) return fail("[shake] " + shake_why);
+    if (!(f > 0)) return fail("[reproduce] departure_frequencies_Hz: frequencies must be positive");
+  if (!(confirmation_amplitude_g > 0)) return fail("[reproduce.confirmation] amplitude_g: must be positive");
+  if (!(confirmation_record_s > 0)) return fail("[reproduce.confirmation] record_s: must be positive");
+  if (!(confirmation_direction.v.norm() > 0)) return fail("[reproduce.confirmation] direction: not set");
+  if (!std::isfinite(invisible_shift_per_g)) return fail("[reproduce] invisible_shift_per_g: must be finite");
+  if (threads < 0) return fail("[reproduce] threads: must not be negative");
+  if (std::string w; !shake.IsValid(&w)) return fail("[shake] " + w);
+  if (positions.empty()) return fail("[dividing_head]: the static test needs positions");
+  const Identifiability ident = identifiability(positions, fixed);
+  if (!ident.full_rank())
+    return fail("[dividing_head] with [identification] fixed: rank " + std::to_string(ident.rank) + " of " +
+                std::to_string(ident.parameters) + "; fix more coefficients (the paper fixes k1_asym, k_PP and k_OO)");
   return true;
 }
 
