@@ -20,7 +20,7 @@
 #include "rectification/simulation/shake.hpp"
 #include "rectification/prediction/frequency_study.hpp"
 #include "rectification/simulation/sweep.hpp"
-#include "rectification/simulation/table_motion.hpp"
+#include "rectification/simulation/shaker_motion.hpp"
 #include "validation/identification/dividing_head.hpp"
 #include "validation/identification/identification.hpp"
 #include "validation/diagnosis/campaign.hpp"
@@ -45,7 +45,7 @@ struct DividingHead {
 };
 
 // The [vibration] table. type: sine | random | sine_on_random | swept_sine. The request a
-// shaker run builds its table motion from (rectification/simulation/table_motion.hpp), and
+// shaker run builds its table motion from (rectification/simulation/shaker_motion.hpp), and
 // what eq. (3) needs.
 struct VibrationSpec : rectification::VibrationRequest {
   std::optional<vibration::RandomVibration> gaussian;  // random, sine_on_random (from rms_g or the PSD)

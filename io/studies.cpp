@@ -241,11 +241,11 @@ std::string predict_report(const Case& c, const PredictStudy& s) {
 namespace {
 
 // The table's motion and what the shaker and the readout can do with it.
-rectification::TableMotion shake_motion(const Case& c) {
+rectification::ShakerMotion shake_motion(const Case& c) {
   const VibrationSpec& vs = *c.vibration;
-  rectification::TableMotion t;
+  rectification::ShakerMotion t;
   try {
-    t = rectification::table_motion(vs, c.shaker, *c.orientation_g, c.g_m_per_s2, c.seed);
+    t = rectification::shaker_motion(vs, c.shaker, *c.orientation_g, c.g_m_per_s2, c.seed);
   } catch (const std::invalid_argument& e) {
     throw InputError(c.path + ": [vibration]/[shaker]: " + e.what());
   }

@@ -19,7 +19,7 @@
 #include "rectification/prediction/frequency.hpp"
 #include "rectification/prediction/frequency_study.hpp"
 #include "rectification/simulation/shake.hpp"
-#include "rectification/simulation/table_motion.hpp"
+#include "rectification/simulation/shaker_motion.hpp"
 #include "validation/identification/static_test.hpp"
 
 namespace vrelab::io {
@@ -51,7 +51,7 @@ std::string predict_report(const Case& c, const PredictStudy& s);
 
 // ---- shake: one run on the virtual shaker.
 struct ShakeStudy {
-  rectification::TableMotion table;
+  rectification::ShakerMotion table;
   rectification::ShakeResult result;
   double predicted_g = 0;  // eq. (3) corrected, the truth's coefficients
   double wall_s = 0;

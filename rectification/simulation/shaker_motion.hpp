@@ -1,5 +1,5 @@
 #pragma once
-// rectification/simulation/table_motion.hpp -- the shaker table's motion for a run on the
+// rectification/simulation/shaker_motion.hpp -- the shaker table's motion for a run on the
 // virtual shaker: the commanded vibration with the shaker's imperfections, and its demand.
 //
 // Takes: the commanded vibration (sine, random or sine-on-random from PSD tables, swept
@@ -11,8 +11,8 @@
 //        the random part), the shaker's demand (rms/peak acceleration, velocity,
 //        displacement) and the highest frequency in the motion (Hz). Throws
 //        std::invalid_argument naming the setting for a request the shaker cannot make.
-// One builder: `shake` and the diagnosis' virtual lab build the same motion from the same
-// request.
+// The one builder of a shaker run's motion: `shake` uses it, and the diagnosis' virtual lab
+// can build its runs' motion with it (validation/diagnosis has its own today).
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -44,14 +44,14 @@ struct ShakerImperfections {
   bool imperfect() const { return transverse || !harmonics.empty() || rocking; }
 };
 
-struct TableMotion {
+struct ShakerMotion {
   std::shared_ptr<const vibration::Excitation> motion;
   vibration::ShakerDemand demand;
   double top_Hz = 0;      // highest frequency in the motion
   bool periodic = false;  // a pure sine request: measured over whole periods (shake_sine)
 };
 
-TableMotion table_motion(const VibrationRequest& v, const ShakerImperfections& shaker, const Vec3& a_static_g,
+ShakerMotion shaker_motion(const VibrationRequest& v, const ShakerImperfections& shaker, const Vec3& a_static_g,
                          double g_m_per_s2, std::uint64_t seed);
 
 }  // namespace vrelab::rectification

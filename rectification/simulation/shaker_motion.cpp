@@ -1,4 +1,4 @@
-#include "rectification/simulation/table_motion.hpp"
+#include "rectification/simulation/shaker_motion.hpp"
 
 #include <algorithm>
 #include <stdexcept>
@@ -33,9 +33,9 @@ ExcitationPtr imperfect_tone(const std::shared_ptr<const vibration::ToneExcitati
 
 }  // namespace
 
-TableMotion table_motion(const VibrationRequest& v, const ShakerImperfections& shaker, const Vec3& a_static_g,
+ShakerMotion shaker_motion(const VibrationRequest& v, const ShakerImperfections& shaker, const Vec3& a_static_g,
                          double g_m_per_s2, std::uint64_t seed) {
-  TableMotion t;
+  ShakerMotion t;
   t.periodic = v.type == "sine";
   if ((v.type == "random" || v.type == "sine_on_random") && !v.psd)
     throw std::invalid_argument("rms_g: a shaken " + v.type + " profile needs PSD tables psd_IA / psd_PA / psd_OA");
