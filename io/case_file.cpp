@@ -741,7 +741,7 @@ std::vector<validation::NamedVector> named_vectors(Table& t, std::string_view ke
 }
 
 void read_reproduce(Table t, Case& c) {
-  ReproduceSpec r;
+  validation::ReproduceSettings r;
   r.frequency_Hz = t.number("frequency_Hz");
   if (!(r.frequency_Hz > 0)) t.fail(t.raw().get("frequency_Hz"), "frequency_Hz", "must be positive");
   r.amplitudes_g = number_list(t, "amplitudes_g");
@@ -763,8 +763,8 @@ void read_reproduce(Table t, Case& c) {
   const auto index = [&](std::string_view key, std::size_t n) {
     return static_cast<std::size_t>(conf->integer(key, false, 1, 1, static_cast<std::int64_t>(n)) - 1);
   };
-  r.confirmation_orientation = index("orientation", r.orientations.size());
-  r.confirmation_direction = index("direction", r.directions.size());
+  r.confirmation_orientation = r.orientations[index("orientation", r.orientations.size())];
+  r.confirmation_direction = r.directions[index("direction", r.directions.size())];
   r.confirmation_amplitude_g = conf->number("amplitude_g");
   if (!(r.confirmation_amplitude_g > 0)) conf->fail(conf->raw().get("amplitude_g"), "amplitude_g", "must be positive");
   r.confirmation_record_s = conf->number("record_s");
@@ -784,6 +784,11 @@ void read_reproduce(Table t, Case& c) {
   t.check_unknown({"frequency_Hz", "amplitudes_g", "directions", "direction_names", "orientations_g",
                    "orientation_names", "departure_frequencies_Hz", "invisible_shift_per_g", "threads",
                    "confirmation"});
+  // The rest of the configuration from the tables read before this one.
+  if (c.dividing_head) r.positions = c.dividing_head->positions, r.errors = c.dividing_head->errors;
+  r.fixed = c.fixed;
+  r.seed = c.seed;
+  r.shake = c.shake;
   c.reproduce = r;
 }
 

@@ -20,6 +20,7 @@
 #include "rectification/simulation/shake.hpp"
 #include "rectification/prediction/frequency_study.hpp"
 #include "rectification/simulation/sweep.hpp"
+#include "rectification/simulation/shaker_motion.hpp"
 #include "validation/identification/dividing_head.hpp"
 #include "validation/identification/identification.hpp"
 #include "validation/diagnosis/campaign.hpp"
@@ -43,36 +44,18 @@ struct DividingHead {
   bool from_ode = false;    // source = "ode": readings from the ODE plant, else model (1)
 };
 
-// The [vibration] table. type: sine | random | sine_on_random | swept_sine.
-struct VibrationSpec {
-  std::string type;
-  vibration::SineVibration sine;                       // sine, sine_on_random
+// The [vibration] table. type: sine | random | sine_on_random | swept_sine. The request a
+// shaker run builds its table motion from (rectification/simulation/shaker_motion.hpp), and
+// what eq. (3) needs.
+struct VibrationSpec : rectification::VibrationRequest {
   std::optional<vibration::RandomVibration> gaussian;  // random, sine_on_random (from rms_g or the PSD)
-  std::optional<vibration::RandomProfile> psd;         // PSD tables: needed to shake random profiles
-  std::optional<vibration::SweptSine> swept;
   double duration_s = 10.0;  // measuring time of a non-periodic run
   int line = 0;              // of the [vibration] table, for messages
 };
 
 // The [shaker] table: limits and imperfections, each off unless given.
-struct ShakerSpec {
+struct ShakerSpec : rectification::ShakerImperfections {
   vibration::ShakerLimits limits;
-  std::optional<vibration::TransverseSpec> transverse;
-  std::vector<vibration::Harmonic> harmonics;
-  std::optional<vibration::RockingSpec> rocking;
-  bool imperfect() const { return transverse || !harmonics.empty() || rocking; }
-};
-
-// The [reproduce] table: the shaker runs of `vrelab reproduce` (validation/reproduce/reproduce.hpp).
-struct ReproduceSpec {
-  double frequency_Hz = 20.0;
-  std::vector<double> amplitudes_g;
-  std::vector<validation::NamedVector> directions, orientations;
-  std::size_t confirmation_orientation = 0, confirmation_direction = 0;  // indices
-  double confirmation_amplitude_g = 3.0, confirmation_record_s = 2.0;
-  std::vector<double> departure_frequencies_Hz;
-  double invisible_shift_per_g = 0.0;
-  int threads = 0;
 };
 
 // The [campaign] table: what `vrelab campaign` hides in the truth and how the lab tests it.
@@ -105,7 +88,9 @@ struct Case {
   std::optional<rectification::SweepGrid> sweep;  // [sweep]
   std::optional<rectification::FrequencyStudySettings> frequency_study;  // [frequency_study]
   int sweep_threads = 0;                          // 0: all cores
-  std::optional<ReproduceSpec> reproduce;         // [reproduce]
+  // [reproduce] with the static test ([dividing_head], [identification] fixed), the seed and
+  // [shake]/[readout]: the whole configuration of `vrelab reproduce`.
+  std::optional<validation::ReproduceSettings> reproduce;
   std::optional<CampaignSpec> campaign;           // [campaign]
 };
 

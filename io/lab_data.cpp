@@ -13,6 +13,7 @@
 #include <toml++/toml.h>
 
 #include "io/case_file.hpp"
+#include "io/csv.hpp"
 #include "io/output.hpp"
 #include "rectification/measurement/series.hpp"
 #include "validation/diagnosis/diagnosis_report.hpp"
@@ -26,36 +27,7 @@ namespace fs = std::filesystem;
 // One CSV line into cells, trimmed of blanks. A cell may be quoted ("a, b"; "" is a quote
 // inside), as spreadsheets write them; an unclosed quote is std::invalid_argument naming `where`.
 std::vector<std::string> split(const std::string& line, const std::string& where) {
-  std::vector<std::string> out;
-  std::size_t i = 0;
-  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
-  while (true) {
-    while (i < line.size() && blank(line[i])) ++i;
-    std::string cell;
-    if (i < line.size() && line[i] == '"') {
-      for (++i;; ++i) {
-        if (i >= line.size()) throw std::invalid_argument(where + ": a quoted cell is not closed");
-        if (line[i] == '"') {
-          if (i + 1 < line.size() && line[i + 1] == '"') cell += '"', ++i;
-          else break;
-        } else {
-          cell += line[i];
-        }
-      }
-      ++i;
-      while (i < line.size() && blank(line[i])) ++i;
-      if (i < line.size() && line[i] != ',') throw std::invalid_argument(where + ": text after a quoted cell");
-    } else {
-      const std::size_t end = std::min(line.find(',', i), line.size());
-      cell = line.substr(i, end - i);
-      while (!cell.empty() && blank(cell.back())) cell.pop_back();
-      i = end;
-    }
-    out.push_back(std::move(cell));
-    if (i >= line.size()) break;
-    ++i;  // the comma
-  }
-  return out;
+  return split_csv_line(line, where);
 }
 
 // A CSV file with a header: rows with their line numbers; '#' lines and blank lines skipped.

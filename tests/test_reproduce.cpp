@@ -333,3 +333,57 @@ TEST(Report, MarkdownAndHtmlCarryTheSameContentAndHtmlIsEscaped) {
   EXPECT_EQ(html.find("<x>"), std::string::npos);
   EXPECT_NE(html.find("</html>"), std::string::npos);
 }
+
+TEST(ReproduceSettings, IsValidNamesTheKeyAndRefusesARankDeficientPositionSet) {
+  TempDir d;
+  const fs::path case_path = d.path / "small.toml";
+  std::ofstream(case_path) << kSmallCase;
+  const io::Case c = io::read_case(case_path.string());
+  ASSERT_TRUE(c.reproduce.has_value());
+  validation::ReproduceSettings s = *c.reproduce;
+  std::string why;
+  EXPECT_TRUE(s.IsValid(&why)) << why;
+  // The case reader fills the whole configuration: static test, seed, measurement.
+  EXPECT_EQ(s.seed, 11u);
+  EXPECT_EQ(s.positions.size(), c.dividing_head->positions.size());
+  EXPECT_EQ(s.shake.blocks, 10);
+  EXPECT_EQ(s.confirmation_direction.name, "IA");
+
+  validation::ReproduceSettings bad = s;
+  bad.amplitudes_g.clear();
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("amplitudes_g"), std::string::npos) << why;
+  bad = s;
+  bad.confirmation_record_s = 0;
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("record_s"), std::string::npos) << why;
+  // Nothing fixed: k1_asym, k_PP and k_OO cannot all be told from the others by a static test.
+  bad = s;
+  bad.fixed = {};
+  EXPECT_FALSE(bad.IsValid(&why));
+  EXPECT_NE(why.find("rank"), std::string::npos) << why;
+  EXPECT_THROW(validation::reproduce(c.plant, bad), std::invalid_argument);
+}
+
+TEST(ReproduceAnalysis, AgreementCountsRunsWithinTwoAndThreeCombinedSigma) {
+  // Residuals of 1, 2.5 and 4 combined sigma (sigma 3 + 4 -> combined 5): one within 2,
+  // two within 3, the worst at |z| = 4; rms of (5, 12.5, 20) ug.
+  std::vector<validation::RunResult> runs(3);
+  const double z[] = {1.0, -2.5, 4.0};
+  for (int i = 0; i < 3; ++i) {
+    auto& r = runs[static_cast<std::size_t>(i)];
+    r.sigma_measured_g = 3e-6;
+    r.predicted = {100e-6, 4e-6};
+    r.measured_g = r.predicted.value_g + z[i] * 5e-6;
+    r.orientation = "up", r.direction = "IA", r.amplitude_g = i + 1, r.frequency_Hz = 20;
+  }
+  const validation::Agreement a = validation::agreement(runs);
+  EXPECT_EQ(a.n, 3u);
+  EXPECT_EQ(a.within_2, 1u);
+  EXPECT_EQ(a.within_3, 2u);
+  EXPECT_NEAR(a.max_abs_z, 4.0, 1e-12);
+  EXPECT_EQ(a.worst, "3 g along IA at up (20 Hz)");
+  EXPECT_NEAR(a.rms_residual_g, std::sqrt((25.0 + 156.25 + 400.0) / 3) * 1e-6, 1e-15);
+  EXPECT_NEAR(a.max_abs_residual_g, 20e-6, 1e-15);
+  EXPECT_NEAR(a.median_relative, 0.125, 1e-12);  // |residual|/|prediction|: 0.05, 0.125, 0.2
+}

@@ -9,6 +9,7 @@
 #include "plant/accelerometer.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/simulation/shake.hpp"
+#include "rectification/simulation/shaker_motion.hpp"
 
 using namespace vrelab;
 using namespace vrelab::plant;
@@ -120,4 +121,27 @@ TEST(ShakeSampled, SinkSeesEverySampleOfTheRecord) {
                                              ++count;
                                            });
   EXPECT_EQ(count, r.samples);
+}
+
+TEST(ShakerMotion, SineIsPeriodicWithItsDemandAndImperfectionsNeedATone) {
+  rectification::VibrationRequest v;
+  v.type = "sine";
+  v.sine.amplitude_g = Vec3(3.0, 0.0, 0.0);
+  v.sine.frequency_Hz = 40.0;
+  rectification::ShakerImperfections none;
+  const rectification::ShakerMotion t = rectification::shaker_motion(v, none, Vec3(1, 0, 0), 9.81, 1);
+  EXPECT_TRUE(t.periodic);
+  EXPECT_DOUBLE_EQ(t.top_Hz, 40.0);
+  // 3 g peak: rms 3/sqrt(2) g on IA.
+  EXPECT_NEAR(t.demand.acceleration_rms_g[0], 3.0 / std::sqrt(2.0), 1e-12);
+  // Harmonic distortion: content at twice the frequency.
+  rectification::ShakerImperfections harmonic;
+  harmonic.harmonics.push_back({2, 0.1, 0.0});
+  EXPECT_GE(rectification::shaker_motion(v, harmonic, Vec3(1, 0, 0), 9.81, 1).top_Hz, 80.0);
+  // A random request without PSD tables, and imperfections without a tone, are refused.
+  rectification::VibrationRequest random;
+  random.type = "random";
+  EXPECT_THROW(rectification::shaker_motion(random, none, Vec3(1, 0, 0), 9.81, 1), std::invalid_argument);
+  v.sine.frequency_Hz = 0;
+  EXPECT_THROW(rectification::shaker_motion(v, none, Vec3(1, 0, 0), 9.81, 1), std::invalid_argument);
 }

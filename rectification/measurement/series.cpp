@@ -5,6 +5,16 @@
 
 namespace vrelab::rectification {
 
+bool SeriesWindows::IsValid(std::string* why) const {
+  try {
+    validate();
+  } catch (const std::invalid_argument& e) {
+    if (why) *why = e.what();
+    return false;
+  }
+  return true;
+}
+
 void SeriesWindows::validate() const {
   auto finite = [](double x) { return std::isfinite(x); };
   if (!finite(baseline_from_s) || !finite(baseline_to_s) || !(baseline_to_s > baseline_from_s))

@@ -22,6 +22,8 @@ struct SeriesWindows {
   int blocks = 4;
   // Throws std::invalid_argument naming the field.
   void validate() const;
+  // False (with validate()'s reason in *why) for windows no measurement can use.
+  bool IsValid(std::string* why) const;
 };
 
 struct SeriesResult {

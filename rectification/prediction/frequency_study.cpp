@@ -9,6 +9,20 @@
 
 namespace vrelab::rectification {
 
+bool FrequencyStudySettings::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (frequencies_Hz.empty()) return fail("points: the frequency grid is empty");
+  for (const auto* grid : {&frequencies_Hz, &ode_frequencies_Hz})
+    for (double f : *grid)
+      if (!(f > 0)) return fail("from_Hz/to_Hz: frequencies must be positive");
+  if (!(amplitude_g > 0)) return fail("amplitude_g: must be positive");
+  if (!(direction.norm() > 0)) return fail("direction: must not be zero");
+  return true;
+}
+
 std::vector<MechanismCurve> frequency_study(const plant::PlantConfig& plant, const Vec3& a, const FrequencyStudySettings& s) {
   using namespace plant;
   struct Mechanism {

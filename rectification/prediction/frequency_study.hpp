@@ -23,6 +23,9 @@ struct FrequencyStudySettings {
   double amplitude_g = 3.0;
   Vec3 direction = Vec3(1, 1, 1).normalized();  // in phase; on every axis so every cross term acts
   double pickoff_p2_per_rad = 20.0;
+  // False (with the reason, naming the setting, in *why) for an empty grid, a frequency or
+  // the amplitude not positive, or a zero direction.
+  bool IsValid(std::string* why) const;
 };
 
 struct MechanismCurve {

@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <mutex>
 #include <numbers>
 #include <stdexcept>
-#include <thread>
 
+#include "core/parallel.hpp"
 #include "plant/ode_solver.hpp"
 #include "rectification/prediction/eq3.hpp"
 
@@ -21,6 +20,21 @@ vibration::SineVibration SweepCondition::vibration() const {
     v.phase_rad[i] = direction[i] < 0 ? std::numbers::pi : 0.0;
   }
   return v;
+}
+
+bool SweepGrid::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (size() == 0) return fail("the grid is empty (frequencies, amplitudes, directions and orientations each need one)");
+  for (double f : frequencies_Hz)
+    if (!(f > 0)) return fail("frequencies must be positive");
+  for (double a : amplitudes_g)
+    if (!(a > 0)) return fail("amplitudes_g: amplitudes must be positive");
+  for (const Vec3& d : directions)
+    if (!(d.norm() > 0)) return fail("directions: a direction must not be zero");
+  return true;
 }
 
 SweepCondition sweep_condition(const SweepGrid& g, std::size_t index) {
@@ -63,45 +77,40 @@ void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth
     return (0.05 + 5 / f) * std::max(f, 50.0);
   };
   std::stable_sort(todo.begin(), todo.end(), [&](std::size_t a, std::size_t b) { return cost(a) > cost(b); });
-  std::atomic<std::size_t> next{0};
-  std::mutex lock;
   SweepProgress progress;
   progress.total = todo.size();
   const auto start = std::chrono::steady_clock::now();
-  auto worker = [&] {
-    for (std::size_t k = next++; k < todo.size(); k = next++) {
-      SweepRow row;
-      row.condition = sweep_condition(grid, todo[k]);
-      const auto t0 = std::chrono::steady_clock::now();
-      try {
-        const vibration::SineVibration v = row.condition.vibration();
-        ShakeSettings own = settings;  // independent readout noise per condition
-        own.readout.seed = settings.readout.seed + row.condition.index;
-        const ShakeResult r = shake_sine(plant, row.condition.orientation_g, v, own);
-        row.measured_g = r.measured_g;
-        row.sigma_g = r.sigma_g;
-        row.settle_s = r.settle_s;
-        row.steps = r.steps;
-        row.predicted_eq3_g = sine_rectification(truth, row.condition.orientation_g, v).total_g();
-        row.ok = true;
-      } catch (const plant::SolverError& e) {
-        row.error = e.what();
-      } catch (const std::invalid_argument& e) {
-        row.error = e.what();
-      }
-      row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      std::lock_guard<std::mutex> g(lock);
-      on_row(row);
-      ++progress.done;
-      progress.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (on_progress) on_progress(progress);
-    }
-  };
-  const int n = std::max(1, threads);
-  std::vector<std::thread> pool;
-  for (int t = 1; t < n; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
+  std::vector<SweepRow> rows(todo.size());
+  core::parallel_for(
+      todo.size(), threads,
+      [&](std::size_t k) {
+        SweepRow& row = rows[k];
+        row.condition = sweep_condition(grid, todo[k]);
+        const auto t0 = std::chrono::steady_clock::now();
+        try {
+          const vibration::SineVibration v = row.condition.vibration();
+          ShakeSettings own = settings;  // independent readout noise per condition
+          own.readout.seed = settings.readout.seed + row.condition.index;
+          const ShakeResult r = shake_sine(plant, row.condition.orientation_g, v, own);
+          row.measured_g = r.measured_g;
+          row.sigma_g = r.sigma_g;
+          row.settle_s = r.settle_s;
+          row.steps = r.steps;
+          row.predicted_eq3_g = sine_rectification(truth, row.condition.orientation_g, v).total_g();
+          row.ok = true;
+        } catch (const plant::SolverError& e) {
+          row.error = e.what();
+        } catch (const std::invalid_argument& e) {
+          row.error = e.what();
+        }
+        row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      },
+      [&](std::size_t k) {  // under the pool's lock
+        on_row(rows[k]);
+        ++progress.done;
+        progress.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (on_progress) on_progress(progress);
+      });
 }
 
 }  // namespace vrelab::rectification

@@ -5,7 +5,7 @@
 //        x directions (unit vectors in sensor axes; the vibration is amplitude * direction,
 //        in phase) x static orientations (gravity in sensor axes, g).
 // Gives: one SweepRow per condition (measured error, sigma, eq. (3) prediction), computed
-//        on `threads` threads; conditions listed in `skip` (already on disk) are not run.
+//        on `threads` threads (0: all cores, core::parallel_for); conditions listed in `skip` (already on disk) are not run.
 //        A solver failure in one condition is recorded in its row (ok = false, message
 //        naming the call and the simulated time); the others go on. With a readout, the
 //        noise of condition i is drawn from seed readout.seed + i (independent runs).
@@ -28,6 +28,9 @@ struct SweepGrid {
   std::size_t size() const {
     return frequencies_Hz.size() * amplitudes_g.size() * directions.size() * orientations_g.size();
   }
+  // False (with the reason, naming the list, in *why) for an empty grid, a frequency or an
+  // amplitude that is not positive, or a zero direction.
+  bool IsValid(std::string* why) const;
 };
 
 struct SweepCondition {

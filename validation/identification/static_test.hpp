@@ -33,7 +33,15 @@ struct StaticTestSettings {
   FixedSet fixed{};
   OutputSource source;  // empty: model (1) with the true coefficients
   std::uint64_t seed = 1;
-  int monte_carlo_trials = 0;
+  int monte_carlo_trials = 0;  // 0: none; else at least 2
+  // False (with the reason, naming the setting, in *why) for settings no run can use.
+  bool IsValid(std::string* why) const {
+    if (monte_carlo_trials == 1 || monte_carlo_trials < 0) {
+      if (why) *why = "monte_carlo_trials: needs at least 2 trials (or 0 for none)";
+      return false;
+    }
+    return true;
+  }
 };
 
 struct StaticTestReport {

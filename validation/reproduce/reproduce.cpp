@@ -5,10 +5,13 @@
 #include <map>
 #include <numbers>
 #include <stdexcept>
-#include <thread>
+#include <memory>
+#include <sstream>
 
 #include <Eigen/Dense>
 
+#include "core/parallel.hpp"
+#include "core/progress.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/prediction/frequency.hpp"
 #include "rectification/simulation/sweep.hpp"
@@ -64,10 +67,14 @@ namespace {
 // the measurement filled in. A failed condition throws (the reproduction needs them all).
 std::vector<RunResult> shake_grid(const plant::PlantConfig& plant, const rectification::ShakeSettings& shake,
                                   const rectification::SweepGrid& grid, const std::vector<NamedVector>& directions,
-                                  const std::vector<NamedVector>& orientations, int threads) {
+                                  const std::vector<NamedVector>& orientations, int threads,
+                                  std::ostream* progress_out, const std::string& label) {
   std::vector<RunResult> runs(grid.size());
   std::vector<std::string> failures;
+  std::unique_ptr<core::Progress> progress;
+  if (progress_out) progress = std::make_unique<core::Progress>(*progress_out, label, grid.size());
   rectification::run_sweep(plant, plant.coefficients, shake, grid, {}, threads, [&](const rectification::SweepRow& row) {
+    if (progress) progress->tick();
     const rectification::SweepCondition& c = row.condition;
     if (!row.ok) {
       failures.push_back(row.error);
@@ -85,6 +92,7 @@ std::vector<RunResult> shake_grid(const plant::PlantConfig& plant, const rectifi
     r.true_at_frequency_g =
         rectification::sine_rectification_at_frequency(plant, c.orientation_g, c.vibration()).total_g();
   });
+  if (progress) progress->finish();
   if (!failures.empty()) throw std::runtime_error("reproduce: a shaker run failed: " + failures.front());
   return runs;
 }
@@ -131,15 +139,163 @@ Prediction predict_with_uncertainty(const Model& f, const Coefficients& c,
   return {f(c), std::sqrt(std::max(var, 0.0))};
 }
 
+bool ReproduceSettings::IsValid(std::string* why) const {
+  auto fail = [&](const std::string& m) {
+    if (why) *why = m;
+    return false;
+  };
+  if (amplitudes_g.empty() || directions.empty() || orientations.empty())
+    return fail("[reproduce] amplitudes_g, directions, orientations_g: the amplitude study needs each");
+  if (!(frequency_Hz > 0)) return fail("[reproduce] frequency_Hz: must be positive");
+  for (double a : amplitudes_g)
+    if (!(a > 0)) return fail("[reproduce] amplitudes_g: amplitudes must be positive");
+  for (double f : departure_frequencies_Hz)
+    if (!(f > 0)) return fail("[reproduce] departure_frequencies_Hz: frequencies must be positive");
+  if (!(confirmation_amplitude_g > 0)) return fail("[reproduce.confirmation] amplitude_g: must be positive");
+  if (!(confirmation_record_s > 0)) return fail("[reproduce.confirmation] record_s: must be positive");
+  if (!(confirmation_direction.v.norm() > 0)) return fail("[reproduce.confirmation] direction: not set");
+  if (!std::isfinite(invisible_shift_per_g)) return fail("[reproduce] invisible_shift_per_g: must be finite");
+  if (threads < 0) return fail("[reproduce] threads: must not be negative");
+  if (std::string w; !shake.IsValid(&w)) return fail("[shake] " + w);
+  if (positions.empty()) return fail("[dividing_head]: the static test needs positions");
+  const Identifiability ident = identifiability(positions, fixed);
+  if (!ident.full_rank())
+    return fail("[dividing_head] with [identification] fixed: rank " + std::to_string(ident.rank) + " of " +
+                std::to_string(ident.parameters) + "; fix more coefficients (the paper fixes k1_asym, k_PP and k_OO)");
+  return true;
+}
+
+std::string run_label(const RunResult& r) {
+  std::ostringstream a, f;
+  a << r.amplitude_g, f << r.frequency_Hz;  // as {:g}
+  return a.str() + " g along " + r.direction + " at " + r.orientation + " (" + f.str() + " Hz)";
+}
+
+Agreement agreement(const std::vector<RunResult>& runs) {
+  Agreement a;
+  std::vector<double> rel;
+  double ss = 0;
+  for (const RunResult& r : runs) {
+    const double z = std::abs(r.z());
+    ++a.n;
+    if (z <= 2) ++a.within_2;
+    if (z <= 3) ++a.within_3;
+    if (z >= a.max_abs_z) a.max_abs_z = z, a.worst = run_label(r);
+    ss += r.residual_g() * r.residual_g();
+    a.max_abs_residual_g = std::max(a.max_abs_residual_g, std::abs(r.residual_g()));
+    if (std::abs(r.predicted.value_g) > 3 * r.predicted.sigma_g && r.predicted.value_g != 0)
+      rel.push_back(std::abs(r.residual_g() / r.predicted.value_g));
+  }
+  a.rms_residual_g = runs.empty() ? 0 : std::sqrt(ss / static_cast<double>(runs.size()));
+  if (!rel.empty()) {
+    std::sort(rel.begin(), rel.end());
+    a.median_relative = rel[rel.size() / 2];
+  }
+  return a;
+}
+
+namespace {
+
+AmplitudeAnalysis analyse_amplitude(const std::vector<RunResult>& runs, const ReproduceSettings& s) {
+  AmplitudeAnalysis a;
+  a.max_amplitude_g = *std::max_element(s.amplitudes_g.begin(), s.amplitudes_g.end());
+  a.all = agreement(runs);
+  std::vector<RunResult> nonzero;  // by symmetry, e.g. along PA or OA with k_PP = k_OO = 0, some are zero
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const RunResult& r = runs[i];
+    const double d = r.measured_g - r.printed_g;
+    if (std::abs(d) > 3 * r.combined_sigma_g()) {
+      ++a.printed_off_runs;
+      if (std::abs(d) > std::abs(a.printed_worst_g)) a.printed_worst_g = d;
+      const std::string where = r.orientation + " along " + r.direction;
+      if (std::find(a.printed_off_where.begin(), a.printed_off_where.end(), where) == a.printed_off_where.end())
+        a.printed_off_where.push_back(where);
+    }
+    if (std::abs(r.printed_g - r.predicted.value_g) > a.printed_gap_g)
+      a.printed_gap_g = std::abs(r.printed_g - r.predicted.value_g), a.printed_gap_where = run_label(r),
+      a.printed_gap_sigma_g = r.combined_sigma_g();
+    if (r.predicted.value_g != 0) nonzero.push_back(r);
+    if (r.predicted.sigma_g > r.sigma_measured_g) ++a.prediction_dominates;
+    if (r.predicted.value_g != 0)
+      a.frequency_departure_g = std::max(a.frequency_departure_g, std::abs(r.at_frequency.value_g - r.predicted.value_g));
+    if (r.amplitude_g == a.max_amplitude_g && r.direction == s.directions.front().name && r.predicted.value_g != 0)
+      a.growth_runs.push_back(i);
+  }
+  a.nonzero = agreement(nonzero);
+  return a;
+}
+
+// Eq. (3) from the identified coefficients over amplitude, per orientation and direction.
+std::vector<CurvePoint> amplitude_curves(const ReproduceResult& res, const ReproduceSettings& s) {
+  constexpr int kCurvePoints = 61;
+  const double a_max = res.amplitude.max_amplitude_g;
+  std::vector<CurvePoint> curves;
+  for (const auto& ori : s.orientations)
+    for (const auto& d : s.directions)
+      for (int k = 0; k < kCurvePoints; ++k) {
+        CurvePoint p;
+        p.orientation = ori.name, p.direction = d.name;
+        p.amplitude_g = a_max * k / (kCurvePoints - 1);
+        const vibration::SineVibration v{p.amplitude_g * d.v.normalized(), Vec3::Zero(), s.frequency_Hz};
+        const Model qs = [&](const Coefficients& c) { return rectification::sine_rectification(c, ori.v, v).total_g(); };
+        p.predicted = predict_with_uncertainty(qs, res.identified, res.identified_uncertainty.covariance);
+        p.printed_g = rectification::sine_rectification_as_printed(res.identified, ori.v, v);
+        curves.push_back(p);
+      }
+  return curves;
+}
+
+// The departure in frequency: the change from the reference run (the study's frequency, or
+// the lowest), measured (sigma: the two runs') against the change the frequency-dependent
+// eq. (3) predicts (with its own sigma: the coefficient errors do not cancel in it, the terms
+// scale differently with frequency).
+DepartureAnalysis analyse_departure(const ReproduceResult& res, const ReproduceSettings& s) {
+  DepartureAnalysis a;
+  const auto& runs = res.frequency_runs;
+  if (runs.empty()) return a;
+  const auto& cov = res.identified_uncertainty.covariance;
+  for (std::size_t i = 0; i < runs.size(); ++i)  // sorted: the lowest unless the study's is there
+    if (runs[i].frequency_Hz == s.frequency_Hz) a.reference = i;
+  const RunResult& ref = runs[a.reference];
+  a.reference_Hz = ref.frequency_Hz;
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const RunResult& r = runs[i];
+    const bool is_ref = i == a.reference;
+    FrequencyChange c;
+    c.measured_g = r.measured_g - ref.measured_g;
+    c.sigma_measured_g = is_ref ? 0.0 : std::hypot(r.sigma_measured_g, ref.sigma_measured_g);
+    c.predicted = is_ref ? Prediction{} : predicted_change(r, ref, res.nominal, cov);
+    c.true_g = r.true_at_frequency_g - ref.true_at_frequency_g;
+    const double sz = std::hypot(c.sigma_measured_g, c.predicted.sigma_g);
+    c.z = sz > 0 ? (c.measured_g - c.predicted.value_g) / sz : 0.0;
+    if (c.sigma_measured_g > 0 && std::abs(c.measured_g) > 3 * c.sigma_measured_g) a.departs_Hz.push_back(r.frequency_Hz);
+    if (std::abs(c.z) >= a.worst_z_change) a.worst_z_change = std::abs(c.z), a.worst_z_change_Hz = r.frequency_Hz;
+    if (c.sigma_measured_g > 0) a.worst_z_true = std::max(a.worst_z_true, std::abs(c.measured_g - c.true_g) / c.sigma_measured_g);
+    a.changes.push_back(c);
+  }
+  const auto& f = s.departure_frequencies_Hz;
+  const double lo = *std::min_element(f.begin(), f.end()) / 1.5, hi = *std::max_element(f.begin(), f.end()) * 1.5;
+  for (int k = 0; k < 80; ++k) {
+    RunResult r = runs.front();
+    r.frequency_Hz = lo * std::pow(hi / lo, k / 79.0);
+    predict_run(r, res.nominal, cov);
+    a.curve.push_back(r);
+  }
+  return a;
+}
+
+}  // namespace
+
 ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const ReproduceSettings& s,
-                          const std::function<void(const std::string&)>& log) {
+                          const std::function<void(const std::string&)>& log, std::ostream* progress) {
   auto say = [&](const std::string& m) {
     if (log) log(m);
   };
-  if (s.amplitudes_g.empty() || s.directions.empty() || s.orientations.empty())
-    throw std::invalid_argument("reproduce: the amplitude study needs amplitudes, directions and orientations");
-  const int threads = s.threads > 0 ? s.threads : std::max(1u, std::thread::hardware_concurrency());
+  std::string why;
+  if (!s.IsValid(&why)) throw std::invalid_argument("reproduce: " + why);
+  const int threads = core::thread_count(s.threads);
   ReproduceResult out;
+  out.truth = truth_plant.coefficients;
 
   // 1. The static test on the plant, settled in each position.
   say("static test: the plant settled in each position of the dividing head");
@@ -230,7 +386,8 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
     x.readout.seed = s.shake.readout.seed + static_cast<std::uint64_t>(k) * 1000003u;
     return x;
   };
-  out.amplitude_runs = shake_grid(truth_plant, section(1), grid, s.directions, s.orientations, threads);
+  out.amplitude_runs =
+      shake_grid(truth_plant, section(1), grid, s.directions, s.orientations, threads, progress, "amplitude study");
   for (RunResult& r : out.amplitude_runs) predict_run(r, nominal, cov);
 
   // 4. The departure in frequency.
@@ -239,7 +396,8 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
     const rectification::SweepGrid fg = grid_of(s.departure_frequencies_Hz, {s.confirmation_amplitude_g},
                                                 {s.confirmation_direction}, {s.confirmation_orientation});
     out.frequency_runs =
-        shake_grid(truth_plant, section(2), fg, {s.confirmation_direction}, {s.confirmation_orientation}, threads);
+        shake_grid(truth_plant, section(2), fg, {s.confirmation_direction}, {s.confirmation_orientation}, threads,
+                   progress, "frequency departure");
     std::sort(out.frequency_runs.begin(), out.frequency_runs.end(),
               [](const RunResult& a, const RunResult& b) { return a.frequency_Hz < b.frequency_Hz; });
     for (RunResult& r : out.frequency_runs) predict_run(r, nominal, cov);
@@ -259,7 +417,8 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
     const std::vector<NamedVector> axes = {{"IA", Vec3(1, 0, 0)}, {"PA", Vec3(0, 1, 0)}, {"OA", Vec3(0, 0, 1)}};
     say("invisible shift: 3 x " + std::to_string(s.amplitudes_g.size()) + " shaker runs on the second instrument");
     const rectification::SweepGrid ig = grid_of({s.frequency_Hz}, s.amplitudes_g, axes, {s.confirmation_orientation});
-    inv.runs = shake_grid(other, section(3), ig, axes, {s.confirmation_orientation}, threads);
+    inv.runs = shake_grid(other, section(3), ig, axes, {s.confirmation_orientation}, threads, progress,
+                          "invisible shift");
     // Generalised least squares for c in residual = -c |w|^2 / 2: the runs share the
     // prediction's coefficient errors, so V = diag(sigma_m^2) + G Sigma G^T.
     const int n = static_cast<int>(inv.runs.size());
@@ -285,6 +444,9 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
     inv.c_fit_per_g = x.dot(ldlt.solve(res)) / info;
     inv.c_fit_sigma_per_g = 1 / std::sqrt(info);
   }
+  out.amplitude = analyse_amplitude(out.amplitude_runs, s);
+  out.amplitude_curves = amplitude_curves(out, s);
+  out.departure = analyse_departure(out, s);
   return out;
 }
 

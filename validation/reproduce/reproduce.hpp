@@ -25,6 +25,7 @@
 // readout.seed + k * 1000003 + i; the confirmation run from readout.seed.
 #include <cstdint>
 #include <functional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -60,6 +61,11 @@ struct ReproduceSettings {
   // The invisible shift c (1/g); 0: skipped.
   double invisible_shift_per_g = 0.0;
   int threads = 0;  // 0: all cores
+
+  // True when the settings describe a run: the amplitude study has amplitudes, directions
+  // and orientations, the numbers are positive, the confirmation run is set. Else false,
+  // with the reason (naming the setting) in *why when given.
+  bool IsValid(std::string* why) const;
 };
 
 struct Prediction {
@@ -105,7 +111,64 @@ struct InvisibleResult {
   double c_fit_per_g = 0, c_fit_sigma_per_g = 0;
 };
 
+// Agreement statistics of a set of runs against the corrected eq. (3).
+struct Agreement {
+  std::size_t n = 0, within_2 = 0, within_3 = 0;
+  double max_abs_z = 0, rms_residual_g = 0, max_abs_residual_g = 0;
+  double median_relative = 0;  // |residual| / |predicted| over runs with |predicted| > 3 sigma_pred
+  std::string worst;           // the run with max |z|
+};
+Agreement agreement(const std::vector<RunResult>& runs);
+// "3 g along IA at IA up (20 Hz)": a run in words.
+std::string run_label(const RunResult& r);
+
+// What the amplitude study shows, computed from its runs.
+struct AmplitudeAnalysis {
+  double max_amplitude_g = 0;
+  Agreement all, nonzero;                 // nonzero: runs whose prediction is not zero by symmetry
+  std::size_t prediction_dominates = 0;   // runs where the prediction's sigma exceeds the measurement's
+  // Where the printed eq. (3) departs from the measurement by more than 3 combined sigma.
+  std::size_t printed_off_runs = 0;
+  double printed_worst_g = 0;             // measured - printed, the largest such
+  std::vector<std::string> printed_off_where;  // "<orientation> along <direction>", once each
+  // How far the printed form is from the corrected one (largest over the runs), and where.
+  double printed_gap_g = 0, printed_gap_sigma_g = 0;
+  std::string printed_gap_where;
+  // Largest |frequency-dependent - quasi-static| over the runs with a non-zero prediction.
+  double frequency_departure_g = 0;
+  // Runs at the largest amplitude along the first direction with a non-zero prediction.
+  std::vector<std::size_t> growth_runs;   // indices into amplitude_runs
+};
+
+// A point of the predicted curves over amplitude (per orientation and direction).
+struct CurvePoint {
+  std::string orientation, direction;
+  double amplitude_g = 0;
+  Prediction predicted;
+  double printed_g = 0;
+};
+
+// The change of a frequency run from the reference run: measured (sigma of the two runs),
+// predicted by the frequency-dependent eq. (3) (its own sigma), with the true coefficients.
+struct FrequencyChange {
+  double measured_g = 0, sigma_measured_g = 0;
+  Prediction predicted;
+  double true_g = 0;
+  double z = 0;  // (measured - predicted) / combined sigma
+};
+
+// The departure test over frequency (empty when no frequency runs).
+struct DepartureAnalysis {
+  std::size_t reference = 0;  // index in frequency_runs: the study's frequency, or the lowest
+  double reference_Hz = 0;
+  std::vector<FrequencyChange> changes;  // one per frequency run (the reference's is zero)
+  std::vector<double> departs_Hz;        // where the measured change exceeds 3 sigma
+  double worst_z_change = 0, worst_z_change_Hz = 0, worst_z_true = 0;
+  std::vector<RunResult> curve;          // predictions over a log grid around the frequencies
+};
+
 struct ReproduceResult {
+  plant::Coefficients truth;       // the plant's coefficients
   StaticTestReport static_test;
   plant::Coefficients identified;  // least squares
   plant::PlantConfig nominal;      // identified coefficients, nominal dynamics, no effects
@@ -114,11 +177,18 @@ struct ReproduceResult {
   std::vector<RunResult> amplitude_runs;
   std::vector<RunResult> frequency_runs;
   InvisibleResult invisible;
+  AmplitudeAnalysis amplitude;
+  std::vector<CurvePoint> amplitude_curves;
+  DepartureAnalysis departure;
 };
 
-// Progress messages (one line each) go to `log` when given.
+// Progress messages (one line each) go to `log` when given; with `progress` set, each stage of
+// shaker runs draws a core::Progress there (ETA). Throws std::invalid_argument when
+// !s.IsValid(). The analysis (agreement, the printed-vs-corrected gap, the departure test,
+// the predicted curves) is in the result.
 ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const ReproduceSettings& s,
-                          const std::function<void(const std::string&)>& log = {});
+                          const std::function<void(const std::string&)>& log = {},
+                          std::ostream* progress = nullptr);
 
 // Fills the predictions of a run (orientation, direction, amplitude, frequency given) from
 // the coefficients of `nominal` and their covariance.
