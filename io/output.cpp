@@ -96,7 +96,34 @@ json plant_json(const plant::PlantConfig& p, bool physical) {
           {"effects", effects}};
 }
 
+// The plot scripts are found from where the program is, never from a source path compiled
+// in: VRELAB_PLOTS_DIR when set; else beside the executable's real path (/proc/self/exe), at
+// ../share/vrelab/plots (an install: <prefix>/bin/vrelab) or share/vrelab/plots (the build
+// tree, where the build copies tools/plots; the test programs sit in build/tests/ and find
+// the same copy through ../share).
 std::string run_plot_script(const std::string& script, const std::string& dir) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> places;
+  if (const char* env = std::getenv("VRELAB_PLOTS_DIR"); env != nullptr && *env != '\0') {
+    places.emplace_back(env);
+  } else {
+    std::error_code ec;
+    const fs::path exe = fs::canonical("/proc/self/exe", ec);
+    if (!ec) places = {exe.parent_path() / ".." / "share" / "vrelab" / "plots", exe.parent_path() / "share" / "vrelab" / "plots"};
+  }
+  fs::path script_path;
+  std::string looked;
+  for (const fs::path& place : places) {
+    std::error_code ec;
+    if (fs::is_regular_file(place / script, ec)) {
+      script_path = (place / script).lexically_normal();
+      break;
+    }
+    looked += (looked.empty() ? "" : ", ") + place.lexically_normal().string();
+  }
+  if (script_path.empty())
+    return "plot script " + script + " not found (looked in " + (looked.empty() ? std::string("no place") : looked) +
+           "; set VRELAB_PLOTS_DIR to the folder of the plot scripts)";
   std::string py;
   for (const char* candidate : {"/usr/bin/python3", "python3"}) {
     const std::string probe = std::string(candidate) + " -c 'import matplotlib' >/dev/null 2>&1";
@@ -112,7 +139,7 @@ std::string run_plot_script(const std::string& script, const std::string& dir) {
     for (char ch : x) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
     return q + "'";
   };
-  const std::string cmd = py + " " + quote(std::string(VRELAB_SOURCE_DIR) + "/tools/plots/" + script) + " " + quote(dir);
+  const std::string cmd = py + " " + quote(script_path.string()) + " " + quote(dir);
   if (std::system(cmd.c_str()) != 0) return "the figure script failed: " + cmd;
   return "";
 }

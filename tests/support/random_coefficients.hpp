@@ -21,13 +21,4 @@ inline plant::Coefficients random_coefficients(std::mt19937_64& rng, double lo =
   return c;
 }
 
-// The shipped instrument's coefficients (cases/paper-static.toml; k_PP = k_OO = 0).
-inline plant::Coefficients paper_like() {
-  plant::Coefficients c;
-  c[plant::K1] = 1.25, c[plant::k0] = 1.5e-3, c[plant::k1_asym] = 2e-5, c[plant::k2] = 1.5e-5, c[plant::k3] = 1e-6;
-  c[plant::k4] = 2e-7, c[plant::delta_OA] = 1e-4, c[plant::delta_PA] = -5e-5, c[plant::k_IP] = 8e-6;
-  c[plant::k_IO] = -5e-6, c[plant::k_PO] = 3e-6;
-  return c;
-}
-
 }  // namespace vrelab::test

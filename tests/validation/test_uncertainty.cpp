@@ -7,14 +7,14 @@
 #include <numbers>
 #include <random>
 
-#include "support/random_coefficients.hpp"
+#include "support/instrument.hpp"
 #include "plant/model1.hpp"
 #include "validation/identification/static_test.hpp"
 
 using namespace vrelab;
 using namespace vrelab::plant;
 using namespace vrelab::validation;
-using vrelab::test::paper_like;
+using vrelab::test::paper_like_coefficients;
 constexpr double kArcsec = std::numbers::pi / (180 * 3600);
 
 namespace {
@@ -31,7 +31,7 @@ StaticTestErrors paper_errors() {
 }  // namespace
 
 TEST(ReadingBudget, AngleSensitivityAndBiasMatchFiniteDifferencesOfTheSimulatedTest) {
-  const Coefficients c = paper_like();
+  const Coefficients c = paper_like_coefficients();
   for (const auto& positions : {equally_spaced_positions(8), equally_spaced_positions(12)}) {
     StaticTestErrors e;
     e.angle_sigma_rad = 1.0;  // unit sigma: the variance is the squared sensitivity
@@ -54,7 +54,7 @@ TEST(ReadingBudget, AngleSensitivityAndBiasMatchFiniteDifferencesOfTheSimulatedT
 }
 
 TEST(ReadingBudget, VectorPositionsUseAnIsotropicRotationError) {
-  const Coefficients c = paper_like();
+  const Coefficients c = paper_like_coefficients();
   const Position p = vector_position(Vec3(0.6, 0.0, 0.8));
   StaticTestErrors e;
   e.angle_sigma_rad = 1.0;
@@ -75,7 +75,7 @@ TEST(Propagation, FirstOrderSigmaAgreesWithMonteCarloWithin10Percent) {
   // 1/sqrt(2N) = 1.3 %, so 10 % is a 7-sigma bound; the linearisation error at arcsec
   // angles is ~1e-5 relative. The bias check: the MC mean error of least squares equals
   // the first-order effect of the initial orientation error within 5 standard errors.
-  const Coefficients truth = paper_like();
+  const Coefficients truth = paper_like_coefficients();
   const auto positions = equally_spaced_positions(8);
   StaticTestSettings s;
   s.fixed[k1_asym] = truth[k1_asym];
@@ -103,7 +103,7 @@ TEST(Propagation, FirstOrderSigmaAgreesWithMonteCarloWithin10Percent) {
 TEST(Propagation, WeightedLeastSquaresIsNoWorseThanTheClosedForms) {
   // Gauss-Markov: with weights 1/variance the least-squares sigma of every coefficient is
   // at most that of any other linear unbiased estimator from the same readings (first order).
-  const Coefficients truth = paper_like();
+  const Coefficients truth = paper_like_coefficients();
   StaticTestSettings s;
   s.fixed[k1_asym] = truth[k1_asym];
   s.fixed[k_PP] = 0.0;

@@ -19,6 +19,7 @@
 #include "app/commands.hpp"
 #include "io/report.hpp"
 #include "rectification/prediction/eq3.hpp"
+#include "support/instrument.hpp"
 #include "support/random_coefficients.hpp"
 #include "validation/reproduce/reproduce.hpp"
 #include "validation/identification/static_test.hpp"
@@ -26,7 +27,7 @@
 using namespace vrelab;
 using namespace vrelab::plant;
 using namespace vrelab::validation;
-using vrelab::test::paper_like;
+using vrelab::test::paper_like_coefficients;
 namespace fs = std::filesystem;
 using vrelab::test::read_file;
 using vrelab::test::TempDir;
@@ -86,7 +87,7 @@ TEST(PredictionUncertainty, TheStaticTestsCovarianceCarriesEq3sScatterOverRepeat
   // first-order covariance, against the scatter of eq. (3) over 1000 simulated tests (same
   // initial orientation error, fresh set-angle errors and noise). Relative sd of the sample
   // sd: 1/sqrt(2000) = 2.2 %; first-order truncation is ~(angle error)^2, negligible. Bound 10 %.
-  const Coefficients truth = paper_like();
+  const Coefficients truth = paper_like_coefficients();
   const std::vector<Position> positions = equally_spaced_positions(8);
   StaticTestErrors e;
   e.initial_error_rad = Vec3(3, -2, 4) * kArcsec;

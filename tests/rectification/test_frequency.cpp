@@ -20,7 +20,7 @@
 #include "rectification/prediction/frequency.hpp"
 #include "plant/effects/effects.hpp"
 #include "rectification/simulation/shake.hpp"
-#include "support/random_coefficients.hpp"
+#include "support/instrument.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/excitation.hpp"
 
@@ -35,8 +35,7 @@ TEST(FrequencyDependentEq3, MatchesTheOdeForEachMechanismFrom1HzTo5kHz) {
     Vec3 w;
   };
   auto base = [] {
-    PlantConfig c;
-    c.coefficients[K1] = 1.25;
+    PlantConfig c = test::paper_like_linear_plant();
     return c;
   };
   std::vector<Mechanism> ms;
@@ -97,8 +96,8 @@ TEST(FrequencyDependentEq3, MatchesTheOdeForEachMechanismFrom1HzTo5kHz) {
 // At rest a readout polynomial R acts on model (1)'s output: U/K1 = R(model (1) / K1), the
 // static test sees it (checked against the closed form at a few orientations).
 TEST(FrequencyDependentEq3, ReadoutPolynomialActsOnTheStaticOutputToo) {
-  PlantConfig c;
-  c.coefficients[K1] = 1.25, c.coefficients[k2] = 1.5e-5, c.coefficients[k_IP] = 5e-6;
+  PlantConfig c = test::paper_like_linear_plant();
+  c.coefficients[k2] = 1.5e-5, c.coefficients[k_IP] = 5e-6;
   const std::array<double, 7> poly{0, 0, 1e-5, 2e-6, 0, 1e-7, 3e-8};
   c.effects.push_back(std::make_shared<OutputPolynomial>("higher_order", poly));
   for (const Vec3& a : {Vec3(1, 0, 0), Vec3(-0.6, 0.8, 0), Vec3(0.3, 0.2, -0.9)}) {
@@ -112,8 +111,7 @@ TEST(FrequencyDependentEq3, ReadoutPolynomialActsOnTheStaticOutputToo) {
 }
 
 TEST(FrequencyDependentEq3, IsEq3AtLowFrequencyAndFallsAboveTheLoop) {
-  PlantConfig c;
-  c.coefficients[K1] = 1.25;
+  PlantConfig c = test::paper_like_linear_plant();
   c.coefficients[k2] = 2e-5;
   const Vec3 a(1, 0, 0);
   vibration::SineVibration v;
@@ -130,8 +128,7 @@ TEST(FrequencyDependentEq3, HoldsWithoutIntegratorAndBehindAMaskedMechanicalMode
   // Two plants with inert states (the PI integral without integrator; the masked axes of a
   // mode along IA only): their loops run, and the ODE agrees with the prediction (1 %).
   const Vec3 a(0.5, std::sqrt(0.75), 0);
-  PlantConfig no_pi;
-  no_pi.coefficients[K1] = 1.25;
+  PlantConfig no_pi = test::paper_like_linear_plant();
   no_pi.coefficients[k2] = 2e-5;
   no_pi.dynamics.integrator = false;
   PlantConfig mode = no_pi;
@@ -178,8 +175,7 @@ struct Responses {
 TEST(PeriodicRectification, ASingleToneAveragedNumericallyIsTheClosedForm) {
   const Vec3 a(0.5, std::sqrt(0.75), 0);
   auto base = [] {
-    PlantConfig c;
-    c.coefficients[K1] = 1.25;
+    PlantConfig c = test::paper_like_linear_plant();
     c.coefficients[k2] = 2e-5, c.coefficients[k3] = 1e-6, c.coefficients[k4] = 2e-7;
     c.coefficients[k_IP] = 1e-5, c.coefficients[k_PP] = -3e-6, c.coefficients[delta_OA] = 1e-3;
     return c;
@@ -234,8 +230,8 @@ TEST(PeriodicRectification, ASingleToneAveragedNumericallyIsTheClosedForm) {
 TEST(PeriodicRectification, ASecondHarmonicRectifiesThroughItsCrossProducts) {
   const double w = 3, h = 0.3, phi = 1.0;
   const Vec3 a(0, 0, 1);
-  PlantConfig c;
-  c.coefficients[K1] = 1.25, c.coefficients[k2] = 2e-5, c.coefficients[k3] = 4e-6;
+  PlantConfig c = test::paper_like_linear_plant();
+  c.coefficients[k2] = 2e-5, c.coefficients[k3] = 4e-6;
   c.location[k2] = c.location[k3] = Location::input;
   vibration::SineVibration v;
   v.amplitude_g = Vec3(w, 0, 0);
@@ -267,8 +263,7 @@ TEST(PeriodicRectification, ASecondHarmonicRectifiesThroughItsCrossProducts) {
 // change at 50 Hz (0.56 vs 0.64 ug: the film's harmonics are left out) and 3 % at 200 and
 // 500 Hz; bound 15 % of the change, which is > 0.5 ug at each frequency (so the check is sharp).
 TEST(PeriodicRectification, SqueezeFilmDescribingFunctionPredictsTheOdesChange) {
-  PlantConfig base;
-  base.coefficients = test::paper_like();
+  PlantConfig base = test::paper_like_plant();
   const Dynamics& d = base.dynamics;
   const double c0 = 2 * d.pendulum_damping_ratio * 2 * std::numbers::pi * d.pendulum_frequency_Hz;
   const Vec3 a = Vec3(1, 0, 1).normalized();

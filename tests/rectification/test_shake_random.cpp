@@ -8,6 +8,7 @@
 #include "plant/accelerometer.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/simulation/shake.hpp"
+#include "support/instrument.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/random.hpp"
 #include "vibration/sampled.hpp"
@@ -25,8 +26,7 @@ vibration::PsdTable flat(double f1, double f2, double level) {
 }
 
 PlantConfig plant_with(std::initializer_list<std::pair<int, double>> coefs) {
-  PlantConfig cfg;
-  cfg.coefficients[K1] = 1.25;
+  PlantConfig cfg = test::paper_like_linear_plant();
   for (auto [c, v] : coefs) cfg.coefficients[c] = v;
   return cfg;
 }

@@ -15,6 +15,7 @@
 #include "plant/physical.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/simulation/shake.hpp"
+#include "support/instrument.hpp"
 #include "support/random_coefficients.hpp"
 #include "validation/identification/dividing_head.hpp"
 
@@ -71,8 +72,7 @@ TEST(PlantStatic, CrossTermsAtTheInputHoldToSecondOrder) {
 }
 
 TEST(PlantDynamics, LinearPlantDoesNotRectifyA20gSineAt1kHz) {
-  PlantConfig cfg;
-  cfg.coefficients[K1] = 1.25;
+  PlantConfig cfg = test::paper_like_linear_plant();
   vibration::SineVibration v;
   v.amplitude_g = Vec3(20, 0, 0);
   v.frequency_Hz = 1000;
@@ -88,8 +88,7 @@ TEST(PlantDynamics, EachTermAtEachPlaceRectifiesAsEq3AtOnePercentOfTheBandwidth)
     if (c == delta_OA || c == delta_PA) continue;  // linear: no rectification
     for (Location l : {Location::input, Location::loop, Location::output}) {
       if (!location_allowed(c, l)) continue;
-      PlantConfig cfg;
-      cfg.coefficients[K1] = 1.25;
+      PlantConfig cfg = test::paper_like_linear_plant();
       cfg.coefficients[c] = c == k1_asym ? 1e-3 : 2e-4;
       cfg.location[c] = l;
       vibration::SineVibration v;
@@ -200,8 +199,7 @@ TEST(PlantPhysical, MatchesTheFromCoefficientsPlantWithTheSameServoNearTheCrosso
   // c2 then rectifies as a loop-located k2 = -c2 does, compared at 300 Hz where the loop
   // shapes the result. The torquers differ by 2 c2^2 i^3 (+ O(c2^3)), which rectifies like
   // k3 = 2 c2^2: relative to the k2 term, 6 c2 a_IA = 4.4e-5 here; allowed: twice that.
-  PlantConfig ref;
-  ref.coefficients[K1] = 1.25;
+  PlantConfig ref = test::paper_like_linear_plant();
   const Servo sv = design_servo(ref.dynamics);
   PhysicalParameters p;
   const double g = 9.81, amps_per_g = p.pendulosity_kg_m * g / p.torquer_N_m_per_A;
@@ -242,8 +240,7 @@ TEST(PlantEffects, SqueezeFilmDescribingFunctionIsItsSeries) {
 // largest angle 9.5x nominal). Bound: 0.001 ug, against 0.5 ug that the same film moves the rectification
 // of the paper-like instrument at 500 Hz (the film acts through the loop's response).
 TEST(PlantEffects, SqueezeFilmDampingDoesNotRectifyByItself) {
-  PlantConfig c;
-  c.coefficients[K1] = 1.25;
+  PlantConfig c = test::paper_like_linear_plant();
   const Dynamics& d = c.dynamics;
   const double c0 = 2 * d.pendulum_damping_ratio * 2 * std::numbers::pi * d.pendulum_frequency_Hz;
   c.effects.push_back(std::make_shared<SqueezeFilmDamping>(1.1e-3, c0, d.angle_gain_rad_per_s2_per_g));
@@ -255,7 +252,7 @@ TEST(PlantEffects, SqueezeFilmDampingDoesNotRectifyByItself) {
     EXPECT_NEAR(rectification::shake_sine(c, a, v).measured_g, 0.0, 1e-9) << f << " Hz";
   }
   PlantConfig nl = c, nominal = c;
-  nl.coefficients = nominal.coefficients = test::paper_like();
+  nl.coefficients = nominal.coefficients = test::paper_like_coefficients();
   nominal.effects.clear();
   v.frequency_Hz = 500;
   EXPECT_GT(std::abs(rectification::shake_sine(nl, a, v).measured_g - rectification::shake_sine(nominal, a, v).measured_g), 0.5e-6);

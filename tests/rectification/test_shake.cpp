@@ -10,6 +10,7 @@
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "rectification/simulation/shaker_motion.hpp"
+#include "support/instrument.hpp"
 
 using namespace vrelab;
 using namespace vrelab::plant;
@@ -17,8 +18,7 @@ using namespace vrelab::plant;
 namespace {
 
 PlantConfig k2_plant() {
-  PlantConfig cfg;
-  cfg.coefficients[K1] = 1.25;
+  PlantConfig cfg = test::paper_like_linear_plant();
   cfg.coefficients[k2] = 1.5e-5;
   return cfg;
 }

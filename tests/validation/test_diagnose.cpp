@@ -17,7 +17,7 @@
 #include <fmt/format.h>
 
 #include "support/files.hpp"
-#include "support/random_coefficients.hpp"
+#include "support/instrument.hpp"
 #include "io/case_file.hpp"
 #include "app/commands.hpp"
 #include "io/lab_data.hpp"
@@ -34,11 +34,7 @@ using vrelab::test::TempDir;
 
 namespace {
 
-plant::PlantConfig truth() {
-  plant::PlantConfig p;
-  p.coefficients = test::paper_like();
-  return p;
-}
+plant::PlantConfig truth() { return test::paper_like_plant(); }
 
 // A smaller design than the default (36 runs), for test time.
 CampaignDesign small_design() {
@@ -238,8 +234,7 @@ TEST(EffectRegistry, EachEffectsTruthAndHypothesisMakeTheSameChange) {
 // acts on the whole output: with a bias k0 it also gives k4 5 k0, so the instrument here is
 // linear.)
 TEST(EffectLibrary, TheStaticTestTakesUpK5AsItsProjectionOnModel1) {
-  plant::PlantConfig p;
-  p.coefficients[plant::K1] = 1.25;
+  plant::PlantConfig p = test::paper_like_linear_plant();
   const std::vector<Position> positions = equally_spaced_positions(12);
   const std::vector<double> weights(positions.size(), 1.0);
   FixedSet fixed{};
