@@ -31,37 +31,12 @@ plant::PlantConfig random_truth(std::mt19937_64& rng) {
   return p;
 }
 
-double log_uniform(std::mt19937_64& rng, double lo, double hi) {
-  return std::exp(std::uniform_real_distribution<double>(std::log(lo), std::log(hi))(rng));
-}
-
-// A hidden effect's parameter, drawn where its gap is several sigma in the default design.
+// A hidden effect's parameter, drawn by the effect itself (its `draw`: where its gap is
+// several sigma in the default design).
 HiddenEffect draw_effect(const std::string& name, std::mt19937_64& rng) {
-  std::bernoulli_distribution sign(0.5);
-  const double s = sign(rng) ? 1 : -1;
-  if (name == "pickoff_nonlinearity") return {name, s * log_uniform(rng, 5, 50)};
-  if (name == "pendulum_geometry") return {name, 1};
-  if (name == "quadratic_cross_axis") return {name, s * log_uniform(rng, 0.5e-6, 5e-6)};
-  if (name == "nonlinearity_at_input") return {name, 1};
-  if (name == "servo_dynamics") return {name, sign(rng) ? log_uniform(rng, 0.6, 0.85) : log_uniform(rng, 1.15, 1.6)};
-  if (name == "mechanical_mode") return {name, log_uniform(rng, 300, 1200)};
-  if (name == "shaker_transverse_motion") return {name, s * log_uniform(rng, 0.02, 0.1)};
-  if (name == "servo_phase_margin") return {name, s * log_uniform(rng, 4, 20)};
-  if (name == "higher_order_k5") return {name, s * log_uniform(rng, 5e-8, 5e-7)};
-  if (name == "higher_order_k6") return {name, s * log_uniform(rng, 1e-8, 6e-8)};
-  if (name == "readout_nonlinearity") return {name, s * log_uniform(rng, 1e-5, 4e-5)};
-  // The gap 1.0-1.2 mrad: the pendulum swings up to 1.01 mrad at 4 g (130 Hz; 0.998 mrad in
-  // the 100 Hz runs), so these films are near contact; at 1.3 mrad and more the film's gap
-  // trades with the coefficients' errors (docs/diagnose.md).
-  if (name == "mounting_misalignment") return {name, s * log_uniform(rng, 0.02, 0.06)};  // 1.1-3.4 deg
-  if (name == "squeeze_film_damping") return {name, 1 / log_uniform(rng, 1.0e-3, 1.2e-3)};
-  if (name == "shaker_harmonic_distortion") return {name, log_uniform(rng, 0.1, 0.3)};
-  if (name == "fixture_rocking") return {name, s * log_uniform(rng, 0.2e-6, 1e-6)};
-  // Outside the library: the DAQ's full scale just below the 4 g IA runs' peak output
-  // (4.71 g), and a 3rd harmonic (the library's distortion is the 2nd).
-  if (name == "readout_clipping") return {name, log_uniform(rng, 4.2, 4.7)};
-  if (name == "shaker_third_harmonic") return {name, log_uniform(rng, 0.1, 0.3)};
-  throw std::invalid_argument("blind: no parameter range for " + name);
+  const Effect* e = find_effect(name);
+  if (!e) throw std::invalid_argument("blind: no effect named " + name);
+  return draw_hidden(*e, rng);
 }
 
 // Campaign i's key: its category and hidden effects, from its own seed.
@@ -97,7 +72,7 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
     k.simulate_s = seconds_since(t0);
     k.diagnosis = diagnose(camp, settings);  // the key (k.hidden) is not passed
     if (k.category == "single") {
-      const EffectModel* e = find_effect(k.hidden[0].name);
+      const Effect* e = find_effect(k.hidden[0].name);
       for (const RunRecord& r : camp.runs) {
         const double size = predict_run_g(truth, r, e, k.hidden[0].parameter) - predict_run_g(truth, r);
         k.effect_max_sigma = std::max(k.effect_max_sigma, std::abs(size) / r.sigma_g);

@@ -111,7 +111,6 @@ struct Effect {
   // The right number of finite values that `check` accepts; why says otherwise.
   bool is_valid(ParameterValues values, std::string* why = nullptr) const;
 };
-using EffectModel = Effect;  // kept for app/diagnose.cpp until it says Effect
 
 // Every effect, the library's first in the diagnosis' order, then those outside it.
 const std::vector<Effect>& effect_registry();
