@@ -1,118 +1,217 @@
-// vrelab: the command-line interface. A thin layer: options in, library calls, results out.
-// Exit codes: 0 success, 2 bad input (case file, options, parameters the physics rejects,
-// solver failures), 1 anything else.
+// vrelab: the command-line interface. A thin layer: options in, library calls,
+// results out. Exit codes: 0 success, 2 bad input (case file, options,
+// parameters the physics rejects, solver failures), 1 anything else.
+#include <CLI/CLI.hpp>
+#include <functional>
 #include <iostream>
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
-#include <CLI/CLI.hpp>
-
-#include "io/case_file.hpp"
 #include "app/commands.hpp"
+#include "io/case_file.hpp"
 #include "plant/ode_solver.hpp"
 #include "vrelab_version.hpp"
 
-int main(int argc, char** argv) {
-  using namespace vrelab::app;
-  using namespace vrelab::io;
-  CLI::App app{"vrelab: a virtual shaker laboratory for the vibration rectification error of accelerometers"};
-  app.set_version_flag("--version", std::string("vrelab ") + vrelab::kProgramVersion + " (" + vrelab::kGitDescribe + ")");
-  app.require_subcommand(1);
+namespace {
 
-  IdentifyOptions id;
-  auto* identify = app.add_subcommand(
-      "identify", "Virtual static test on a dividing head; identify the coefficients of model (1)");
-  identify->add_option("case", id.case_path, "Case file (TOML)")->required();
-  identify->add_option("--json", id.json_path, "Write the result as JSON to this file");
-  identify->add_option("--monte-carlo", id.monte_carlo, "Also run N simulated tests for Monte Carlo uncertainty")
+using namespace vrelab::app;
+using namespace vrelab::io;
+
+// A subcommand and what running it does (its exit code); each add_* registers
+// one command's options on the CLI.
+struct Command {
+  CLI::App* sub;
+  std::function<int()> run;
+};
+
+Command add_identify(CLI::App& app) {
+  auto owned = std::make_shared<IdentifyOptions>();
+  IdentifyOptions& o = *owned;
+  CLI::App* cmd = app.add_subcommand("identify",
+                                     "Virtual static test on a dividing head; "
+                                     "identify the coefficients of model (1)");
+  cmd->add_option("case", o.case_path, "Case file (TOML)")->required();
+  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
+  cmd->add_option("--monte-carlo", o.monte_carlo, "Also run N simulated tests for Monte Carlo uncertainty")
       ->check(CLI::NonNegativeNumber);
-  identify->add_option("--seed", id.seed, "Override the case's [run] seed");
+  cmd->add_option("--seed", o.seed, "Override the case's [run] seed");
+  return {cmd, [owned] {
+            run_identify(*owned, std::cout);
+            return 0;
+          }};
+}
 
-  PredictOptions pr;
-  auto* predict = app.add_subcommand("predict", "Vibration error implied by model (1): eq. (3), corrected");
-  predict->add_option("case", pr.case_path, "Case file (TOML)")->required();
-  predict->add_option("--json", pr.json_path, "Write the result as JSON to this file");
-  predict->add_flag("--frequency-dependent", pr.frequency_dependent,
-                    "Also eq. (3) at [vibration] frequency_Hz through the plant's dynamics ([plant]; sine only)");
+Command add_predict(CLI::App& app) {
+  auto owned = std::make_shared<PredictOptions>();
+  PredictOptions& o = *owned;
+  CLI::App* cmd = app.add_subcommand("predict", "Vibration error implied by model (1): eq. (3), corrected");
+  cmd->add_option("case", o.case_path, "Case file (TOML)")->required();
+  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
+  cmd->add_flag("--frequency-dependent", o.frequency_dependent,
+                "Also eq. (3) at [vibration] frequency_Hz through the plant's "
+                "dynamics ([plant]; sine only)");
+  return {cmd, [owned] {
+            run_predict(*owned, std::cout);
+            return 0;
+          }};
+}
 
-  ShakeOptions sh;
-  auto* shake = app.add_subcommand("shake", "One run on the virtual shaker: measured vibration error vs eq. (3)");
-  shake->add_option("case", sh.case_path, "Case file (TOML)")->required();
-  shake->add_option("--json", sh.json_path, "Write the result as JSON to this file");
-  shake->add_option("--series", sh.series_path, "Write the sampled record as CSV to this file");
-  shake->add_option("--seed", sh.seed, "Override the case's [run] seed");
+Command add_shake(CLI::App& app) {
+  auto owned = std::make_shared<ShakeOptions>();
+  ShakeOptions& o = *owned;
+  CLI::App* cmd = app.add_subcommand("shake", "One run on the virtual shaker: measured vibration error vs eq. (3)");
+  cmd->add_option("case", o.case_path, "Case file (TOML)")->required();
+  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
+  cmd->add_option("--series", o.series_path, "Write the sampled record as CSV to this file");
+  cmd->add_option("--seed", o.seed, "Override the case's [run] seed");
+  return {cmd, [owned] {
+            run_shake(*owned, std::cout);
+            return 0;
+          }};
+}
 
-  MeasureOptions me;
-  auto* measure = app.add_subcommand("measure", "Vibration error from a recorded output series (CSV)");
-  measure->add_option("series", me.series_path, "CSV: time_s first, then output column(s); '#' lines are comments")
+Command add_measure(CLI::App& app) {
+  auto owned = std::make_shared<MeasureOptions>();
+  MeasureOptions& o = *owned;
+  CLI::App* cmd = app.add_subcommand("measure", "Vibration error from a recorded output series (CSV)");
+  cmd->add_option("series", o.series_path, "CSV: time_s first, then output column(s); '#' lines are comments")
       ->required();
-  measure->add_option("--on", me.on_s, "Vibration interval FROM,TO in s")->delimiter(',')->expected(2)->required();
-  measure->add_option("--baseline", me.baseline_s, "Baseline (at rest) interval FROM,TO in s")
+  cmd->add_option("--on", o.on_s, "Vibration interval FROM,TO in s")->delimiter(',')->expected(2)->required();
+  cmd->add_option("--baseline", o.baseline_s, "Baseline (at rest) interval FROM,TO in s")
       ->delimiter(',')
       ->expected(2)
       ->required();
-  measure->add_option("--frequency", me.frequency_Hz, "Sine frequency in Hz: measure over whole periods");
-  measure->add_option("--K1", me.K1, "Scale factor, output units per g (default 1: output in g)");
-  measure->add_option("--column", me.column, "Output column name (default: the last column)");
-  measure->add_option("--blocks", me.blocks, "Blocks for the batch-means uncertainty (default 4)");
-  measure->add_option("--json", me.json_path, "Write the result as JSON to this file");
+  cmd->add_option("--frequency", o.frequency_Hz, "Sine frequency in Hz: measure over whole periods");
+  cmd->add_option("--K1", o.K1, "Scale factor, output units per g (default 1: output in g)");
+  cmd->add_option("--column", o.column, "Output column name (default: the last column)");
+  cmd->add_option("--blocks", o.blocks, "Blocks for the batch-means uncertainty (default 4)");
+  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
+  return {cmd, [owned] {
+            run_measure(*owned, std::cout);
+            return 0;
+          }};
+}
 
-  SweepOptions sw;
-  auto* sweep = app.add_subcommand("sweep", "A grid of shaker runs on all cores; resumable");
-  sweep->add_option("case", sw.case_path, "Case file (TOML) with a [sweep] table")->required();
-  sweep->add_option("--out", sw.out_path, "Results CSV (resumed if it exists)")->required();
-  sweep->add_flag("--restart", sw.restart, "Discard an existing results file");
-  sweep->add_option("--threads", sw.threads, "Threads (default: the case's, 0 = all cores)");
-  bool no_progress = false;
-  sweep->add_flag("--no-progress", no_progress, "No progress bar");
+Command add_sweep(CLI::App& app) {
+  auto owned = std::make_shared<SweepOptions>();
+  SweepOptions& o = *owned;
+  CLI::App* cmd = app.add_subcommand("sweep", "A grid of shaker runs on all cores; resumable");
+  cmd->add_option("case", o.case_path, "Case file (TOML) with a [sweep] table")->required();
+  cmd->add_option("--out", o.out_path, "Results CSV (resumed if it exists)")->required();
+  cmd->add_flag("--restart", o.restart, "Discard an existing results file");
+  cmd->add_option("--threads", o.threads, "Threads (default: the case's, 0 = all cores)");
+  cmd->add_flag_callback(
+      "--no-progress", [&o] { o.progress = false; }, "No progress bar");
+  return {cmd, [owned] { return run_sweep(*owned, std::cout) > 0 ? 2 : 0; }};
+}
 
-  FrequencyOptions fr;
-  auto* frequency = app.add_subcommand(
-      "frequency", "Vibration error against frequency per term and place: eq. (3) through the dynamics vs the ODE");
-  frequency->add_option("case", fr.case_path, "Case file (TOML): [coefficients], [orientation], [plant], [frequency_study]")
+Command add_frequency(CLI::App& app) {
+  auto owned = std::make_shared<FrequencyOptions>();
+  FrequencyOptions& o = *owned;
+  CLI::App* cmd = app.add_subcommand("frequency",
+                                     "Vibration error against frequency per term and place: eq. "
+                                     "(3) through the dynamics vs the ODE");
+  cmd->add_option("case", o.case_path,
+                  "Case file (TOML): [coefficients], [orientation], [plant], "
+                  "[frequency_study]")
       ->required();
-  frequency->add_option("--out", fr.out_dir, "Output folder (CSV, JSON, Markdown table, PNG/SVG figure)")->required();
+  cmd->add_option("--out", o.out_dir, "Output folder (CSV, JSON, Markdown table, PNG/SVG figure)")->required();
+  return {cmd, [owned] {
+            run_frequency(*owned, std::cout);
+            return 0;
+          }};
+}
 
-  ReproduceOptions rp;
-  auto* reproduce = app.add_subcommand(
-      "reproduce", "The paper's experiment end to end: static test, confirmation plot, eq. (3) vs the shaker; report");
-  reproduce->add_option("case", rp.case_path, "Case file (TOML) with [dividing_head] and [reproduce]")
+Command add_reproduce(CLI::App& app) {
+  auto owned = std::make_shared<ReproduceOptions>();
+  ReproduceOptions& o = *owned;
+  CLI::App* cmd = app.add_subcommand("reproduce",
+                                     "The paper's experiment end to end: static test, "
+                                     "confirmation plot, eq. (3) vs the shaker; report");
+  cmd->add_option("case", o.case_path, "Case file (TOML) with [dividing_head] and [reproduce]")->capture_default_str();
+  cmd->add_option("--out", o.out_dir, "Output folder (report.html, report.md, figures, CSV/JSON)")
       ->capture_default_str();
-  reproduce->add_option("--out", rp.out_dir, "Output folder (report.html, report.md, figures, CSV/JSON)")
-      ->capture_default_str();
-  reproduce->add_option("--threads", rp.threads, "Threads (default: the case's, 0 = all cores)");
-  bool no_plots = false;
-  reproduce->add_flag("--no-plots", no_plots, "Write the data and the report without figures");
+  cmd->add_option("--threads", o.threads, "Threads (default: the case's, 0 = all cores)");
+  cmd->add_flag_callback(
+      "--no-plots", [&o] { o.plots = false; }, "Write the data and the report without figures");
+  return {cmd, [owned] {
+            run_reproduce(*owned, std::cout);
+            return 0;
+          }};
+}
 
-  CampaignOptions cp;
-  auto* campaign = app.add_subcommand("campaign", "The virtual lab: a whole campaign from a truth with hidden effects, "
-                                                  "in the lab data format, and its answer key");
-  campaign->add_option("case", cp.case_path, "Case file (TOML) with [coefficients], [plant] and [campaign]")->required();
-  campaign->add_option("--out", cp.out_dir, "Campaign folder (docs/data-format.md)")->required();
-  campaign->add_option("--key", cp.key_path, "Answer key (JSON; default <out>.key.json); diagnose never reads it");
-  campaign->add_option("--seed", cp.seed, "Seed (default: the case's [run] seed)");
+Command add_campaign(CLI::App& app) {
+  auto owned = std::make_shared<CampaignOptions>();
+  CampaignOptions& o = *owned;
+  CLI::App* cmd = app.add_subcommand("campaign",
+                                     "The virtual lab: a whole campaign from a truth with hidden effects, "
+                                     "in the lab data format, and its answer key");
+  cmd->add_option("case", o.case_path, "Case file (TOML) with [coefficients], [plant] and [campaign]")->required();
+  cmd->add_option("--out", o.out_dir, "Campaign folder (docs/data-format.md)")->required();
+  cmd->add_option("--key", o.key_path, "Answer key (JSON; default <out>.key.json); diagnose never reads it");
+  cmd->add_option("--seed", o.seed, "Seed (default: the case's [run] seed)");
+  return {cmd, [owned] {
+            run_campaign(*owned, std::cout);
+            return 0;
+          }};
+}
 
-  DiagnoseOptions dg;
-  auto* diagnose = app.add_subcommand("diagnose", "The sim-to-real gap of a campaign: where, which effect, how far it shrinks");
-  diagnose->add_option("dir", dg.dir, "Campaign folder (docs/data-format.md)")->required();
-  diagnose->add_option("--json", dg.json_path, "Write the diagnosis as JSON");
-  diagnose->add_option("--report", dg.report_dir, "Write report.md, report.html and diagnosis.json to this folder");
+Command add_diagnose(CLI::App& app) {
+  auto owned = std::make_shared<DiagnoseOptions>();
+  DiagnoseOptions& o = *owned;
+  CLI::App* cmd = app.add_subcommand("diagnose",
+                                     "The sim-to-real gap of a campaign: "
+                                     "where, which effect, how far it shrinks");
+  cmd->add_option("dir", o.dir, "Campaign folder (docs/data-format.md)")->required();
+  cmd->add_option("--json", o.json_path, "Write the diagnosis as JSON");
+  cmd->add_option("--report", o.report_dir, "Write report.md, report.html and diagnosis.json to this folder");
   // DiagnoseSettings over the manifest's [diagnose] (docs/data-format.md).
-  diagnose->add_option("--significance-sigma", dg.settings.significance_sigma, "A gap is significant beyond this many sigma (5)");
-  diagnose->add_option("--model-accuracy", dg.settings.model_accuracy, "The simulation's relative accuracy (0.002)");
-  diagnose->add_option("--explained-shrinkage", dg.settings.explained_shrinkage,
-                       "Held-out gap rms share an effect must remove to explain the gap (0.9)");
-  diagnose->add_option("--resimulate-runs", dg.settings.resimulate_runs, "Runs re-simulated on the ODE plant (12; 0: none)");
-  diagnose->add_flag_callback("--no-pairs", [&dg] { dg.settings.try_pairs = false; }, "Do not try two effects at once");
+  cmd->add_option("--significance-sigma", o.settings.significance_sigma,
+                  "A gap is significant beyond this many sigma (5)");
+  cmd->add_option("--model-accuracy", o.settings.model_accuracy, "The simulation's relative accuracy (0.002)");
+  cmd->add_option("--explained-shrinkage", o.settings.explained_shrinkage,
+                  "Held-out gap rms share an effect must remove to explain the gap (0.9)");
+  cmd->add_option("--resimulate-runs", o.settings.resimulate_runs, "Runs re-simulated on the ODE plant (12; 0: none)");
+  cmd->add_flag_callback(
+      "--no-pairs", [&o] { o.settings.try_pairs = false; }, "Do not try two effects at once");
+  return {cmd, [owned] {
+            run_diagnose(*owned, std::cout);
+            return 0;
+          }};
+}
 
-  BlindOptions bl;
-  auto* blind = app.add_subcommand("blind", "Campaigns with random hidden effects, diagnosed without their keys, then scored");
-  blind->add_option("--n", bl.settings.n, "Number of campaigns")->capture_default_str();
-  blind->add_option("--seed", bl.settings.seed, "Seed of the draw")->capture_default_str();
-  blind->add_option("--out", bl.out_dir, "Output folder (scores.json, confusion.csv)")->capture_default_str();
-  blind->add_option("--threads", bl.settings.threads, "Threads (0: all cores)");
-  blind->add_flag_callback("--no-progress", [&bl] { bl.progress = false; }, "No progress bar");
+Command add_blind(CLI::App& app) {
+  auto owned = std::make_shared<BlindOptions>();
+  BlindOptions& o = *owned;
+  CLI::App* cmd = app.add_subcommand("blind",
+                                     "Campaigns with random hidden effects, "
+                                     "diagnosed without their keys, then scored");
+  cmd->add_option("--n", o.settings.n, "Number of campaigns")->capture_default_str();
+  cmd->add_option("--seed", o.settings.seed, "Seed of the draw")->capture_default_str();
+  cmd->add_option("--out", o.out_dir, "Output folder (scores.json, confusion.csv)")->capture_default_str();
+  cmd->add_option("--threads", o.settings.threads, "Threads (0: all cores)");
+  cmd->add_flag_callback(
+      "--no-progress", [&o] { o.progress = false; }, "No progress bar");
+  return {cmd, [owned] {
+            run_blind(*owned, std::cout);
+            return 0;
+          }};
+}
 
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "vrelab: a virtual shaker laboratory for the vibration "
+      "rectification error of accelerometers"};
+  app.set_version_flag("--version",
+                       std::string("vrelab ") + vrelab::kProgramVersion + " (" + vrelab::kGitDescribe + ")");
+  app.require_subcommand(1);
+  const std::vector<Command> commands = {add_identify(app), add_predict(app),   add_shake(app),     add_measure(app),
+                                         add_sweep(app),    add_frequency(app), add_reproduce(app), add_campaign(app),
+                                         add_diagnose(app), add_blind(app)};
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -120,22 +219,8 @@ int main(int argc, char** argv) {
     return rc == 0 ? 0 : 2;
   }
   try {
-    if (*identify) run_identify(id, std::cout);
-    if (*predict) run_predict(pr, std::cout);
-    if (*shake) run_shake(sh, std::cout);
-    if (*measure) run_measure(me, std::cout);
-    if (*frequency) run_frequency(fr, std::cout);
-    if (*campaign) run_campaign(cp, std::cout);
-    if (*diagnose) run_diagnose(dg, std::cout);
-    if (*blind) run_blind(bl, std::cout);
-    if (*reproduce) {
-      rp.plots = !no_plots;
-      run_reproduce(rp, std::cout);
-    }
-    if (*sweep) {
-      sw.progress = !no_progress;
-      if (run_sweep(sw, std::cout) > 0) return 2;
-    }
+    for (const Command& c : commands)
+      if (*c.sub) return c.run();
   } catch (const InputError& e) {
     std::cerr << "vrelab: error: " << e.what() << "\n";
     return 2;
@@ -143,8 +228,8 @@ int main(int argc, char** argv) {
     std::cerr << "vrelab: error: " << e.what() << "\n";
     return 2;
   } catch (const std::invalid_argument& e) {
-    // The library rejects parameters it cannot work with (e.g. an unstable loop design):
-    // input that passed the case reader's checks but not the physics.
+    // The library rejects parameters it cannot work with (e.g. an unstable loop
+    // design): input that passed the case reader's checks but not the physics.
     std::cerr << "vrelab: error: " << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
