@@ -5,15 +5,29 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "rectification/simulation/shaker_motion.hpp"
 #include "validation/diagnosis/effects/common.hpp"
 #include "vibration/excitation.hpp"
 
 namespace vrelab::validation {
 
+namespace {
+
+// A sine run's motion through the one builder of a shaker run's motion.
+std::shared_ptr<const vibration::Excitation> sine_motion(const vibration::SineVibration& sine,
+                                                         const rectification::ShakerImperfections& shaker,
+                                                         const Vec3& static_gravity_g, double g_m_per_s2) {
+  rectification::VibrationRequest request;
+  request.type = "sine";
+  request.sine = sine;
+  return rectification::shaker_motion(request, shaker, static_gravity_g, g_m_per_s2, 0).motion;
+}
+
+}  // namespace
+
 std::shared_ptr<const vibration::Excitation> TableMotion::excitation() const {
-  auto tone = std::make_shared<vibration::SineExcitation>(sine);
-  std::shared_ptr<const vibration::Excitation> motion = tone;
-  if (!harmonics.empty()) motion = std::make_shared<vibration::HarmonicDistortion>(tone, harmonics);
+  rectification::ShakerImperfections shaker;
+  shaker.harmonics = harmonics;
   if (rocking_rad_per_g != 0) {
     // Gravity and the table's motion turn with the fixture; the lever arm adds a tangential
     // acceleration along PA (~ f^2) and a centripetal one along -IA (~ f^2 alpha^2).
@@ -21,12 +35,10 @@ std::shared_ptr<const vibration::Excitation> TableMotion::excitation() const {
     rs.axis = Vec3::UnitZ();
     rs.amplitude_rad = std::abs(rocking_rad_per_g) * commanded_amplitude_g;
     rs.phase_rad = rocking_rad_per_g < 0 ? std::numbers::pi : 0.0;
-    rs.static_gravity_g = static_gravity_g;
     rs.lever_arm_m = Vec3(kRockingLeverArm_m, 0, 0);
-    rs.g_m_per_s2 = 9.80665;
-    motion = std::make_shared<vibration::Rocking>(motion, tone, rs);
+    shaker.rocking = rs;
   }
-  return motion;
+  return sine_motion(sine, shaker, static_gravity_g, 9.80665);
 }
 
 plant::PlantConfig VirtualLab::run_plant() const {
@@ -36,11 +48,11 @@ plant::PlantConfig VirtualLab::run_plant() const {
 }
 
 std::shared_ptr<const vibration::Excitation> VirtualLab::excitation() const {
-  auto tone = std::make_shared<vibration::SineExcitation>(table);
-  std::shared_ptr<const vibration::Excitation> motion = tone;
-  if (!harmonics.empty()) motion = std::make_shared<vibration::HarmonicDistortion>(tone, harmonics);
-  if (rocking) motion = std::make_shared<vibration::Rocking>(motion, tone, *rocking);
-  return motion;
+  rectification::ShakerImperfections shaker;
+  shaker.harmonics = harmonics;
+  shaker.rocking = rocking;
+  return sine_motion(table, shaker, rocking ? rocking->static_gravity_g : static_gravity_g,
+                     rocking ? rocking->g_m_per_s2 : 9.80665);
 }
 
 const char* to_string(ActsOn a) {
