@@ -8,7 +8,7 @@
 #include "io/case_file.hpp"
 #include "io/output.hpp"
 #include "validation/diagnosis/campaign.hpp"
-#include "validation/diagnosis/diagnosis_report.hpp"
+#include "validation/diagnosis/diagnose.hpp"
 
 namespace vrelab::io {
 namespace {
@@ -75,7 +75,7 @@ FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides&
   if (o.try_pairs) s.try_pairs = *o.try_pairs;
   if (o.any()) f.settings_from += ", set over by the caller";
   std::string why;
-  if (!validation::is_valid(s, &why)) throw InputError("diagnose settings: " + why);
+  if (!s.IsValid(&why)) throw InputError("diagnose settings: " + why);
   const auto start = Clock::now();
   try {
     f.diagnosis = validation::diagnose(c, s);
@@ -99,10 +99,10 @@ std::string header(const FolderDiagnosis& f) {
 
 }  // namespace
 
-std::string FolderDiagnosis::BriefReport() const { return header(*this) + validation::brief_report(diagnosis, campaign); }
+std::string FolderDiagnosis::BriefReport() const { return header(*this) + diagnosis.BriefReport(); }
 
 std::string FolderDiagnosis::FullReport() const {
-  return header(*this) + validation::full_report(diagnosis, campaign, wall_s);
+  return header(*this) + diagnosis.FullReport(wall_s);
 }
 
 }  // namespace vrelab::io

@@ -16,7 +16,7 @@
 #include "io/csv.hpp"
 #include "io/output.hpp"
 #include "rectification/measurement/series.hpp"
-#include "validation/diagnosis/diagnosis_report.hpp"
+#include "validation/diagnosis/diagnose.hpp"
 #include "validation/identification/dividing_head.hpp"
 
 namespace vrelab::io {
@@ -149,7 +149,7 @@ void read_diagnose_settings(const toml::table& t, const std::string& file, LabMa
     s.try_pairs = n->value<bool>().value();
   }
   std::string why;
-  if (!validation::is_valid(s, &why)) throw InputError(file + ": [diagnose] " + why);
+  if (!s.IsValid(&why)) throw InputError(file + ": [diagnose] " + why);
 }
 
 // A run's raw record as a CSV of time and output.

@@ -11,7 +11,7 @@
 #include "io/lab_data.hpp"
 #include "support/files.hpp"
 #include "validation/diagnosis/blind.hpp"
-#include "validation/diagnosis/diagnosis_report.hpp"
+#include "validation/diagnosis/diagnose.hpp"
 
 using namespace vrelab;
 namespace fs = std::filesystem;
@@ -72,14 +72,14 @@ TEST(DiagnoseSettings, ABadKeyOrValueNamesTheFileTheKeyAndWhy) {
 
 TEST(DiagnoseSettings, IsValidNamesTheField) {
   std::string why;
-  EXPECT_TRUE(validation::is_valid(validation::DiagnoseSettings{}, &why)) << why;
+  EXPECT_TRUE(validation::DiagnoseSettings{}.IsValid(&why)) << why;
   validation::DiagnoseSettings s;
   s.explained_shrinkage = 0;
-  EXPECT_FALSE(validation::is_valid(s, &why));
+  EXPECT_FALSE(s.IsValid(&why));
   EXPECT_NE(why.find("explained_shrinkage"), std::string::npos);
   s = {};
   s.resimulate_runs = -1;
-  EXPECT_FALSE(validation::is_valid(s, &why));
+  EXPECT_FALSE(s.IsValid(&why));
   EXPECT_NE(why.find("resimulate_runs"), std::string::npos);
   const nlohmann::json j = io::to_json(validation::DiagnoseSettings{});
   EXPECT_EQ(j["significance_sigma"], 5.0);

@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "core/parallel.hpp"
-#include "validation/diagnosis/diagnosis_report.hpp"
+#include "validation/diagnosis/diagnose.hpp"
 
 namespace vrelab::validation {
 namespace {
@@ -141,7 +141,7 @@ bool BlindSettings::IsValid(std::string* why) const {
   std::string w;
   if (n < 1) w = fmt::format("n = {}: at least one campaign", n);
   else if (threads < 0) w = fmt::format("threads = {}: must not be negative (0: all cores)", threads);
-  else if (std::string d; !is_valid(diagnose, &d)) w = "diagnose." + d;
+  else if (std::string d; !diagnose.IsValid(&d)) w = "diagnose." + d;
   if (why) *why = w;
   return w.empty();
 }

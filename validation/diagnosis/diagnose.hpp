@@ -97,6 +97,8 @@ struct DiagnoseSettings {
   double explained_shrinkage = 0.9;
   int resimulate_runs = 12;             // runs (largest gaps first) re-simulated on the ODE; 0: none
   bool try_pairs = true;                // two effects at once when no one effect explains the gap
+  // False with `why` naming the setting (its field name), its value and the rule it breaks.
+  bool IsValid(std::string* why) const;
 };
 
 struct EffectFit {
@@ -155,6 +157,11 @@ struct Diagnosis {
   int resimulated_runs = 0;
   double resimulated_rms_before_g = 0, resimulated_rms_after_g = 0;
   std::vector<std::string> resimulation_failures;
+  // The verdict and the held-out shrinkage (brief), or everything found: where, the folds, each
+  // effect and pair, the shrinkage, the ODE confirmation (full; wall_s >= 0 is printed).
+  // validation/diagnosis/diagnosis_report.cpp.
+  std::string BriefReport() const;
+  std::string FullReport(double wall_s = -1) const;
 };
 
 Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {});

@@ -1,4 +1,6 @@
-#include "validation/diagnosis/diagnosis_report.hpp"
+// validation/diagnosis/diagnosis_report.cpp -- a diagnosis in words (Diagnosis::BriefReport,
+// FullReport) and the check of its settings (DiagnoseSettings::IsValid).
+#include "validation/diagnosis/diagnose.hpp"
 
 #include <cmath>
 
@@ -15,7 +17,8 @@ std::string heldout_line(const Diagnosis& d, double wall_s) {
 
 }  // namespace
 
-bool is_valid(const DiagnoseSettings& s, std::string* why) {
+bool DiagnoseSettings::IsValid(std::string* why) const {
+  const DiagnoseSettings& s = *this;
   std::string w;
   if (!(std::isfinite(s.model_accuracy) && s.model_accuracy >= 0 && s.model_accuracy < 1))
     w = fmt::format("model_accuracy = {}: the simulation's relative accuracy must be in [0, 1)", s.model_accuracy);
@@ -29,11 +32,13 @@ bool is_valid(const DiagnoseSettings& s, std::string* why) {
   return w.empty();
 }
 
-std::string brief_report(const Diagnosis& d, const Campaign&) {
+std::string Diagnosis::BriefReport() const {
+  const Diagnosis& d = *this;
   return "Verdict: " + d.verdict + "\n" + heldout_line(d, -1);
 }
 
-std::string full_report(const Diagnosis& d, const Campaign&, double wall_s) {
+std::string Diagnosis::FullReport(double wall_s) const {
+  const Diagnosis& d = *this;
   std::string t = "Gap: " + d.where + "\n";
   t += "Cross-validation: " + d.folds + "\n";
   t += "Verdict: " + d.verdict + "\n";
