@@ -72,7 +72,7 @@ struct ReproduceOptions {
 // The paper's experiment end to end: report.html, report.md, figures, CSV/JSON (app/reproduce.cpp).
 void run_reproduce(const ReproduceOptions& o, std::ostream& out);
 
-// Issue 5 (app/diagnose.cpp): the virtual lab, the diagnosis, and the blind test.
+// app/diagnose.cpp: the virtual lab, the diagnosis, and the blind test.
 struct CampaignOptions {
   std::string case_path, out_dir, key_path;  // key: default <out_dir>.key.json
   std::optional<std::uint64_t> seed;

@@ -267,8 +267,8 @@ TEST(PeriodicRectification, SqueezeFilmDescribingFunctionPredictsTheOdesChange) 
   const Dynamics& d = base.dynamics;
   const double c0 = 2 * d.pendulum_damping_ratio * 2 * std::numbers::pi * d.pendulum_frequency_Hz;
   const Vec3 a = Vec3(1, 0, 1).normalized();
-  // Also a film whose c0 is 3x the pendulum's own damping (the film's c0 adds to it): a
-  // reviewer found the first version scaling the nominal damping instead (-5.3 vs -14.8 ug).
+  // Also a film whose c0 is 3x the pendulum's own damping: the film's own c0 adds to the
+  // damping (scaling the nominal damping instead gives -5.3 where the ODE says -14.8 ug).
   for (const auto& [f, c0_factor] : std::vector<std::pair<double, double>>{{50.0, 1}, {200.0, 1}, {500.0, 1}, {200.0, 3}, {500.0, 3}}) {
     vibration::SineVibration v;
     v.amplitude_g = Vec3(4, 0, 0), v.frequency_Hz = f;

@@ -1,4 +1,4 @@
-// Issue 5: the effect library's predictions against the ODE truth, diagnose on small
+// The effect library's predictions against the ODE truth, diagnose on small
 // simulated campaigns (clean, one hidden effect, one outside the library), and the lab data
 // format (round trip, the hand-written example, bad input that skips runs or stops).
 // Seeds here (31-36, 41) were not used to develop the diagnosis (that used 7 and

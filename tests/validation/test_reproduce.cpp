@@ -1,4 +1,4 @@
-// `vrelab reproduce` (issue 4): the prediction's uncertainty against Monte Carlo, the whole
+// `vrelab reproduce`: the prediction's uncertainty against Monte Carlo, the whole
 // reproduction on a small case (agreement at low frequency, the departure in frequency, the
 // invisible shift recovered), the report written as Markdown and HTML, and bad input.
 #include <gtest/gtest.h>

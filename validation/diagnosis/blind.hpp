@@ -1,5 +1,5 @@
 #pragma once
-// validation/diagnosis/blind.hpp -- the blind test of the diagnosis (issue 5; docs/diagnose.md):
+// validation/diagnosis/blind.hpp -- the blind test of the diagnosis (docs/diagnose.md):
 // campaigns simulated with random hidden effects, diagnosed without their keys, then scored.
 //
 // Takes: BlindSettings (how many campaigns, the seed of the draw, threads, the diagnosis' settings).

@@ -1,6 +1,6 @@
 #pragma once
 // validation/diagnosis/campaign.hpp -- the virtual lab: a whole test campaign simulated from a "truth"
-// instrument that may carry hidden effects (issue 5).
+// instrument that may carry hidden effects.
 //
 // Takes: the truth plant (coefficients, dynamics), the hidden effects (names in the effect
 //        registry, validation/diagnosis/effect.hpp, with their parameter: the library's and

@@ -622,12 +622,9 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   std::sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
   for (const auto& sc : scored) d.effects.push_back(sc.fit);
 
-  // 4. The verdict and the held-out shrinkage of the chosen effect(s).
-  // (Requiring the held-out gap rms to shrink as well was tried and dropped: it turned a
-  // squeeze film called higher_order_k6, whose point prediction made the gap 7x larger, into
-  // "unexplained", but it also failed a right harmonic distortion (h = 0.1265 +- 0.0057 for
-  // 0.1227, held-out chi^2 346 -> 156 for 168 runs) whose adjusted residuals, which leave out
-  // the runs' correlations, grew from 1.4 to 2.2 ug.)
+  // 4. The verdict and the held-out shrinkage of the chosen effect(s). The held-out gap rms
+  // need not shrink for "explained": the adjusted residuals leave out the runs' correlations
+  // and can grow while chi^2 falls (docs/diagnose.md).
   const auto explains = [&](const Scored& sc, double rms_after) {
     return sc.fit.evidence > s.significance_sigma * s.significance_sigma &&
            (chi2_as_sigma(sc.fit.heldout_chi2, n) < s.significance_sigma ||

@@ -1,6 +1,6 @@
 #pragma once
 // validation/diagnosis/diagnose.hpp -- the sim-to-real gap: where it lies, which effect causes it, how
-// far it shrinks (issue 5; docs/diagnose.md).
+// far it shrinks (docs/diagnose.md).
 //
 // Takes: a campaign (a lab's static readings and shaker-run summaries, in memory; the lab
 //        data format of docs/data-format.md is read by the app) and the nominal dynamics.
