@@ -76,6 +76,7 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out);
 struct CampaignOptions {
   std::string case_path, out_dir, key_path;  // key: default <out_dir>.key.json
   std::optional<std::uint64_t> seed;
+  bool progress = true;
 };
 void run_campaign(const CampaignOptions& o, std::ostream& out);
 

@@ -152,6 +152,7 @@ Command add_campaign(CLI::App& app) {
   cmd->add_option("--out", o.out_dir, "Campaign folder (docs/data-format.md)")->required();
   cmd->add_option("--key", o.key_path, "Answer key (JSON; default <out>.key.json); diagnose never reads it");
   cmd->add_option("--seed", o.seed, "Seed (default: the case's [run] seed)");
+  cmd->add_flag_callback("--no-progress", [&o] { o.progress = false; }, "No progress bar");
   return {cmd, [owned] {
             run_campaign(*owned, std::cout);
             return 0;

@@ -26,7 +26,7 @@ class Progress {
   double elapsed_s() const { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count(); }
   std::size_t done() const { return done_; }
 
-  // One more item finished (`already` items counted as done before the run, e.g. resumed).
+  // `items` more finished.
   void tick(std::size_t items = 1) {
     done_ += items;
     if (!enabled_) return;
@@ -34,19 +34,14 @@ class Progress {
     if (!tty_ && decile == last_decile_ && done_ < total_) return;
     last_decile_ = decile;
     const double t = elapsed_s();
-    const std::size_t fresh = done_ - already_;
-    const double eta = fresh > 0 && done_ < total_ ? t / static_cast<double>(fresh) * static_cast<double>(total_ - done_) : 0.0;
+    const double eta = done_ > 0 && done_ < total_ ? t / static_cast<double>(done_) * static_cast<double>(total_ - done_) : 0.0;
     constexpr int kWidth = 24;
-    const int fill = total_ ? static_cast<int>(kWidth * done_ / total_) : kWidth;
+    const int fill = total_ && done_ < total_ ? static_cast<int>(kWidth * done_ / total_) : kWidth;
     char line[160];
     std::snprintf(line, sizeof line, "%s [%s%s] %zu/%zu, %.1f s, ETA %.0f s", label_.c_str(), std::string(fill, '#').c_str(),
                   std::string(kWidth - fill, '.').c_str(), done_, total_, t, eta);
     out_ << (tty_ ? "\r" : "") << line << (tty_ ? " " : "\n") << std::flush;
     drawn_ = true;
-  }
-  // Items done before this run started (a resumed sweep): counted, left out of the ETA's rate.
-  void resume_from(std::size_t already) {
-    done_ = already_ = already;
   }
   void finish() {
     if (enabled_ && tty_ && drawn_) out_ << "\n" << std::flush;
@@ -56,7 +51,7 @@ class Progress {
  private:
   std::ostream& out_;
   std::string label_;
-  std::size_t total_, done_ = 0, already_ = 0, last_decile_ = 11;
+  std::size_t total_, done_ = 0, last_decile_ = 11;
   bool enabled_, tty_, drawn_ = false;
   std::chrono::steady_clock::time_point start_;
 };

@@ -1,5 +1,7 @@
 #include "io/diagnosis.hpp"
 
+#include <iostream>
+
 #include <chrono>
 #include <stdexcept>
 
@@ -8,6 +10,7 @@
 #include "io/case_file.hpp"
 #include "io/output.hpp"
 #include "validation/diagnosis/campaign.hpp"
+#include "core/progress.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 
 namespace vrelab::io {
@@ -30,8 +33,12 @@ CampaignWritten write_virtual_campaign(const CampaignRequest& request) {
   w.request.seed = c.seed;
   if (w.request.key_path.empty()) w.request.key_path = request.out_dir + ".key.json";
   const auto start = Clock::now();
-  // Not yet with a progress display: simulate_campaign takes no callback.
-  validation::Campaign camp = validation::simulate_campaign(c.plant, spec.hidden, spec.design, c.seed, 0);
+  core::Progress progress(std::cerr, "campaign", spec.design.frequencies_Hz.size() * spec.design.amplitudes_g.size() *
+                                                    spec.design.directions.size() * spec.design.orientations_g.size(),
+                          request.progress);
+  validation::Campaign camp =
+      validation::simulate_campaign(c.plant, spec.hidden, spec.design, c.seed, 0, [&progress] { progress.tick(); });
+  progress.finish();
   camp.name = spec.name;
   LabManifest m;
   m.name = spec.name, m.output_unit = c.output_unit, m.g_m_per_s2 = c.g_m_per_s2;

@@ -23,6 +23,7 @@ struct CampaignRequest {
   std::string case_path, out_dir;
   std::string key_path;               // the answer key; "": <out_dir>.key.json
   std::optional<std::uint64_t> seed;  // default: the case's [run] seed
+  bool progress = false;              // draw core::Progress on stderr
 };
 
 struct CampaignWritten {

@@ -247,7 +247,9 @@ rectification::ShakerMotion shake_motion(const Case& c) {
   try {
     t = rectification::shaker_motion(vs, c.shaker, *c.orientation_g, c.g_m_per_s2, c.seed);
   } catch (const std::invalid_argument& e) {
-    throw InputError(c.path + ": [vibration]/[shaker]: " + e.what());
+    // The imperfections' own limits are the [shaker] table's; the rest is the request's.
+    const bool shaker = std::string(e.what()).rfind("transverse motion, harmonics and rocking", 0) == 0;
+    throw InputError(fmt::format("{}:{}: [{}] {}", c.path, vs.line, shaker ? "shaker" : "vibration", e.what()));
   }
   try {
     vibration::check_feasible(t.demand, c.shaker.limits);

@@ -65,8 +65,7 @@ std::vector<double> spaced(double f1, double f2, int n, bool logarithmic) {
 
 void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth, const ShakeSettings& settings,
                const SweepGrid& grid,
-               const std::vector<std::size_t>& skip, int threads, const std::function<void(const SweepRow&)>& on_row,
-               const std::function<void(const SweepProgress&)>& on_progress) {
+               const std::vector<std::size_t>& skip, int threads, const std::function<void(const SweepRow&)>& on_row) {
   std::vector<std::size_t> todo;
   for (std::size_t i = 0; i < grid.size(); ++i)
     if (!std::binary_search(skip.begin(), skip.end(), i)) todo.push_back(i);
@@ -77,9 +76,6 @@ void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth
     return (0.05 + 5 / f) * std::max(f, 50.0);
   };
   std::stable_sort(todo.begin(), todo.end(), [&](std::size_t a, std::size_t b) { return cost(a) > cost(b); });
-  SweepProgress progress;
-  progress.total = todo.size();
-  const auto start = std::chrono::steady_clock::now();
   std::vector<SweepRow> rows(todo.size());
   core::parallel_for(
       todo.size(), threads,
@@ -105,12 +101,7 @@ void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth
         }
         row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       },
-      [&](std::size_t k) {  // under the pool's lock
-        on_row(rows[k]);
-        ++progress.done;
-        progress.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        if (on_progress) on_progress(progress);
-      });
+      [&](std::size_t k) { on_row(rows[k]); });  // under the pool's lock
 }
 
 }  // namespace vrelab::rectification

@@ -9,7 +9,6 @@
 //        A solver failure in one condition is recorded in its row (ok = false, message
 //        naming the call and the simulated time); the others go on. With a readout, the
 //        noise of condition i is drawn from seed readout.seed + i (independent runs).
-#include <atomic>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -55,18 +54,12 @@ struct SweepRow {
   long steps = 0;
 };
 
-struct SweepProgress {
-  std::size_t done = 0, total = 0;
-  double elapsed_s = 0;
-};
-
-// Runs every condition not in `skip` (sorted indices). `on_row` and `on_progress` are called
-// under a lock, from the worker threads, as rows complete.
+// Runs every condition not in `skip` (sorted indices). `on_row` is called under a lock, from
+// the worker threads, as rows complete.
 // `truth`: the coefficients eq. (3) is evaluated with (for a physical plant, the implied ones).
 void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth, const ShakeSettings& settings,
                const SweepGrid& grid,
                const std::vector<std::size_t>& skip, int threads,
-               const std::function<void(const SweepRow&)>& on_row,
-               const std::function<void(const SweepProgress&)>& on_progress = {});
+               const std::function<void(const SweepRow&)>& on_row);
 
 }  // namespace vrelab::rectification

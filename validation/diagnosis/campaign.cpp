@@ -65,7 +65,8 @@ VirtualLab truth_lab(const plant::PlantConfig& truth, const std::vector<HiddenEf
 }  // namespace
 
 Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
-                           const CampaignDesign& design, std::uint64_t seed, int threads) {
+                           const CampaignDesign& design, std::uint64_t seed, int threads,
+                           const std::function<void()>& run_done) {
   for (const auto& h : hidden) validate(h);
   Campaign c;
   c.dynamics = truth.dynamics;
@@ -143,7 +144,9 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
       failures[k] = e.what();
     }
   };
-  core::parallel_for(c.runs.size(), std::max(1, threads), run);  // threads <= 0: one
+  core::parallel_for(c.runs.size(), threads, run, [&](std::size_t) {
+    if (run_done) run_done();
+  });
   for (std::size_t k = 0; k < failures.size(); ++k)
     if (!failures[k].empty()) throw std::runtime_error("campaign: " + c.runs[k].id + ": " + failures[k]);
   return c;

@@ -15,6 +15,7 @@
 // The truth is built by each effect's truth hook (plant modules and shaker decorators), not
 // by the hypothesis the diagnosis fits (docs/diagnose.md, "Truth and hypothesis").
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -59,7 +60,9 @@ bool is_out_of_library(const std::string& name);
 // std::invalid_argument "campaign: ..." otherwise.
 void validate(const HiddenEffect& h);
 
+// threads: 0 all cores. run_done, when given, is called (under a lock) after each shaker run.
 Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
-                           const CampaignDesign& design, std::uint64_t seed, int threads = 1);
+                           const CampaignDesign& design, std::uint64_t seed, int threads = 1,
+                           const std::function<void()>& run_done = {});
 
 }  // namespace vrelab::validation

@@ -50,7 +50,7 @@ inline Vec3 signed_in_phase(const vibration::SineVibration& v) {
   return a;
 }
 inline void set_in_phase(vibration::SineVibration& v, const Vec3& a) {
-  for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(a[i]), v.phase_rad[i] = a[i] < 0 ? M_PI : 0.0;
+  for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(a[i]), v.phase_rad[i] = a[i] < 0 ? std::numbers::pi : 0.0;
 }
 
 // A sine as phasors W = A e^{j phase} (g), and back (the truths: any phase).

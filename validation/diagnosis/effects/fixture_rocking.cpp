@@ -30,7 +30,7 @@ Effect effect_fixture_rocking() {
     rs.phase_rad = v[0] < 0 ? std::numbers::pi : 0.0;
     rs.static_gravity_g = lab.static_gravity_g;
     rs.rotate_shaker_motion = true;
-    rs.lever_arm_m = Vec3(0.03, 0, 0);
+    rs.lever_arm_m = Vec3(TableMotion::kRockingLeverArm_m, 0, 0);
     rs.g_m_per_s2 = 9.80665;
     lab.rocking = rs;
   };
