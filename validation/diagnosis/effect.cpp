@@ -1,10 +1,13 @@
 #include "validation/diagnosis/effect.hpp"
 
 #include <algorithm>
+#include <array>
+#include <memory>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
 
+#include "plant/effects/output_polynomial.hpp"
 #include "rectification/simulation/shaker_motion.hpp"
 #include "validation/diagnosis/effects/common.hpp"
 #include "vibration/excitation.hpp"
@@ -123,5 +126,41 @@ const Effect* find_effect(const std::string& name) {
     if (e.name == name) return &e;
   return nullptr;
 }
+
+namespace effects {
+
+Effect higher_order_term(int n, int rank, std::string physics, double unit_value, double example, double lo, double hi) {
+  // (Appending to a named string: GCC 12 warns falsely (-Wrestrict) on "literal" + to_string.)
+  const std::string order = std::to_string(n);
+  Effect e;
+  e.name = std::string("higher_order_k").append(order);
+  e.rank = rank;
+  e.acts_on = ActsOn::instrument;
+  e.acts_at_rest = true;
+  e.physics = std::move(physics);
+  EffectParameter p(std::string("k").append(order), std::string("1/g^").append(std::to_string(n - 1)));
+  p.example = example;
+  p.linear = true, p.unit_value = unit_value;
+  e.parameters = {p};
+  const auto term = [n, name = e.name](double k) {
+    std::array<double, 7> poly{};
+    poly[static_cast<std::size_t>(n)] = k;
+    return std::make_shared<plant::OutputPolynomial>(name, poly);
+  };
+  e.hypothesis = [term](ParameterValues v, plant::PlantConfig& c, TableMotion&) {
+    if (v[0] != 0) c.effects.push_back(term(v[0]));
+  };
+  // The instrument's own term: the static test and the runs both read it.
+  e.truth = [term](ParameterValues v, VirtualLab& lab) {
+    if (v[0] != 0) lab.instrument.effects.push_back(term(v[0]));
+  };
+  e.draw = [lo, hi](std::mt19937_64& rng) {
+    const double s = random_sign(rng);
+    return std::vector<double>{s * log_uniform(rng, lo, hi)};
+  };
+  return e;
+}
+
+}  // namespace effects
 
 }  // namespace vrelab::validation

@@ -76,6 +76,11 @@ inline bool harmonic_ratio(const std::string& name, ParameterValues p, std::stri
   return false;
 }
 
+// An input-axis term k_n a^n beyond model (1) (n = 5, 6), on the readout
+// (plant::OutputPolynomial): linear in k_n, acting at rest too (the static test takes part of
+// it up), the instrument's own in the virtual lab; drawn log-uniform in [lo, hi] with a sign.
+Effect higher_order_term(int n, int rank, std::string physics, double unit_value, double example, double lo, double hi);
+
 }  // namespace vrelab::validation::effects
 
 namespace vrelab::validation {
