@@ -5,10 +5,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <iterator>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -307,7 +309,10 @@ class SeriesFile {
 
 }  // namespace
 
-ShakeStudy shake(const Case& c, const std::string& series_path) {
+namespace {
+
+ShakeStudy shake_with(const Case& c, const std::function<rectification::SampleSink()>& make_sink,
+                      const std::function<void()>& done) {
   require(c, c.coefficients.has_value(), "coefficients", "shake");
   require(c, c.orientation_g.has_value(), "orientation", "shake");
   require(c, c.vibration.has_value(), "vibration", "shake");
@@ -315,17 +320,33 @@ ShakeStudy shake(const Case& c, const std::string& series_path) {
   const VibrationSpec& vs = *c.vibration;
   ShakeStudy s;
   s.table = shake_motion(c);
-  SeriesFile series(c, series_path);
+  const rectification::SampleSink sink = make_sink();
   const auto start = std::chrono::steady_clock::now();
   const Vec3& a = *c.orientation_g;
-  s.result = s.table.periodic ? rectification::shake_sine(c.plant, a, vs.sine, c.shake, series.sink(),
+  s.result = s.table.periodic ? rectification::shake_sine(c.plant, a, vs.sine, c.shake, sink,
                                                           c.shaker.imperfect() ? s.table.motion.get() : nullptr)
-                              : rectification::shake_excitation(c.plant, a, *s.table.motion, vs.duration_s, c.shake,
-                                                                series.sink());
+                              : rectification::shake_excitation(c.plant, a, *s.table.motion, vs.duration_s, c.shake, sink);
   s.wall_s = seconds_since(start);
   s.predicted_g = predict_terms(c).total_g();
-  series.commit();
+  done();
   return s;
+}
+
+}  // namespace
+
+ShakeStudy shake(const Case& c, const std::string& series_path) {
+  std::optional<SeriesFile> series;
+  return shake_with(
+      c,
+      [&] {
+        series.emplace(c, series_path);
+        return series->sink();
+      },
+      [&] { series->commit(); });
+}
+
+ShakeStudy shake(const Case& c, const rectification::SampleSink& sink) {
+  return shake_with(c, [&] { return sink; }, [] {});
 }
 
 std::string shake_report(const Case& c, const ShakeStudy& s) {

@@ -58,6 +58,9 @@ struct ShakeStudy {
 };
 // `series_path` non-empty: the sampled record is written there (atomically).
 ShakeStudy shake(const Case& c, const std::string& series_path);
+// `sink` given: called for every sample of the record (as with a series file, the run is then
+// a sampled record; rectification/simulation/shake.hpp). A sink that throws ends the run.
+ShakeStudy shake(const Case& c, const rectification::SampleSink& sink);
 std::string shake_report(const Case& c, const ShakeStudy& s);
 
 // ---- measure: the vibration error of a recorded series (io/csv.hpp).
