@@ -1,0 +1,170 @@
+"""vrelab: a virtual shaker laboratory for the vibration rectification error (VRE) of
+pendulous accelerometers -- the C++ library, from Python.
+
+Every function is one library call, the same as the CLI command of its name; results are
+objects with typed attributes (units in their names and docstrings: g, Hz, s) and a
+to_dict() equal to the CLI's JSON for the same case.
+
+    import vrelab
+    case = vrelab.load_case("cases/shake-sine.toml")     # or a dict of tables
+    r = vrelab.shake(case, series=True)
+    r.measured_g, r.sigma_g, r.predicted_g                # g
+    r.series["time_s"], r.series["output_mA"]              # NumPy arrays
+
+Errors: vrelab.InputError (a ValueError; the CLI's exit code 2, same message) and
+vrelab.SolverError (the ODE solver failed; .call, .t_s). Units: README "Units".
+"""
+import os
+import tempfile
+
+from ._core import (  # noqa: F401
+    Case,
+    CampaignWritten,
+    Diagnosis,
+    FrequencyResult,
+    IdentifyResult,
+    InputError,
+    PredictResult,
+    ReproduceResult,
+    ShakeResult,
+    SolverError,
+    SweepRun,
+    __version__,
+    case_toml,
+    frequency,
+    git_describe,
+    identify,
+    predict,
+    predict_total_g,
+    reproduce,
+    shake,
+)
+from . import _core
+
+__all__ = [
+    "Case", "InputError", "SolverError", "load_case", "case_toml", "identify", "predict", "shake",
+    "sweep", "frequency", "campaign", "diagnose", "reproduce", "__version__",
+]
+
+
+def load_case(case, name=None):
+    """A Case from a path (str or os.PathLike), a dict of tables, or a Case (returned as is).
+
+    A dict is written as TOML (vrelab.case_toml) and read by the same reader as a file, so bad
+    input raises vrelab.InputError with the file reader's message (naming `name`, default
+    "<dict>", and the TOML line).
+    """
+    if isinstance(case, Case):
+        return case
+    if isinstance(case, dict):
+        return Case.from_dict(case, name or "<dict>")
+    if isinstance(case, (str, os.PathLike)):
+        return Case.from_file(os.fspath(case))
+    raise TypeError("a case is a path, a dict of tables or a vrelab.Case, not %s" % type(case).__name__)
+
+
+def _wrap(fn):
+    """Lets fn take a path or a dict where it takes a Case."""
+    def call(case, *args, **kwargs):
+        return fn(load_case(case), *args, **kwargs)
+    call.__name__ = fn.__name__
+    call.__doc__ = fn.__doc__
+    return call
+
+
+identify = _wrap(_core.identify)
+predict = _wrap(_core.predict)
+predict_total_g = _wrap(_core.predict_total_g)
+shake = _wrap(_core.shake)
+frequency = _wrap(_core.frequency)
+
+
+def reproduce(case="cases/paper.toml", out_dir="out/paper", threads=-1, plots=True):
+    return _core.reproduce(load_case(case), os.fspath(out_dir), threads, plots)
+
+
+reproduce.__doc__ = _core.reproduce.__doc__
+
+
+class SweepResult:
+    """A sweep: the counts of the run (conditions, ran, written, failures, wall_s in s), the
+    CSV file (path) and its rows as a dict of NumPy columns (columns; .frame() gives a pandas
+    DataFrame when pandas is installed)."""
+
+    def __init__(self, run, columns):
+        self.run = run
+        self.path = run.path
+        self.conditions, self.ran, self.written = run.conditions, run.ran, run.written
+        self.failures, self.wall_s = list(run.failures), run.wall_s
+        self.columns = columns
+
+    def frame(self):
+        import pandas  # optional
+        return pandas.DataFrame(self.columns)
+
+    def report(self):
+        return self.run.report()
+
+    def to_dict(self):
+        return {"conditions": self.conditions, "ran": self.ran, "written": self.written,
+                "failures": self.failures, "wall_s": self.wall_s, "path": self.path,
+                "columns": {k: v.tolist() for k, v in self.columns.items()}}
+
+
+def _read_csv_columns(path):
+    """The columns of a CSV file ('#' lines are comments) as NumPy arrays (float where every
+    value parses, else str)."""
+    import csv
+    import numpy as np
+    with open(path, newline="") as f:
+        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
+    if not rows:
+        return {}
+    head, body = rows[0], rows[1:]
+    cols = {}
+    for i, name in enumerate(head):
+        values = [r[i] if i < len(r) else "" for r in body]
+        try:
+            cols[name] = np.array([float(v) for v in values], dtype=float)
+        except ValueError:
+            cols[name] = np.array(values, dtype=str)
+    return cols
+
+
+def sweep(case, out=None, restart=False, threads=-1, progress=False):
+    """sweep(case, out=None, restart=False, threads=-1, progress=False) -> SweepResult
+
+    A grid of shaker runs (the case's [sweep]: frequency Hz x amplitude g x direction x
+    orientation) on `threads` threads (-1: the case's; 0: all cores), written to the CSV file
+    `out` (resumed when it exists unless restart=True; None: a temporary file) and returned as
+    a dict of NumPy columns (measured and predicted errors in g). Same as `vrelab sweep CASE
+    --out FILE`. Releases the GIL.
+    """
+    c = load_case(case)
+    if out is None:
+        with tempfile.TemporaryDirectory(prefix="vrelab-sweep-") as d:
+            path = os.path.join(d, "sweep.csv")
+            run = _core._sweep(c, path, True, threads, progress)
+            return SweepResult(run, _read_csv_columns(path))
+    run = _core._sweep(c, os.fspath(out), restart, threads, progress)
+    return SweepResult(run, _read_csv_columns(os.fspath(out)))
+
+
+def campaign(case, out_dir, key=None, seed=None):
+    """campaign(case_path, out_dir, key=None, seed=None) -> CampaignWritten
+
+    The virtual lab: a whole campaign (static test, shaker runs) simulated from the case's
+    truth with its hidden effects ([campaign]) and written to out_dir in the lab data format;
+    the answer key apart (key, default <out_dir>.key.json). Same as `vrelab campaign CASE
+    --out DIR [--key FILE]`. Takes a case file path (the folder records it). Releases the GIL.
+    """
+    if not isinstance(case, (str, os.PathLike)):
+        raise TypeError("campaign takes a case file path (the campaign's manifest records it)")
+    return _core._campaign(os.fspath(case), os.fspath(out_dir), os.fspath(key) if key else "", seed)
+
+
+def diagnose(dir, **settings):
+    return _core.diagnose(os.fspath(dir), **settings)
+
+
+diagnose.__doc__ = _core.diagnose.__doc__
