@@ -1,0 +1,200 @@
+"""The Python module against the CLI: the same case gives the same JSON (to_dict() == the
+CLI's --json, number for number: the same C++ writers make both, so equality is exact but for
+wall-clock times), series round trips into NumPy, the CLI's exit-2 messages as
+vrelab.InputError, and shake on two threads at once.
+
+Run by ctest (python_tests, label fast) with PYTHONPATH at build/python and VRELAB_CLI at the
+program of the same build."""
+import json
+import math
+import os
+import subprocess
+import threading
+import tomllib
+
+import numpy as np
+import pytest
+
+import vrelab
+
+SRC = os.environ.get("VRELAB_SOURCE_DIR", os.path.join(os.path.dirname(__file__), "..", ".."))
+CLI = os.environ.get("VRELAB_CLI", os.path.join(SRC, "build", "vrelab"))
+CASES = os.path.join(SRC, "cases")
+
+# Keys that hold wall-clock times: they differ between any two runs.
+TIMES = {"wall_s", "wall_time_s", "elapsed_s"}
+
+
+def strip_times(x):
+    if isinstance(x, dict):
+        return {k: strip_times(v) for k, v in x.items() if k not in TIMES}
+    if isinstance(x, list):
+        return [strip_times(v) for v in x]
+    return x
+
+
+def cli(*args, check=True):
+    return subprocess.run([CLI, *args], capture_output=True, text=True, check=check)
+
+
+def cli_json(tmp_path, *args):
+    out = tmp_path / "cli.json"
+    cli(*args, "--json", str(out))
+    return json.loads(out.read_text())
+
+
+def case(name):
+    return os.path.join(CASES, name)
+
+
+def test_version_is_the_programs():
+    out = cli("--version").stdout
+    assert vrelab.__version__ in out and vrelab.git_describe in out
+
+
+# ---- the CLI's JSON, number for number
+
+def test_predict_equals_cli(tmp_path):
+    path = case("paper-predict.toml")
+    assert vrelab.predict(path).to_dict() == cli_json(tmp_path, "predict", path)
+
+
+def test_frequency_dependent_predict_equals_cli(tmp_path):
+    path = case("shake-sine.toml")
+    r = vrelab.predict(path, frequency_dependent=True)
+    assert r.to_dict() == cli_json(tmp_path, "predict", path, "--frequency-dependent")
+    assert r.frequency_dependent_g is not None and r.printed_g is not None
+
+
+def test_identify_equals_cli(tmp_path):
+    path = case("paper-static.toml")
+    r = vrelab.identify(path)
+    assert r.to_dict() == cli_json(tmp_path, "identify", path)
+    assert r.methods == ["paper_printed", "paper_corrected", "least_squares"]
+    assert set(r.estimate("least_squares")) == set(r.truth)
+    with pytest.raises(KeyError):
+        r.estimate("no_such_method")
+
+
+def test_shake_equals_cli(tmp_path):
+    path = case("shake-sine.toml")
+    r = vrelab.shake(path)
+    d = cli_json(tmp_path, "shake", path)
+    assert strip_times(r.to_dict()) == strip_times(d)
+    # eq. (3) holds at 5 Hz (1 % of the loop crossover): the measured error is the prediction.
+    assert r.measured_g == pytest.approx(r.predicted_g, rel=1e-3)
+
+
+def test_diagnose_equals_cli(tmp_path):
+    folder = case("lab-example")
+    r = vrelab.diagnose(folder)
+    assert strip_times(r.to_dict()) == strip_times(cli_json(tmp_path, "diagnose", folder))
+    assert r.verdict and r.runs > 0
+
+
+def test_dict_case_is_the_file_case():
+    path = case("paper-predict.toml")
+    with open(path, "rb") as f:
+        d = tomllib.load(f)
+    from_dict = vrelab.load_case(d)
+    assert from_dict.path == "<dict>"
+    assert vrelab.predict(from_dict).terms == vrelab.predict(path).terms
+    assert from_dict.content == vrelab.load_case(path).content
+
+
+# ---- NumPy series
+
+def test_shake_series_round_trip_equals_the_cli_series_file(tmp_path):
+    path = case("shake-sine-lab.toml")
+    r = vrelab.shake(path, series=True)
+    csv = tmp_path / "ts.csv"
+    d = cli_json(tmp_path, "shake", path, "--series", str(csv))
+    assert strip_times(r.to_dict()) == strip_times(d)
+    data = np.loadtxt(csv, delimiter=",", comments="#", skiprows=3)
+    s = r.series
+    names = ["time_s", "input_IA_g", "input_PA_g", "input_OA_g", "output_mA"]
+    assert list(s) == names
+    for i, n in enumerate(names):
+        assert isinstance(s[n], np.ndarray) and s[n].dtype == np.float64 and s[n].shape == (r.samples,)
+        # the file holds 10 (inputs) and 13 (output) significant digits
+        np.testing.assert_allclose(s[n], data[:, i], rtol=1e-9, atol=1e-12)
+    # the series measures what the run measured: mean over the vibration minus the mean at rest
+    assert (s["time_s"] < 0).sum() > 0 and (s["time_s"] >= 0).sum() > 0
+
+
+def test_sweep_columns(tmp_path):
+    d = {
+        "coefficients": {"K1": 1.25, "k0": 0.0, "k1_asym": 0.0, "k2": 1.5e-5, "k3": 0.0, "k4": 0.0,
+                         "delta_OA": 0.0, "delta_PA": 0.0, "k_IP": 0.0, "k_IO": 0.0, "k_PO": 0.0,
+                         "k_PP": 0.0, "k_OO": 0.0},
+        "orientation": {"a_g": [0.0, 0.0, 1.0]},
+        "sweep": {"frequencies_Hz": [5.0, 10.0], "amplitudes_g": [1.0], "directions": [[1.0, 0.0, 0.0]]},
+    }
+    try:
+        r = vrelab.sweep(d, threads=1)
+    except vrelab.InputError as e:  # the [sweep] keys are the case reader's; show them
+        pytest.fail(str(e))
+    assert r.conditions == 2 and r.written == 2 and not r.failures
+    cols = r.columns
+    assert all(isinstance(v, np.ndarray) and len(v) == 2 for v in cols.values())
+
+
+# ---- errors
+
+def test_bad_case_file_raises_input_error_with_the_cli_message(tmp_path):
+    bad = tmp_path / "typo.toml"
+    bad.write_text(open(case("ideal-static.toml")).read().replace("angle_sigma_arcsec", "angle_sigma_arcsex"))
+    p = cli("identify", str(bad), check=False)
+    assert p.returncode == 2
+    with pytest.raises(vrelab.InputError) as e:
+        vrelab.identify(str(bad))
+    assert isinstance(e.value, ValueError)
+    assert p.stderr.strip() == "vrelab: error: " + str(e.value)
+
+
+def test_missing_file_and_missing_table():
+    with pytest.raises(vrelab.InputError, match="no such file"):
+        vrelab.load_case("/no/such/case.toml")
+    with pytest.raises(vrelab.InputError, match=r"paper-static.toml: shake needs a \[orientation\] table"):
+        vrelab.shake(case("paper-static.toml"))
+
+
+def test_bad_dict_names_the_dict_and_the_key():
+    with open(case("paper-predict.toml"), "rb") as f:
+        d = tomllib.load(f)
+    d["coefficients"]["k2"] = math.nan
+    with pytest.raises(vrelab.InputError, match=r"^lab-1:\d+: .*k2"):
+        vrelab.load_case(d, name="lab-1")
+    d["coefficients"]["k2"] = 1e-5
+    d["vibraton"] = {}
+    with pytest.raises(ValueError, match="did you mean 'vibration'"):
+        vrelab.load_case(d)
+    with pytest.raises(vrelab.InputError, match="cannot be written as TOML"):
+        vrelab.load_case({"run": {"seed": object()}})
+
+
+def test_solver_error_is_its_own_type():
+    assert issubclass(vrelab.SolverError, RuntimeError)
+    assert not issubclass(vrelab.SolverError, ValueError)
+
+
+# ---- threads
+
+def test_two_threads_shake_at_once():
+    path = case("shake-sine.toml")
+    alone = vrelab.shake(path).to_dict()
+    results, errors = [None, None], []
+
+    def run(i):
+        try:
+            results[i] = vrelab.shake(path).to_dict()
+        except Exception as e:  # pragma: no cover
+            errors.append(e)
+
+    threads = [threading.Thread(target=run, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert not errors
+    assert strip_times(results[0]) == strip_times(alone) == strip_times(results[1])
