@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Sets vrelab up on a fresh Debian (12) machine and runs the main job:
 #   1. installs the Debian packages it builds with (apt-get, with sudo when not root);
-#   2. configures and builds into build/ (the program is build/vrelab);
+#   2. configures and builds into build/ (the program is build/vrelab, the Python module
+#      build/python/vrelab, made importable by /usr/bin/python3 with a .pth file);
 #   3. runs the main job on the shipped default case.
 # Options: --no-run (skip step 3). CMake options can be passed in VRELAB_CMAKE_ARGS.
 set -euo pipefail
@@ -9,7 +10,8 @@ cd "$(dirname "$0")"
 
 packages=(build-essential cmake git pkg-config
           libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libfftw3-dev libsundials-dev
-          libgtest-dev libbenchmark-dev python3-matplotlib)
+          libgtest-dev libbenchmark-dev python3-matplotlib
+          python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest)
 
 run_main=1
 [ "${1:-}" = "--no-run" ] && run_main=0
@@ -26,6 +28,18 @@ echo "== Building into build/"
 # shellcheck disable=SC2086
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release ${VRELAB_CMAKE_ARGS:-}
 cmake --build build -j"$(nproc)"
+
+# `import vrelab` for Debian's /usr/bin/python3: a .pth file in its site directory for local
+# installs (/usr/local/lib/python3.X/dist-packages, not dpkg's) naming build/python, so every
+# rebuild is what Python imports (README, "Python").
+if [ -d build/python/vrelab ]; then
+  site=$(/usr/bin/python3 -c 'import site; print(site.getsitepackages()[0])')
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo mkdir -p "$site"
+  echo "$PWD/build/python" | $sudo tee "$site/vrelab.pth" >/dev/null
+  echo "== Python: $site/vrelab.pth -> $PWD/build/python"
+fi
 
 if [ "$run_main" -eq 1 ]; then
   # The main job: the paper's experiment reproduced on the shipped default case; the
