@@ -1,4 +1,4 @@
-// python/bench_predict.cpp -- the C++ side of the Python module's overhead (docs/python.md): the
+// python/bench/bench_predict.cpp -- the C++ side of the Python module's overhead (docs/python.md): the
 // library calls that vrelab.predict_total_g and vrelab.predict make, on a case read once.
 // Usage: build/vrelab_bench_python [CASE]  (default cases/paper-predict.toml)
 #include <benchmark/benchmark.h>
