@@ -198,3 +198,22 @@ def test_two_threads_shake_at_once():
         t.join()
     assert not errors
     assert strip_times(results[0]) == strip_times(alone) == strip_times(results[1])
+
+
+# ---- Ctrl-C
+
+def test_ctrl_c_interrupts_a_shake_with_its_series():
+    import signal
+    import time
+    with open(case("shake-sine-lab.toml"), "rb") as f:
+        d = tomllib.load(f)
+    d["shake"]["min_measure_s"] = 60.0  # a minute of record at 20 kHz: tens of seconds uninterrupted
+    c = vrelab.load_case(d)
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    start = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        vrelab.shake(c, series=True)
+    timer.join()
+    # the sink looks at Python's signals every 2^14 samples (< 1 s of record, well under 1 s of work)
+    assert time.perf_counter() - start < 10
