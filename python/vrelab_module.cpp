@@ -32,6 +32,7 @@
 #include "io/case_file.hpp"
 #include "io/diagnosis.hpp"
 #include "io/diagnosis_json.hpp"
+#include "io/output.hpp"
 #include "io/reproduce_report.hpp"
 #include "io/reproduce_run.hpp"
 #include "io/results_json.hpp"
@@ -441,8 +442,12 @@ PYBIND11_MODULE(_core, m) {
         for (const auto& cv : r.s.curves) n.push_back(cv.name);
         return n;
       })
-      .def("write", [](const FrequencyResult& r, const std::string& dir) { io::write_frequency_data(r.c, r.s, dir); }, py::arg("dir"),
-           "frequency.csv, ode_points.csv, summary.md, summary.json in dir (no figures).")
+      .def("write", [](const FrequencyResult& r, const std::string& dir, bool figures) {
+        io::write_frequency_data(r.c, r.s, dir);
+        return figures ? io::run_plot_script("frequency.py", dir) : std::string("figures=False was given");
+      }, py::arg("dir"), py::arg("figures") = true,
+           "frequency.csv, ode_points.csv, summary.md, summary.json in dir, and with figures=True frequency.png/svg "
+           "(as `vrelab frequency CASE --out DIR`). Returns \"\" when the figures were drawn, else why not.")
       .def("report", [](const FrequencyResult& r) { return io::frequency_report(r.c, r.s); })
       .def("to_dict", [](const FrequencyResult& r) { return to_py(io::frequency_json(r.c, r.s)); }, "summary.json of `vrelab frequency` as a dict.");
   m.def(
@@ -480,7 +485,7 @@ PYBIND11_MODULE(_core, m) {
       py::arg("case_path"), py::arg("out_dir"), py::arg("key_path") = "", py::arg("seed") = py::none());
 
   py::class_<io::FolderDiagnosis>(m, "Diagnosis", "The diagnosis of a campaign folder: where the gap lies and what explains it.")
-      .def_readonly("dir", &io::FolderDiagnosis::dir)
+      .def_readwrite("dir", &io::FolderDiagnosis::dir, "The campaign folder (diagnose_data: the name given).")
       .def_readonly("settings_from", &io::FolderDiagnosis::settings_from)
       .def_readonly("wall_s", &io::FolderDiagnosis::wall_s, "The diagnosis alone, s.")
       .def_property_readonly("verdict", [](const io::FolderDiagnosis& f) { return f.diagnosis.verdict; })

@@ -41,9 +41,27 @@ from ._core import (  # noqa: F401
 )
 from . import _core
 
+
+def _find_plot_scripts():
+    """The library finds its plot scripts beside the running program, which here is Python:
+    point it (VRELAB_PLOTS_DIR, unless set) at the build tree's share/vrelab/plots
+    (build/python/vrelab -> build/share/vrelab/plots) or the installed prefix's
+    (<prefix>/lib/python3.X/dist-packages/vrelab -> <prefix>/share/vrelab/plots)."""
+    if os.environ.get("VRELAB_PLOTS_DIR"):
+        return
+    here = os.path.dirname(os.path.realpath(__file__))
+    for up in ("../../share/vrelab/plots", "../../../../share/vrelab/plots"):
+        d = os.path.normpath(os.path.join(here, up))
+        if os.path.isfile(os.path.join(d, "reproduce.py")):
+            os.environ["VRELAB_PLOTS_DIR"] = d
+            return
+
+
+_find_plot_scripts()
+
 __all__ = [
     "Case", "InputError", "SolverError", "load_case", "case_toml", "identify", "predict", "shake",
-    "sweep", "frequency", "campaign", "diagnose", "reproduce", "__version__",
+    "sweep", "frequency", "campaign", "diagnose", "diagnose_data", "reproduce", "__version__",
 ]
 
 
@@ -168,3 +186,51 @@ def diagnose(dir, **settings):
 
 
 diagnose.__doc__ = _core.diagnose.__doc__
+
+
+def _write_columns(path, columns):
+    """A CSV file of the lab data format from a dict of columns (or a pandas DataFrame)."""
+    names = [str(n) for n in columns.keys()]
+    cols = [list(columns[n]) for n in columns.keys()]
+    if len({len(c) for c in cols}) > 1:
+        raise InputError("%s: the columns differ in length" % os.path.basename(path))
+
+    def text(v):
+        if isinstance(v, (bool, int, str)):
+            return str(v)
+        try:
+            return format(float(v), ".17g")  # exact: the file's reader gets the same double
+        except (TypeError, ValueError):
+            return str(v)
+
+    with open(path, "w") as f:
+        f.write(",".join(names) + "\n")
+        for row in zip(*cols):
+            f.write(",".join(text(v) for v in row) + "\n")
+
+
+def diagnose_data(static, runs, manifest=None, name="<memory>", **settings):
+    """diagnose_data(static, runs, manifest=None, name="<memory>", **settings) -> Diagnosis
+
+    diagnose() on a campaign in memory: `static` and `runs` are dicts of columns (lists or
+    NumPy arrays) or pandas DataFrames with the columns of static.csv and runs.csv
+    (docs/data-format.md: series, angle_deg, output_<unit>, sigma_<unit>, count; id,
+    frequency_Hz, amplitude_g, d_IA, d_PA, d_OA, a_IA_g, a_PA_g, a_OA_g, measured_ug,
+    sigma_ug), `manifest` the manifest's tables as a dict (default: output unit mA, default
+    dynamics). They are written in the lab data format to a private temporary folder and read
+    by the same reader as a folder, so the checks and messages are the folder's (naming
+    `name` for the folder). Settings as for diagnose().
+    """
+    man = manifest if manifest is not None else {"campaign": {"name": name, "format_version": 1},
+                                                 "instrument": {"output_unit": "mA"}}
+    with tempfile.TemporaryDirectory(prefix="vrelab-campaign-") as d:
+        with open(os.path.join(d, "manifest.toml"), "w") as f:
+            f.write(case_toml(man))
+        _write_columns(os.path.join(d, "static.csv"), static)
+        _write_columns(os.path.join(d, "runs.csv"), runs)
+        try:
+            result = _core.diagnose(d, **settings)
+        except InputError as e:
+            raise InputError(str(e).replace(d, name)) from None
+    result.dir = name  # the folder is gone; the result names the data as given
+    return result
