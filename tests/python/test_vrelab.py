@@ -217,3 +217,33 @@ def test_ctrl_c_interrupts_a_shake_with_its_series():
     timer.join()
     # the sink looks at Python's signals every 2^14 samples (< 1 s of record, well under 1 s of work)
     assert time.perf_counter() - start < 10
+
+
+# ---- a campaign in memory
+
+def columns(path):
+    import csv
+    with open(path) as f:
+        rows = list(csv.reader(line for line in f if not line.startswith("#")))
+    out = {}
+    for i, name in enumerate(rows[0]):
+        values = [r[i] for r in rows[1:]]
+        try:
+            out[name] = np.array([float(v) for v in values])
+        except ValueError:
+            out[name] = values
+    return out
+
+
+def test_diagnose_data_in_memory_equals_the_folder():
+    folder = case("lab-example")
+    static, runs = columns(os.path.join(folder, "static.csv")), columns(os.path.join(folder, "runs.csv"))
+    with open(os.path.join(folder, "manifest.toml"), "rb") as f:
+        manifest = tomllib.load(f)
+    a = strip_times(vrelab.diagnose_data(static, runs, manifest, name="lab-1").to_dict())
+    b = strip_times(vrelab.diagnose(folder).to_dict())
+    assert a.pop("data") == "lab-1" and b.pop("data") == folder  # the data as named
+    assert a == b
+    del runs["frequency_Hz"]
+    with pytest.raises(vrelab.InputError, match="^lab-1/runs.csv: the header lacks column 'frequency_Hz'"):
+        vrelab.diagnose_data(static, runs, manifest, name="lab-1")
