@@ -7,6 +7,12 @@ if(NOT DEFINED Python_EXECUTABLE AND EXISTS /usr/bin/python3)
   set(Python_EXECUTABLE /usr/bin/python3)
 endif()
 set(VRELAB_PYTHON_MODULE OFF)
+if(VRELAB_SANITIZE)
+  # An ASan-instrumented module loads only with the ASan runtime preloaded into the
+  # interpreter: the sanitizer build leaves the module (and its tests) out.
+  message(STATUS "vrelab: no Python module in the sanitizer build")
+  return()
+endif()
 find_package(Python 3.8 COMPONENTS Interpreter Development.Module QUIET)
 if(Python_FOUND)
   set(PYBIND11_FINDPYTHON ON)

@@ -14,6 +14,7 @@ to_dict() equal to the CLI's JSON for the same case.
 Errors: vrelab.InputError (a ValueError; the CLI's exit code 2, same message) and
 vrelab.SolverError (the ODE solver failed; .call, .t_s). Units: README "Units".
 """
+import functools
 import os
 import tempfile
 
@@ -82,11 +83,10 @@ def load_case(case, name=None):
 
 
 def _wrap(fn):
-    """Lets fn take a path or a dict where it takes a Case."""
+    """Lets fn take a path or a dict where it takes a Case (help() shows fn's signature and units)."""
+    @functools.wraps(fn)
     def call(case, *args, **kwargs):
         return fn(load_case(case), *args, **kwargs)
-    call.__name__ = fn.__name__
-    call.__doc__ = fn.__doc__
     return call
 
 
