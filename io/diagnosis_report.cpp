@@ -64,7 +64,7 @@ void write_diagnosis_report(const FolderDiagnosis& f, const std::string& dir) {
   which_effect(rep, f);
   rep.heading("3. How far it shrinks");
   how_far(rep, f.diagnosis);
-  write_atomic(dir + "/diagnosis.json", to_json(f).dump(2) + "\n");
+  write_atomic(dir + "/diagnosis.json", json_text(to_json(f)));
   const std::string why = run_plot_script("diagnose.py", dir);
   rep.figure("gap_map", "The gap per run, standardised against all the others (z), over frequency and amplitude, per direction.",
              why.empty(), why);

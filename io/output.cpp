@@ -37,6 +37,10 @@ void write_atomic(const std::string& path, const std::string& text) {
   }
 }
 
+std::string json_text(const nlohmann::json& j) {
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
 nlohmann::json program_record() {
   return {{"name", "vrelab"}, {"version", kProgramVersion}, {"git", kGitDescribe}};
 }

@@ -471,7 +471,7 @@ SweepStudy sweep(const Case& c, const std::string& out_path, bool restart, int t
   const rectification::SweepGrid& grid = *c.sweep;
   if (std::string why; !grid.IsValid(&why)) throw InputError(c.path + ": [sweep] " + why);
   if (std::string why; !c.shake.IsValid(&why)) throw InputError(c.path + ": [shake] " + why);
-  const std::string fingerprint = fmt::format("{:016x}", fnv1a(c.content.dump() + kProgramVersion + kGitDescribe));
+  const std::string fingerprint = fmt::format("{:016x}", fnv1a(c.content.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + kProgramVersion + kGitDescribe));
   const std::string header = sweep_header(c, fingerprint);
   const fs::path path(out_path);
   if (path.has_parent_path()) fs::create_directories(path.parent_path());
@@ -584,7 +584,7 @@ void write_frequency_data(const Case& c, const FrequencyStudy& s, const std::str
   write_atomic(dir + "/frequency.csv", grid_csv);
   write_atomic(dir + "/ode_points.csv", ode_csv);
   write_atomic(dir + "/summary.md", md);
-  write_atomic(dir + "/summary.json", frequency_json(c, s).dump(2) + "\n");
+  write_atomic(dir + "/summary.json", json_text(frequency_json(c, s)));
 }
 
 }  // namespace vrelab::io

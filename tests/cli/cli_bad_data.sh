@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# Lab data as labs and spreadsheets write it: encodings, separators, loose numbers, a hand-
+# edited sweep, figures and reports written whole. Exit 2 and a message naming the file, the
+# line and the column for bad data; exit 0 and a result for good data in odd clothes (a BOM, a
+# path that is not UTF-8). Usage: cli_bad_data.sh <vrelab binary> <cases dir>
+set -u
+bin=$1
+cases=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+pass=0
+
+expect() {  # expect <want rc> <stdout/stderr regex> <args...>
+  local want=$1 pattern=$2
+  shift 2
+  "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
+  local rc=$?
+  if [ "$rc" -ne "$want" ] || ! grep -Eq -- "$pattern" "$tmp/err" "$tmp/out"; then
+    echo "FAIL: vrelab $* -> rc $rc (want $want), stderr: $(tail -c 600 "$tmp/err")"
+    fail=$((fail + 1))
+  else
+    pass=$((pass + 1))
+  fi
+}
+check() {  # check <description> <command...>: a condition that must hold
+  local what=$1
+  shift
+  if "$@"; then pass=$((pass + 1)); else echo "FAIL: $what"; fail=$((fail + 1)); fi
+}
+lab() {  # lab <name>: a fresh copy of the hand-written campaign
+  rm -rf "${tmp:?}/$1"
+  cp -r "$cases/lab-example" "$tmp/$1"
+}
+valid_json() { python3 -c 'import json,sys; json.load(open(sys.argv[1], encoding="utf-8"))' "$1"; }
+latin1=$(printf '\xb0')
+
+# ---- (2) text that is not UTF-8: refused at read time in data; a path is not data.
+lab enc
+sed -i "4s/^ia-10Hz-2g,/ia-10Hz-2g${latin1},/" "$tmp/enc/runs.csv"
+expect 2 'enc/runs\.csv:4:11: not UTF-8 at byte 11 \(0xB0.*save the file as UTF-8' diagnose "$tmp/enc" --json "$tmp/o/enc.json"
+check "no JSON written for non-UTF-8 data" test ! -e "$tmp/o/enc.json"
+lab "dir$latin1"
+expect 0 'Gap:' diagnose "$tmp/dir$latin1" --json "$tmp/o/d$latin1.json"
+check "a Latin-1 folder name still gives valid JSON" valid_json "$tmp/o/d$latin1.json"
+cp "$cases/ideal-static.toml" "$tmp/case$latin1.toml"
+expect 0 'least_squares' identify "$tmp/case$latin1.toml" --json "$tmp/o/case.json"
+check "a Latin-1 case path still gives valid JSON" valid_json "$tmp/o/case.json"
+lab encm
+sed -i "s/^name = .*/name = \"lab ${latin1}\"/" "$tmp/encm/manifest.toml"
+expect 2 'encm/manifest\.toml:[0-9]+: .*utf-8' diagnose "$tmp/encm"
+
+# ---- (7) Excel's CSV UTF-8 (a byte-order mark), ';' separators, a column's case.
+lab bom
+# (without the comment lines, so the BOM stands before the header on line 1)
+for f in static runs; do grep -v '^#' "$cases/lab-example/$f.csv" | { printf '\xef\xbb\xbf'; cat; } >"$tmp/bom/$f.csv"; done
+expect 0 'Gap:' diagnose "$tmp/bom" --json "$tmp/o/bom.json"
+lab semi
+sed -i '/^#/!s/,/;/g' "$tmp/semi/runs.csv"
+expect 2 "semi/runs\.csv:3: the header uses ';' as separator; vrelab reads ',' \(save as CSV, comma-delimited" diagnose "$tmp/semi"
+lab case
+sed -i 's/^id,frequency_Hz,/id,frequency_hz,/' "$tmp/case/runs.csv"
+expect 2 "lacks column 'frequency_Hz' \(the header has: id, frequency_hz, .*did you mean 'frequency_hz'\? \(column names are case-sensitive" diagnose "$tmp/case"
+lab typo
+sed -i 's/^series,angle_deg,/series,angel_deg,/' "$tmp/typo/static.csv"
+expect 2 "lacks column 'angle_deg'.*did you mean 'angel_deg'" diagnose "$tmp/typo"
+
+# ---- (9) loose CSV: more cells than the header, a fractional count, hex, inf; an empty manifest.
+lab cells
+sed -i '5s/$/,7/' "$tmp/cells/runs.csv"
+expect 2 'cells/runs\.csv:5:12: 12 cells, the header has 11' diagnose "$tmp/cells"
+lab count
+sed -i '6s/,2$/,2.5/' "$tmp/count/static.csv"
+expect 2 'count/static\.csv:6:5: column count: 2\.5 is not a whole number' diagnose "$tmp/count"
+lab hex
+sed -i '6s/^1,30,/1,0x1E,/' "$tmp/hex/static.csv"
+expect 2 "hex/static\.csv:6:2: column angle_deg: '0x1E' is not a number \(hexadecimal" diagnose "$tmp/hex"
+lab hexrun
+sed -i '5s/^ia-100Hz-2g,100,/ia-100Hz-2g,0x1E,/' "$tmp/hexrun/runs.csv"
+expect 0 "skipped: run 'ia-100Hz-2g': .*hexrun/runs\.csv:5:2: column frequency_Hz: '0x1E' is not a number \(hexadecimal" diagnose "$tmp/hexrun"
+lab inf
+sed -i '6s/^1,30,/1,inf,/' "$tmp/inf/static.csv"
+expect 2 'inf/static\.csv:6:2: column angle_deg: inf is not a finite number' diagnose "$tmp/inf"
+lab empty
+: >"$tmp/empty/manifest.toml"
+expect 2 'empty/manifest\.toml: missing \[campaign\] format_version = 1; \[instrument\] output_unit .*; \[identification\] fixed' diagnose "$tmp/empty"
+# measure's series: hexadecimal time, a BOM, ';'.
+printf 'time_s,output\n0.0,1.0\n0x1,1.0\n' >"$tmp/hex.csv"
+expect 2 "hex\.csv:3: not a number in '0x1,1\.0' \(column 1, '0x1': hexadecimal" measure "$tmp/hex.csv" --on 1,2 --baseline 0,1
+printf 'time_s;output\n0,1\n' >"$tmp/semi.csv"
+expect 2 "semi\.csv:1: the header uses ';' as separator" measure "$tmp/semi.csv" --on 1,2 --baseline 0,1
+
+echo "cli_bad_data: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
