@@ -90,5 +90,24 @@ expect 2 "hex\.csv:3: not a number in '0x1,1\.0' \(column 1, '0x1': hexadecimal"
 printf 'time_s;output\n0,1\n' >"$tmp/semi.csv"
 expect 2 "semi\.csv:1: the header uses ';' as separator" measure "$tmp/semi.csv" --on 1,2 --baseline 0,1
 
+# ---- (11) a resumed sweep finds a row edited by hand (its checksum) and runs it again.
+sed 's/frequency_points = 40/frequency_points = 4/; s/^directions = .*/directions = [[1.0, 0.0, 0.0]]/; s/frequency_to_Hz = 5000.0/frequency_to_Hz = 200.0/' \
+  "$cases/sweep-frequency.toml" >"$tmp/sw.toml"
+expect 0 '4 written, 0 failed' sweep "$tmp/sw.toml" --out "$tmp/sw.csv" --threads 2 --no-progress
+rows() { grep -v '^#' "$1" | cut -d, -f1-14; }  # the results (checksum and wall time aside)
+rows "$tmp/sw.csv" >"$tmp/sw.rows"
+line=$(grep -n '^2,' "$tmp/sw.csv" | cut -d: -f1)
+sed -i '/^2,/s/,2\.8/,3.8/' "$tmp/sw.csv"  # measured_g 2.8e-4 -> 3.8e-4 by hand
+check "the edit took" bash -c "! rows '$tmp/sw.csv' | cmp -s - '$tmp/sw.rows'" 2>/dev/null
+expect 0 "sw\.csv:$line: condition 2: the row does not match its checksum \(edited by hand\?\); run again" \
+  sweep "$tmp/sw.toml" --out "$tmp/sw.csv" --threads 2 --no-progress
+check "the edited row is computed again, as before" cmp -s <(rows "$tmp/sw.csv") "$tmp/sw.rows"
+# write_atomic: the data reach the disk before the rename, the folder's entry after it.
+if command -v strace >/dev/null; then
+  strace -f -e trace=fsync,rename,renameat,renameat2 -o "$tmp/trace" "$bin" identify "$cases/ideal-static.toml" \
+    --json "$tmp/o/sync.json" >/dev/null 2>&1
+  check "fsync, rename, fsync in write_atomic" grep -Pzq 'fsync\(\d+\)\s+= 0\n[^\n]*rename[^\n]*sync\.json[^\n]*\n[^\n]*fsync\(\d+\)\s+= 0' "$tmp/trace"
+fi
+
 echo "cli_bad_data: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
