@@ -33,8 +33,7 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
   write_reproduce_data(c, s, res, wall_s, dir);
   const std::string figures_missing = o.plots ? run_plot_script("reproduce.py", dir) : std::string("--no-plots was given");
   const Report rep = reproduce_full_report(c, s, res, wall_s, figures_missing);
-  write_atomic(dir + "/report.md", rep.markdown());
-  write_atomic(dir + "/report.html", rep.html());
+  write_report_folder(dir, rep);
 
   out << reproduce_brief_report(res);
   if (!figures_missing.empty()) out << "Figures skipped: " << figures_missing << "\n";

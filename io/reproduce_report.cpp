@@ -373,6 +373,7 @@ void report_invisible(Report& rep, const ReproduceResult& res, const std::string
 
 void write_reproduce_data(const Case& c, const ReproduceSettings& s, const ReproduceResult& res, double wall_s,
                           const std::string& dir) {
+  begin_report_folder(dir);
   write_atomic(dir + "/static.csv", static_csv(c, res));
   write_atomic(dir + "/confirmation.csv", confirmation_csv(c, res));
   write_atomic(dir + "/confirmation.json", json_text(reproduce_confirmation_json(c, s, res)));

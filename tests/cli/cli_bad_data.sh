@@ -90,6 +90,56 @@ expect 2 "hex\.csv:3: not a number in '0x1,1\.0' \(column 1, '0x1': hexadecimal"
 printf 'time_s;output\n0,1\n' >"$tmp/semi.csv"
 expect 2 "semi\.csv:1: the header uses ';' as separator" measure "$tmp/semi.csv" --on 1,2 --baseline 0,1
 
+# ---- (3) figures whole or not at all; a report folder never mixes runs.
+plots=$(dirname "$bin")/share/vrelab/plots
+# A figure whose writing dies half-way (a partial PNG, then an interruption): no file of that
+# name, no temporary file left.
+mkdir -p "$tmp/fig"
+check "the plot scripts write through atomic_figure.py" grep -q 'savefig_atomic(fig' "$plots/diagnose.py"
+python3 - "$plots" "$tmp/fig" <<'PY' >"$tmp/fig.log" 2>&1
+import os, sys
+sys.path.insert(0, sys.argv[1])
+from atomic_figure import savefig_atomic
+class Dying:
+    def savefig(self, path, format=None, **kw):
+        with open(path, "wb") as f:
+            f.write(b"\x89PNG\r\n\x1a\n half a figure")
+        raise KeyboardInterrupt
+try:
+    savefig_atomic(Dying(), os.path.join(sys.argv[2], "fig.png"), dpi=150)
+except KeyboardInterrupt:
+    pass
+PY
+check "an interrupted figure leaves no file ($(ls "$tmp/fig"))" test -z "$(ls -A "$tmp/fig")"
+# An old report with a figure this run does not draw, and the user's own file: the old figure
+# goes, the user's file stays.
+mkdir -p "$tmp/rep"
+printf 'old' >"$tmp/rep/fig9_old.png"
+printf 'mine' >"$tmp/rep/notes.txt"
+printf '# vrelab report files\nfig9_old.png\nreport.html\n# complete\n' >"$tmp/rep/report-files.txt"
+expect 0 'Gap:' diagnose "$cases/lab-example" --report "$tmp/rep"
+check "the old report's figure is removed" test ! -e "$tmp/rep/fig9_old.png"
+check "the user's file is kept" test -e "$tmp/rep/notes.txt"
+check "the new report lists its files" grep -qx 'diagnosis.json' "$tmp/rep/report-files.txt"
+check "the new report is complete" test -s "$tmp/rep/report.html"
+# A run killed while drawing (the plot script kills the program): the old report is gone, no
+# new one stands beside the new data, and the next run clears what the killed one wrote.
+mkdir -p "$tmp/killer"
+cat >"$tmp/killer/diagnose.py" <<'PY'
+import os, signal
+pid = os.getppid()  # the shell of std::system, then the program
+while pid > 1:
+    if open(f"/proc/{pid}/comm").read().strip() == "vrelab":
+        os.kill(pid, signal.SIGKILL)
+        break
+    pid = int(open(f"/proc/{pid}/stat").read().rsplit(")", 1)[1].split()[1])
+PY
+(VRELAB_PLOTS_DIR="$tmp/killer" "$bin" diagnose "$cases/lab-example" --report "$tmp/rep"; true) >/dev/null 2>&1
+check "a killed run leaves no report beside its data" test ! -e "$tmp/rep/report.html" -a -e "$tmp/rep/diagnosis.json"
+check "a killed run leaves the old figures removed" test ! -e "$tmp/rep/gap_map.png"
+expect 0 'Gap:' diagnose "$cases/lab-example" --report "$tmp/rep"
+check "the next run writes a whole report" test -s "$tmp/rep/report.html" -a -s "$tmp/rep/gap_map.png"
+
 # ---- (11) a resumed sweep finds a row edited by hand (its checksum) and runs it again.
 sed 's/frequency_points = 40/frequency_points = 4/; s/^directions = .*/directions = [[1.0, 0.0, 0.0]]/; s/frequency_to_Hz = 5000.0/frequency_to_Hz = 200.0/' \
   "$cases/sweep-frequency.toml" >"$tmp/sw.toml"
