@@ -102,14 +102,15 @@ std::optional<double> number(const Csv& csv, const std::pair<int, std::vector<st
   return x;
 }
 
-// "the header has: a, b, c; did you mean 'x'?" for a column `wanted` that is not there.
+// " (the header has: a, b, c); did you mean 'wanted' for 'close'?" for a column `wanted` that
+// is not there, `close` the header's closest name.
 std::string columns_found(const Csv& csv, const std::string& wanted) {
   std::string found;
   for (const auto& n : csv.names) found += (found.empty() ? "" : ", ") + n;
   std::string out = fmt::format(" (the header has: {})", found);
   const std::string close = closest_name(wanted, csv.names);
   if (!close.empty()) {
-    out += fmt::format("; did you mean '{}'?", close);
+    out += fmt::format("; did you mean '{}' for '{}'?", wanted, close);
     std::string a = close, b = wanted;
     for (char& ch : a) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
     for (char& ch : b) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));

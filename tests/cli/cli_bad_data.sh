@@ -60,10 +60,10 @@ sed -i '/^#/!s/,/;/g' "$tmp/semi/runs.csv"
 expect 2 "semi/runs\.csv:3: the header uses ';' as separator; vrelab reads ',' \(save as CSV, comma-delimited" diagnose "$tmp/semi"
 lab case
 sed -i 's/^id,frequency_Hz,/id,frequency_hz,/' "$tmp/case/runs.csv"
-expect 2 "lacks column 'frequency_Hz' \(the header has: id, frequency_hz, .*did you mean 'frequency_hz'\? \(column names are case-sensitive" diagnose "$tmp/case"
+expect 2 "lacks column 'frequency_Hz' \(the header has: id, frequency_hz, .*did you mean 'frequency_Hz' for 'frequency_hz'\? \(column names are case-sensitive" diagnose "$tmp/case"
 lab typo
 sed -i 's/^series,angle_deg,/series,angel_deg,/' "$tmp/typo/static.csv"
-expect 2 "lacks column 'angle_deg'.*did you mean 'angel_deg'" diagnose "$tmp/typo"
+expect 2 "lacks column 'angle_deg'.*did you mean 'angle_deg' for 'angel_deg'\?" diagnose "$tmp/typo"
 
 # ---- (9) loose CSV: more cells than the header, a fractional count, hex, inf; an empty manifest.
 lab cells
