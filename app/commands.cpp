@@ -13,7 +13,7 @@ using namespace vrelab::io;
 namespace {
 
 void write_json(const std::string& path, const nlohmann::json& j) {
-  if (!path.empty()) write_atomic(path, j.dump(2) + "\n");
+  if (!path.empty()) write_atomic(path, json_text(j));
 }
 
 }  // namespace

@@ -30,7 +30,7 @@ void run_campaign(const CampaignOptions& o, std::ostream& out) {
 void run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
   const io::FolderDiagnosis f = io::diagnose_folder(o.dir, o.settings);
   out << program() << f.FullReport();
-  if (!o.json_path.empty()) io::write_atomic(o.json_path, io::to_json(f).dump(2) + "\n");
+  if (!o.json_path.empty()) io::write_atomic(o.json_path, io::json_text(io::to_json(f)));
   if (!o.report_dir.empty()) io::write_diagnosis_report(f, o.report_dir);
 }
 
@@ -40,7 +40,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   core::Progress bar(std::cerr, "blind", static_cast<std::size_t>(o.settings.n), o.progress);
   const validation::BlindResult r = validation::run_blind(o.settings, [&bar](std::size_t, std::size_t) { bar.tick(); });
   bar.finish();
-  io::write_atomic(o.out_dir + "/scores.json", io::to_json(r).dump(2) + "\n");
+  io::write_atomic(o.out_dir + "/scores.json", io::json_text(io::to_json(r)));
   io::write_atomic(o.out_dir + "/confusion.csv", io::confusion_csv(r));
   out << program() << r.FullReport();
   const std::string plot = io::run_plot_script("confusion.py", o.out_dir);

@@ -1,10 +1,17 @@
 #pragma once
-// io/csv.hpp -- the one CSV reader of the library: a line into cells, and an output series.
+// io/csv.hpp -- the one CSV reader of the library: a line into cells, numbers, text checks,
+// and an output series.
 //
 // Cells are trimmed of blanks; a cell may be quoted ("a, b"; "" is a quote inside), as
-// spreadsheets write them. '#' lines are comments.
+// spreadsheets write them. '#' lines are comments. Text must be UTF-8 (a UTF-8 byte-order
+// mark, as Excel's "CSV UTF-8" writes it, is dropped); numbers are finite decimals
+// (parse_decimal); the separator is ',' (a header split by ';' is refused with a hint).
+#include <cstddef>
 #include <functional>
+#include <iosfwd>
+#include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace vrelab::io {
@@ -13,12 +20,40 @@ namespace vrelab::io {
 // std::invalid_argument naming `where` (e.g. "file.csv:12").
 std::vector<std::string> split_csv_line(const std::string& line, const std::string& where);
 
+// A finite decimal number as a lab writes it: [+-]digits[.digits][(e|E)[+-]digits] (".5" and
+// "5." too), nothing else: no blanks, no hexadecimal (strtod reads "0x1E" as 30), no inf or
+// nan, no decimal comma, no value beyond the double range. nullopt for anything else.
+std::optional<double> parse_decimal(std::string_view s);
+// Why `s` is not a finite decimal, for a message: "hexadecimal", "not finite", "a decimal
+// comma", or "not a number".
+std::string why_not_decimal(std::string_view s);
+
+// The byte offset of the first byte of `s` that does not belong to well-formed UTF-8
+// (overlong forms, surrogates and code points past U+10FFFF included), or npos.
+std::size_t first_non_utf8(std::string_view s);
+
+// The checks every line of a text file passes before it is split: on line 1 a UTF-8
+// byte-order mark is removed; a trailing '\r' is removed; a byte that is not UTF-8 is
+// InputError "<path>:<line>:<column>: not UTF-8 at byte N (0xB0) ...; save the file as UTF-8".
+void check_text_line(std::string& line, long line_no, const std::string& path);
+
+// A header line that uses ';' (or a tab) as its separator and holds no ',' is InputError
+// naming the separator: vrelab reads ',' only (a ';' file usually has decimal commas too).
+void check_separator(const std::string& header_line, long line_no, const std::string& path);
+
+// The name in `names` closest to `name` (case-insensitive equality first, then edit
+// distance at most 3), or "" when none is close.
+std::string closest_name(const std::string& name, const std::vector<std::string>& names);
+
 // A recorded output series: a header naming the columns, time (s) in the first column.
 // Streams (t, value of `column`) to `sample` row by row (`column` empty: the last column) and
 // returns the column's name. Anything wrong (no file, no header, a field count, not a
 // number, `sample` rejecting a row with std::invalid_argument) is InputError naming the
 // file and the line.
 std::string read_series_csv(const std::string& path, const std::string& column,
+                            const std::function<void(double t_s, double value)>& sample);
+// The same from a stream (`path` only names it in messages): the in-memory entry point.
+std::string read_series_csv(std::istream& in, const std::string& path, const std::string& column,
                             const std::function<void(double t_s, double value)>& sample);
 
 }  // namespace vrelab::io

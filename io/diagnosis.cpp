@@ -48,7 +48,7 @@ CampaignWritten write_virtual_campaign(const CampaignRequest& request) {
   for (const auto& h : spec.hidden) key["hidden"].push_back({{"name", h.name}, {"parameter", h.parameter}});
   key["truth"] = coefficients_json(c.plant.coefficients);
   key["data"] = request.out_dir;
-  write_atomic(w.request.key_path, key.dump(2) + "\n");
+  write_atomic(w.request.key_path, json_text(key));
   w.statics = camp.statics.size(), w.runs = camp.runs.size(), w.raw_records = !camp.raw.empty();
   w.wall_s = seconds_since(start);
   return w;

@@ -64,14 +64,14 @@ void write_diagnosis_report(const FolderDiagnosis& f, const std::string& dir) {
   which_effect(rep, f);
   rep.heading("3. How far it shrinks");
   how_far(rep, f.diagnosis);
-  write_atomic(dir + "/diagnosis.json", to_json(f).dump(2) + "\n");
+  begin_report_folder(dir);
+  write_atomic(dir + "/diagnosis.json", json_text(to_json(f)));
   const std::string why = run_plot_script("diagnose.py", dir);
   rep.figure("gap_map", "The gap per run, standardised against all the others (z), over frequency and amplitude, per direction.",
              why.empty(), why);
   rep.figure("residuals", "Held-out gap (what the coefficient errors cannot take up) before and after the chosen effect.",
              why.empty(), why);
-  write_atomic(dir + "/report.md", rep.markdown());
-  write_atomic(dir + "/report.html", rep.html());
+  write_report_folder(dir, rep);
 }
 
 }  // namespace vrelab::io

@@ -31,14 +31,18 @@ std::vector<std::string> split(const std::string& line, const std::string& where
 }
 
 // A CSV file with a header: rows with their line numbers; '#' lines and blank lines skipped.
+// Text checked line by line (UTF-8, a byte-order mark dropped, ',' as separator); a row with
+// more cells than the header, or a header naming a column twice, is refused.
 struct Csv {
   std::string path;
   std::map<std::string, std::size_t> column;
+  std::vector<std::string> names;  // the header, in order
   std::vector<std::pair<int, std::vector<std::string>>> rows;
   bool has(const std::string& c) const { return column.count(c) > 0; }
 };
 
 Csv read_csv(const std::string& path) {
+  if (fs::is_directory(path)) throw InputError(path + ": is a folder, not a CSV file");
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open (no such file)");
   Csv csv;
@@ -48,6 +52,7 @@ Csv read_csv(const std::string& path) {
   bool header = false;
   while (std::getline(in, line)) {
     ++n;
+    check_text_line(line, n, path);
     if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
     std::vector<std::string> cells;
     try {
@@ -56,17 +61,27 @@ Csv read_csv(const std::string& path) {
       throw InputError(e.what());
     }
     if (!header) {
-      for (std::size_t i = 0; i < cells.size(); ++i) csv.column[cells[i]] = i;
+      check_separator(line, n, path);
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        if (csv.column.count(cells[i]))
+          throw InputError(fmt::format("{}:{}:{}: column '{}' appears twice in the header", path, n, i + 1, cells[i]));
+        csv.column[cells[i]] = i;
+      }
+      csv.names = cells;
       header = true;
       continue;
     }
+    if (cells.size() > csv.names.size())
+      throw InputError(fmt::format("{}:{}:{}: {} cells, the header has {} (a ',' inside a cell? quote the cell)", path, n,
+                                   csv.names.size() + 1, cells.size(), csv.names.size()));
     csv.rows.emplace_back(n, std::move(cells));
   }
   if (!header) throw InputError(path + ": no header line");
   return csv;
 }
 
-// The value of `col` in a row as a number; nullopt with `why` set when absent or not finite.
+// The value of `col` in a row as a number; nullopt with `why` set when absent or not a finite
+// decimal ("file:line:column (name): ...").
 std::optional<double> number(const Csv& csv, const std::pair<int, std::vector<std::string>>& row, const std::string& col,
                              std::string* why) {
   const auto it = csv.column.find(col);
@@ -75,22 +90,39 @@ std::optional<double> number(const Csv& csv, const std::pair<int, std::vector<st
     return std::nullopt;
   }
   const std::string& s = row.second[it->second];
-  char* end = nullptr;
-  const double x = std::strtod(s.c_str(), &end);
-  if (end == s.c_str() || *end != '\0') {
-    *why = fmt::format("{}:{}: column {}: '{}' is not a number", csv.path, row.first, col, s);
-    return std::nullopt;
-  }
-  if (!std::isfinite(x)) {
-    *why = fmt::format("{}:{}: column {}: {} is not a finite number", csv.path, row.first, col, s);
+  const auto x = parse_decimal(s);
+  if (!x) {
+    const std::string reason = why_not_decimal(s);
+    *why = reason == "not finite"
+               ? fmt::format("{}:{}:{}: column {}: {} is not a finite number", csv.path, row.first, it->second + 1, col, s)
+               : fmt::format("{}:{}:{}: column {}: '{}' is not a number ({})", csv.path, row.first, it->second + 1, col, s,
+                             reason);
     return std::nullopt;
   }
   return x;
 }
 
+// " (the header has: a, b, c); did you mean 'wanted' for 'close'?" for a column `wanted` that
+// is not there, `close` the header's closest name.
+std::string columns_found(const Csv& csv, const std::string& wanted) {
+  std::string found;
+  for (const auto& n : csv.names) found += (found.empty() ? "" : ", ") + n;
+  std::string out = fmt::format(" (the header has: {})", found);
+  const std::string close = closest_name(wanted, csv.names);
+  if (!close.empty()) {
+    out += fmt::format("; did you mean '{}' for '{}'?", wanted, close);
+    std::string a = close, b = wanted;
+    for (char& ch : a) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    for (char& ch : b) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (a == b) out += " (column names are case-sensitive: units such as Hz are written as in SI)";
+  }
+  return out;
+}
+
 void require_columns(const Csv& csv, const std::vector<std::string>& cols, const std::string& hint = "") {
   for (const auto& c : cols)
-    if (!csv.has(c)) throw InputError(fmt::format("{}: the header lacks column '{}'{}", csv.path, c, hint));
+    if (!csv.has(c))
+      throw InputError(fmt::format("{}: the header lacks column '{}'{}{}", csv.path, c, hint, columns_found(csv, c)));
 }
 
 // The output column of a file must carry the manifest's unit: output_<unit>, sigma_<unit>.
@@ -100,7 +132,7 @@ void require_unit(const Csv& csv, const std::string& prefix, const std::string& 
     if (name.rfind(prefix, 0) == 0)
       throw InputError(fmt::format("{}: column '{}' is in '{}', the manifest's output unit is '{}' (expected '{}{}')", csv.path,
                                    name, name.substr(prefix.size()), unit, prefix, unit));
-  throw InputError(fmt::format("{}: the header lacks column '{}{}'", csv.path, prefix, unit));
+  throw InputError(fmt::format("{}: the header lacks column '{}{}'{}", csv.path, prefix, unit, columns_found(csv, prefix + unit)));
 }
 
 double toml_number(const toml::table& t, const std::string& table, const char* key, double fallback, const std::string& file) {
@@ -172,18 +204,43 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     throw InputError(fmt::format("{}:{}: {}", mpath, e.source().begin.line, e.description()));
   }
   check_keys(root, "", {"campaign", "instrument", "dynamics", "identification", "files", "diagnose"}, mpath);
+  // What every campaign states (an empty manifest would otherwise run on defaults and fail
+  // later, on the identification's rank): the format, the output unit, and the held
+  // coefficients (a 1 g test cannot separate the common part of k_PP, k_OO and k2 from k0, so
+  // some must be held; an explicit `fixed = { }` is the lab's choice, judged by the rank check).
+  {
+    std::vector<std::string> missing;
+    if (!root["campaign"]["format_version"]) missing.push_back("[campaign] format_version = 1");
+    if (!root["instrument"]["output_unit"]) missing.push_back("[instrument] output_unit (e.g. \"mA\")");
+    if (!root["identification"]["fixed"]) missing.push_back("[identification] fixed (e.g. { k_PP = 0.0 })");
+    if (!missing.empty()) {
+      std::string list;
+      for (const auto& k : missing) list += (list.empty() ? "" : "; ") + k;
+      throw InputError(fmt::format("{}: missing {} (docs/data-format.md)", mpath, list));
+    }
+  }
   validation::Campaign c;
   LabManifest m;
   if (auto* t = root["campaign"].as_table()) {
     check_keys(*t, "campaign", {"name", "format_version"}, mpath);
     m.name = (*t)["name"].value_or(m.name);
-    if (const auto v = (*t)["format_version"].value<std::int64_t>(); v && *v != 1)
+    const toml::node* fv = t->get("format_version");
+    if (!fv->is_integer())
+      throw InputError(fmt::format("{}:{}: [campaign] format_version: expected the whole number 1", mpath, fv->source().begin.line));
+    if (const auto v = fv->value<std::int64_t>(); v && *v != 1)
       throw InputError(fmt::format("{}: [campaign] format_version: {} is not supported (this program reads 1)", mpath, *v));
+    if (const toml::node* nm = t->get("name"); nm && !nm->is_string())
+      throw InputError(fmt::format("{}:{}: [campaign] name: expected a string", mpath, nm->source().begin.line));
   }
   c.name = m.name;
   if (auto* t = root["instrument"].as_table()) {
     check_keys(*t, "instrument", {"output_unit", "g_m_per_s2"}, mpath);
-    m.output_unit = (*t)["output_unit"].value_or(m.output_unit);
+    const toml::node* u = t->get("output_unit");
+    if (!u->is_string() || u->value<std::string>()->empty() ||
+        u->value<std::string>()->find_first_of(",\" \t") != std::string::npos)
+      throw InputError(fmt::format("{}:{}: [instrument] output_unit: expected a unit name such as \"mA\" (no blanks, commas or quotes)",
+                                   mpath, u->source().begin.line));
+    m.output_unit = *u->value<std::string>();
     m.g_m_per_s2 = toml_number(*t, "instrument", "g_m_per_s2", m.g_m_per_s2, mpath);
   }
   if (auto* t = root["dynamics"].as_table()) {
@@ -251,6 +308,9 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     const double sigma = get("sigma_" + m.output_unit);
     const bool has_count = st.has("count") && st.column.at("count") < row.second.size() && !row.second[st.column.at("count")].empty();
     const double count = has_count ? get("count") : 1.0;
+    if (count != std::floor(count))
+      throw InputError(fmt::format("{}:{}:{}: column count: {} is not a whole number of readings", st.path, row.first,
+                                   st.column.at("count") + 1, row.second[st.column.at("count")]));
     if (!(sigma > 0)) throw InputError(fmt::format("{}:{}: column sigma_{}: must be positive", st.path, row.first, m.output_unit));
     if (!(count >= 1)) throw InputError(fmt::format("{}:{}: column count: must be at least 1", st.path, row.first));
     r.sigma_output = sigma / std::sqrt(count);
@@ -338,15 +398,18 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
         rectification::SeriesMeasurer meas(win);
         std::string line;
         int ln = 0;
-        std::size_t tcol = 0, ucol = 1;
+        std::size_t tcol = 0, ucol = 1, columns = 0;
         bool header = false;
         double last_t = -INFINITY;
         while (std::getline(in, line)) {
           ++ln;
+          check_text_line(line, ln, spath);
           if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
           const auto cells = split(line, spath + ":" + std::to_string(ln));
           if (!header) {
             header = true;
+            check_separator(line, ln, spath);
+            columns = cells.size();
             bool found_t = false, found_u = false;
             for (std::size_t i = 0; i < cells.size(); ++i) {
               if (cells[i] == "time_s") tcol = i, found_t = true;
@@ -358,11 +421,15 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
           }
           if (tcol >= cells.size() || ucol >= cells.size())
             throw std::invalid_argument(fmt::format("{}:{}: too few columns", spath, ln));
-          char* e1 = nullptr;
-          char* e2 = nullptr;
-          const double t = std::strtod(cells[tcol].c_str(), &e1), u = std::strtod(cells[ucol].c_str(), &e2);
-          if (cells[tcol].empty() || cells[ucol].empty() || *e1 != '\0' || *e2 != '\0' || !std::isfinite(t) || !std::isfinite(u))
-            throw std::invalid_argument(fmt::format("{}:{}: a sample is not a finite number", spath, ln));
+          if (cells.size() > columns)
+            throw std::invalid_argument(fmt::format("{}:{}:{}: {} cells, the header has {}", spath, ln, columns + 1, cells.size(), columns));
+          const auto tx = parse_decimal(cells[tcol]), ux = parse_decimal(cells[ucol]);
+          if (!tx || !ux) {
+            const std::size_t col = tx ? ucol : tcol;
+            throw std::invalid_argument(fmt::format("{}:{}: a sample is not a finite number (column {}, '{}': {})", spath, ln,
+                                                    col + 1, cells[col], why_not_decimal(cells[col])));
+          }
+          const double t = *tx, u = *ux;
           if (!(t > last_t)) throw std::invalid_argument(fmt::format("{}:{}: time does not increase", spath, ln));
           last_t = t;
           meas.add(t, u);

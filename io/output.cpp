@@ -6,12 +6,28 @@
 #include <fstream>
 #include <stdexcept>
 
+#include <cerrno>
+#include <cstring>
+
+#include <fcntl.h>
 #include <unistd.h>
 
 #include "vrelab_version.hpp"
 
 namespace vrelab::io {
 
+namespace {
+
+// Flushes an open file (or folder) to the disk; false when the system says it could not.
+// EINVAL: the file system cannot sync (e.g. some network or special file systems): nothing to do.
+bool sync_fd(int fd) { return ::fsync(fd) == 0 || errno == EINVAL; }
+
+}  // namespace
+
+// Durable as well as atomic: the temporary file's data are fsync'ed before the rename (else
+// a crash soon after could leave the new name on an empty or partial file: rename is ordered
+// before the data on ext4's and XFS's delayed allocation), and the folder after it (so the
+// new name itself survives a crash).
 void write_atomic(const std::string& path, const std::string& text) {
   namespace fs = std::filesystem;
   const fs::path target(path);
@@ -19,22 +35,39 @@ void write_atomic(const std::string& path, const std::string& text) {
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), dir_error);
   if (dir_error) throw InputError("cannot create the folder of " + target.string() + ": " + dir_error.message());
   const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) throw InputError("cannot write " + tmp.string());
-    out << text;
-    out.flush();
-    if (!out) {
-      fs::remove(tmp);
-      throw std::runtime_error("writing " + tmp.string() + " failed");
-    }
+  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw InputError("cannot write " + tmp.string() + ": " + std::strerror(errno));
+  std::size_t done = 0;
+  bool ok = true;
+  while (ok && done < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    ok = n > 0;
+    if (ok) done += static_cast<std::size_t>(n);
+  }
+  const std::string why = ok ? "" : std::strerror(errno);
+  ok = ok && sync_fd(fd);
+  ok = (::close(fd) == 0) && ok;
+  if (!ok) {
+    fs::remove(tmp, dir_error);
+    throw std::runtime_error("writing " + tmp.string() + " failed" + (why.empty() ? "" : ": " + why));
   }
   std::error_code ec;
   fs::rename(tmp, target, ec);
   if (ec) {
-    fs::remove(tmp);
+    fs::remove(tmp, dir_error);
     throw InputError("cannot write " + target.string() + ": " + ec.message());
   }
+  const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  const int dfd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dfd >= 0) {
+    sync_fd(dfd);
+    ::close(dfd);
+  }
+}
+
+std::string json_text(const nlohmann::json& j) {
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 nlohmann::json program_record() {

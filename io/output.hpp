@@ -13,6 +13,13 @@ namespace vrelab::io {
 // A path that cannot be written throws InputError (exit code 2).
 void write_atomic(const std::string& path, const std::string& text);
 
+// A result's JSON as written to file: indented by 2, ending in a newline. Text in a result
+// that is not UTF-8 can only come from a path (data files are refused at read time when they
+// are not UTF-8: io/csv.hpp, and TOML is UTF-8 by its grammar): its bad bytes are written as
+// U+FFFD, so a run in a folder named in Latin-1 still writes its result instead of failing
+// after the computation (nlohmann's error_handler_t::replace).
+std::string json_text(const nlohmann::json& j);
+
 // {"name", "version", "git"}: the program that made a result.
 nlohmann::json program_record();
 // {"file", "content"}: the case a result was made from.

@@ -1,6 +1,13 @@
 #include "io/report.hpp"
 
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
 #include <fmt/format.h>
+
+#include "io/output.hpp"
 
 namespace vrelab::io {
 namespace {
@@ -112,6 +119,68 @@ std::string Report::html() const {
   }
   o += "</body>\n</html>\n";
   return o;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+constexpr const char* kReportList = "report-files.txt";
+constexpr const char* kComplete = "# complete";
+
+// A name the list may hold: a plain file name in the folder (nothing outside it is removed).
+bool plain_name(const std::string& n) {
+  return !n.empty() && n[0] != '#' && n.find('/') == std::string::npos && n != "." && n != ".." && n != kReportList;
+}
+
+// Regular files of `dir` written at or after `since` (the list's own time), but the list and
+// temporary files.
+std::vector<std::string> written_since(const fs::path& dir, fs::file_time_type since) {
+  std::vector<std::string> out;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string n = e.path().filename().string();
+    if (!e.is_regular_file(ec) || !plain_name(n) || n.find(".tmp.") != std::string::npos) continue;
+    if (e.last_write_time(ec) >= since && !ec) out.push_back(n);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+void begin_report_folder(const std::string& dir_name) {
+  const fs::path dir(dir_name), list = dir / kReportList;
+  std::error_code ec;
+  for (const char* f : {"report.html", "report.md"}) fs::remove(dir / f, ec);
+  if (fs::is_regular_file(list, ec)) {
+    std::ifstream in(list);
+    bool complete = false;
+    for (std::string line; std::getline(in, line);) {
+      complete = complete || line == kComplete;
+      if (plain_name(line)) fs::remove(dir / line, ec);
+    }
+    if (!complete) {  // the last run was killed: what it wrote is not listed
+      const auto since = fs::last_write_time(list, ec);
+      if (!ec)
+        for (const auto& n : written_since(dir, since)) fs::remove(dir / n, ec);
+    }
+  }
+  // The new list's time (the file system's clock, as the files' times are) marks the start.
+  write_atomic(list.string(), "# vrelab report files (io/report.hpp): removed before the next report is written here\n");
+}
+
+void write_report_folder(const std::string& dir_name, const Report& rep) {
+  const fs::path dir(dir_name), list = dir / kReportList;
+  std::error_code ec;
+  const auto since = fs::last_write_time(list, ec);
+  std::set<std::string> files = {"report.md", "report.html"};
+  if (!ec)
+    for (const auto& n : written_since(dir, since)) files.insert(n);
+  std::string text = "# vrelab report files (io/report.hpp): removed before the next report is written here\n";
+  for (const auto& n : files) text += n + "\n";
+  write_atomic(list.string(), text + kComplete + "\n");
+  write_atomic((dir / "report.md").string(), rep.markdown());
+  write_atomic((dir / "report.html").string(), rep.html());
 }
 
 }  // namespace vrelab::io

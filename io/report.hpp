@@ -37,4 +37,20 @@ class Report {
   std::vector<Block> blocks_;
 };
 
+// ---- A report folder (reproduce --out, diagnose --report): a new run's files never sit beside
+// an old report, and a report is only there when everything it shows is.
+//
+// The folder is kept, not swapped: it may hold the user's own files (or be the campaign's
+// own folder), which writing the report into a sibling folder and renaming it over would
+// take away. Instead DIR/report-files.txt lists what the last report wrote:
+// begin_report_folder removes report.html and report.md first, then every file the list names
+// (figures included, so a run drawing fewer figures leaves none of the old ones) and, when the
+// last run was killed before its list was complete, every file written since it began; it
+// then starts a new list. write_report_folder lists every file written since (data, figures)
+// and writes report.md and, last, report.html. Files are each written atomically
+// (write_atomic; the plot scripts through tools/plots/atomic_figure.py), so a killed run
+// leaves whole files of the new run and no report.
+void begin_report_folder(const std::string& dir);
+void write_report_folder(const std::string& dir, const Report& rep);
+
 }  // namespace vrelab::io

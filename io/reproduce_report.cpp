@@ -373,9 +373,10 @@ void report_invisible(Report& rep, const ReproduceResult& res, const std::string
 
 void write_reproduce_data(const Case& c, const ReproduceSettings& s, const ReproduceResult& res, double wall_s,
                           const std::string& dir) {
+  begin_report_folder(dir);
   write_atomic(dir + "/static.csv", static_csv(c, res));
   write_atomic(dir + "/confirmation.csv", confirmation_csv(c, res));
-  write_atomic(dir + "/confirmation.json", reproduce_confirmation_json(c, s, res).dump(2) + "\n");
+  write_atomic(dir + "/confirmation.json", json_text(reproduce_confirmation_json(c, s, res)));
   write_atomic(dir + "/amplitude.csv", amplitude_csv(c, res));
   write_atomic(dir + "/amplitude_curves.csv", amplitude_curves_csv(c, res));
   if (!res.frequency_runs.empty()) {
@@ -389,7 +390,7 @@ void write_reproduce_data(const Case& c, const ReproduceSettings& s, const Repro
   if (res.invisible.c_per_g == 0)
     for (const char* f : {"invisible.csv", "fig6_invisible.png", "fig6_invisible.svg"}) stale.push_back(f);
   for (const auto& f : stale) std::filesystem::remove(dir + "/" + f);
-  write_atomic(dir + "/summary.json", reproduce_summary_json(c, s, res, wall_s).dump(2) + "\n");
+  write_atomic(dir + "/summary.json", json_text(reproduce_summary_json(c, s, res, wall_s)));
 }
 
 Report reproduce_full_report(const Case& c, const ReproduceSettings& s, const ReproduceResult& res, double wall_s,

@@ -17,7 +17,9 @@ namespace vrelab::io {
 
 // static.csv, confirmation.{csv,json}, amplitude.csv, amplitude_curves.csv, frequency.csv and
 // frequency_curves.csv (when run), invisible.csv (when run), summary.json; removes the files
-// of a section not run (and its figure) left by an earlier run.
+// of a section not run (and its figure) left by an earlier run. Starts the report folder
+// (begin_report_folder: the old report and its files removed first); the report is then
+// written with write_report_folder.
 void write_reproduce_data(const Case& c, const validation::ReproduceSettings& s, const validation::ReproduceResult& res,
                           double wall_s, const std::string& dir);
 

@@ -26,8 +26,7 @@ ReproduceRun reproduce_to_folder(const Case& c, const std::string& out_dir, int 
   write_reproduce_data(c, run.settings, run.result, run.wall_s, out_dir);
   run.figures_missing = plots ? run_plot_script("reproduce.py", out_dir) : std::string("--no-plots was given");
   const Report rep = reproduce_full_report(c, run.settings, run.result, run.wall_s, run.figures_missing);
-  write_atomic(out_dir + "/report.md", rep.markdown());
-  write_atomic(out_dir + "/report.html", rep.html());
+  write_report_folder(out_dir, rep);
   return run;
 }
 

@@ -420,16 +420,27 @@ std::uint64_t fnv1a(const std::string& s) {
   return h;
 }
 
+// `checksum` is FNV-1a (32 bits, 8 hex digits) of the row's text before it ("index,...,steps"):
+// a resumed sweep verifies it, so a row edited by hand is found. wall_s, a timing and not a
+// result, stays last and outside the checksum.
 constexpr const char* kSweepColumns =
     "index,frequency_Hz,amplitude_g,direction_IA,direction_PA,direction_OA,a_IA_g,a_PA_g,a_OA_g,measured_g,sigma_g,"
-    "predicted_eq3_g,settle_s,steps,wall_s";
+    "predicted_eq3_g,settle_s,steps,checksum,wall_s";
+constexpr long kSweepCommas = 15;
+
+std::string row_checksum(const std::string& text) {
+  std::uint32_t h = 2166136261u;
+  for (unsigned char ch : text) h = (h ^ ch) * 16777619u;
+  return fmt::format("{:08x}", h);
+}
 
 std::string sweep_line(const rectification::SweepRow& r) {
   const auto& c = r.condition;
-  return fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.12e},{:.4e},{:.12e},{:.6g},{},{:.4g}\n",
-                     c.index, c.frequency_Hz, c.amplitude_g, c.direction[0], c.direction[1], c.direction[2],
-                     c.orientation_g[0], c.orientation_g[1], c.orientation_g[2], r.measured_g, r.sigma_g,
-                     r.predicted_eq3_g, r.settle_s, r.steps, r.wall_s);
+  const std::string body =
+      fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.12e},{:.4e},{:.12e},{:.6g},{}", c.index,
+                  c.frequency_Hz, c.amplitude_g, c.direction[0], c.direction[1], c.direction[2], c.orientation_g[0],
+                  c.orientation_g[1], c.orientation_g[2], r.measured_g, r.sigma_g, r.predicted_eq3_g, r.settle_s, r.steps);
+  return fmt::format("{},{},{:.4g}\n", body, row_checksum(body), r.wall_s);
 }
 
 // The file's header: the fingerprint ties a results file to the case and the program (a
@@ -446,8 +457,13 @@ std::string sweep_header(const Case& c, const std::string& fingerprint) {
 }
 
 // The rows of an earlier run of the same sweep (index -> line); a partial last line dropped.
+// A line that is not a row of this sweep (its index or its cell count) stops the resume; a
+// row whose checksum does not match its text (edited by hand) is dropped, so its condition
+// is run again, and named in *dropped with its line: the condition's result is a function of
+// the case alone (its noise seed included), so running it again loses nothing, while
+// keeping an edited number would put into the results what the program did not compute.
 std::map<std::size_t, std::string> resumed_rows(const std::string& path, const std::string& fingerprint,
-                                                std::size_t conditions) {
+                                                std::size_t conditions, std::vector<std::string>* dropped) {
   std::map<std::size_t, std::string> rows;
   std::ifstream in(path);
   std::string line, text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -468,10 +484,19 @@ std::map<std::size_t, std::string> resumed_rows(const std::string& path, const s
     } catch (const std::exception&) {
       used = 0;
     }
-    if (used != index_field.size() || used == 0 || std::count(line.begin(), line.end(), ',') != 14 || index >= conditions)
+    if (used != index_field.size() || used == 0 || std::count(line.begin(), line.end(), ',') != kSweepCommas ||
+        index >= conditions)
       throw InputError(fmt::format("{}:{}: not a row of this sweep (index '{}', {} conditions); use --restart to "
                                    "discard the file",
                                    path, line_no, index_field, conditions));
+    const std::size_t wall = line.rfind(','), sum = line.rfind(',', wall - 1);
+    const std::string body = line.substr(0, sum), checksum = line.substr(sum + 1, wall - sum - 1);
+    if (checksum != row_checksum(body)) {
+      dropped->push_back(fmt::format("{}:{}: condition {}: the row does not match its checksum (edited by hand?); run again",
+                                     path, line_no, index));
+      rows.erase(index);
+      continue;
+    }
     rows[index] = line + "\n";
   }
   return rows;
@@ -492,12 +517,13 @@ SweepStudy sweep(const Case& c, const std::string& out_path, bool restart, int t
   const rectification::SweepGrid& grid = *c.sweep;
   if (std::string why; !grid.IsValid(&why)) throw InputError(c.path + ": [sweep] " + why);
   if (std::string why; !c.shake.IsValid(&why)) throw InputError(c.path + ": [shake] " + why);
-  const std::string fingerprint = fmt::format("{:016x}", fnv1a(c.content.dump() + kProgramVersion + kGitDescribe));
+  const std::string fingerprint = fmt::format("{:016x}", fnv1a(c.content.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + kProgramVersion + kGitDescribe));
   const std::string header = sweep_header(c, fingerprint);
   const fs::path path(out_path);
   if (path.has_parent_path()) fs::create_directories(path.parent_path());
   std::map<std::size_t, std::string> rows;
-  if (fs::exists(path) && !restart) rows = resumed_rows(out_path, fingerprint, grid.size());
+  SweepStudy s;
+  if (fs::exists(path) && !restart) rows = resumed_rows(out_path, fingerprint, grid.size(), &s.recomputed);
   write_atomic(out_path, sweep_text(header, rows));  // the kept rows; then appended as conditions finish
   std::vector<std::size_t> skip;
   for (const auto& [i, l] : rows) skip.push_back(i);
@@ -507,8 +533,8 @@ SweepStudy sweep(const Case& c, const std::string& out_path, bool restart, int t
                      "{} already in {}; {} thread(s)\n",
                      grid.frequencies_Hz.size(), grid.amplitudes_g.size(), grid.directions.size(),
                      grid.orientations_g.size(), grid.size(), rows.size(), out_path, used);
+  for (const auto& r : s.recomputed) out << "  " << r << "\n";
   out.flush();
-  SweepStudy s;
   s.conditions = grid.size();
   s.ran = grid.size() - skip.size();
   std::ofstream append(out_path, std::ios::app);
@@ -539,6 +565,7 @@ std::string sweep_report(const SweepStudy& s, const std::string& out_path) {
   std::string out = fmt::format("Done: {} conditions in {:.3g} s wall ({} written, {} failed) -> {}\n", s.ran, s.wall_s,
                                 s.written, s.failures.size(), out_path);
   for (const auto& f : s.failures) out += "  failed: " + f + "\n";
+  for (const auto& r : s.recomputed) out += "  recomputed: " + r + "\n";
   return out;
 }
 
@@ -605,7 +632,7 @@ void write_frequency_data(const Case& c, const FrequencyStudy& s, const std::str
   write_atomic(dir + "/frequency.csv", grid_csv);
   write_atomic(dir + "/ode_points.csv", ode_csv);
   write_atomic(dir + "/summary.md", md);
-  write_atomic(dir + "/summary.json", frequency_json(c, s).dump(2) + "\n");
+  write_atomic(dir + "/summary.json", json_text(frequency_json(c, s)));
 }
 
 }  // namespace vrelab::io

@@ -76,6 +76,8 @@ std::string measure_report(const MeasureStudy& s);
 struct SweepStudy {
   std::size_t conditions = 0, ran = 0, written = 0;
   std::vector<std::string> failures;
+  // Rows of the resumed file whose checksum did not match (file:line, condition): run again.
+  std::vector<std::string> recomputed;
   double wall_s = 0;
 };
 // Announces the grid on `out` before running; with `progress`, draws core::Progress on stderr.

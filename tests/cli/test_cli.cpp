@@ -347,7 +347,7 @@ TEST(CliSweep, PredictsFromTheImpliedCoefficientsOfAPhysicalPlant) {
   std::vector<std::string> f;
   std::stringstream ss(row);
   for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
-  ASSERT_EQ(f.size(), 15u);
+  ASSERT_EQ(f.size(), 16u);  // with the checksum column
   EXPECT_NEAR(std::stod(f[11]), predicted, 1e-12);
 }
 

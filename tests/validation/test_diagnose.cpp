@@ -428,7 +428,7 @@ TEST(LabData, BadRunsAreSkippedWithFileAndLineAndBadFilesStop) {
   const Campaign c = io::read_campaign(dir);
   EXPECT_EQ(c.runs.size(), 8u);
   ASSERT_EQ(c.skipped.size(), 2u);
-  EXPECT_TRUE(std::regex_search(c.skipped[0], std::regex(R"(run 'ia-10Hz-2g': .*runs\.csv:\d+: column measured_ug: nan is not a finite number)")))
+  EXPECT_TRUE(std::regex_search(c.skipped[0], std::regex(R"(run 'ia-10Hz-2g': .*runs\.csv:\d+:10: column measured_ug: nan is not a finite number)")))
       << c.skipped[0];
   EXPECT_TRUE(std::regex_search(c.skipped[1], std::regex(R"(short\.csv: the record ends at 0\.099 s, before on_to_s = 0\.5 s)")))
       << c.skipped[1];

@@ -10,6 +10,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from atomic_figure import savefig_atomic  # noqa: E402
 
 
 def main(out):
@@ -32,8 +33,8 @@ def main(out):
     ax.set_ylabel("hidden in the campaign")
     ax.set_title(f"vrelab blind: {sum(map(sum, m))} campaigns")
     fig.tight_layout()
-    fig.savefig(f"{out}/confusion.png", dpi=150)
-    fig.savefig(f"{out}/confusion.svg")
+    savefig_atomic(fig, f"{out}/confusion.png", dpi=150)
+    savefig_atomic(fig, f"{out}/confusion.svg")
     print(f"confusion.py: wrote {out}/confusion.png, .svg")
 
 

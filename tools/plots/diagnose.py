@@ -11,6 +11,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from atomic_figure import savefig_atomic  # noqa: E402
 
 
 def direction_name(d):
@@ -44,8 +45,8 @@ def main(out):
     axes[0][-1].legend(title="amplitude", fontsize=8, title_fontsize=8)
     fig.suptitle(f"Gap map: {d['verdict']}", fontsize=10)
     fig.tight_layout()
-    fig.savefig(f"{out}/gap_map.png", dpi=150)
-    fig.savefig(f"{out}/gap_map.svg")
+    savefig_atomic(fig, f"{out}/gap_map.png", dpi=150)
+    savefig_atomic(fig, f"{out}/gap_map.svg")
     plt.close(fig)
 
     fig, ax = plt.subplots(figsize=(6.4, 3.6))
@@ -61,8 +62,8 @@ def main(out):
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, which="both")
     fig.tight_layout()
-    fig.savefig(f"{out}/residuals.png", dpi=150)
-    fig.savefig(f"{out}/residuals.svg")
+    savefig_atomic(fig, f"{out}/residuals.png", dpi=150)
+    savefig_atomic(fig, f"{out}/residuals.svg")
     print(f"diagnose.py: wrote {out}/gap_map.png, residuals.png (.svg)")
 
 

@@ -13,6 +13,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from atomic_figure import savefig_atomic  # noqa: E402
 
 
 def read(path):
@@ -84,8 +85,8 @@ def main(out):
     ax2.grid(True, which="both", alpha=0.3)
     ax2.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(f"{out}/frequency.png", dpi=150)
-    fig.savefig(f"{out}/frequency.svg")
+    savefig_atomic(fig, f"{out}/frequency.png", dpi=150)
+    savefig_atomic(fig, f"{out}/frequency.svg")
 
 
 if __name__ == "__main__":

@@ -31,6 +31,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from atomic_figure import savefig_atomic  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
@@ -182,8 +183,8 @@ def symlog_label(v, _):
 
 
 def save(fig, out, name, written):
-    fig.savefig(os.path.join(out, name + ".png"), dpi=150)
-    fig.savefig(os.path.join(out, name + ".svg"))
+    savefig_atomic(fig, os.path.join(out, name + ".png"), dpi=150)
+    savefig_atomic(fig, os.path.join(out, name + ".svg"))
     plt.close(fig)
     written.append(name)
 

@@ -168,7 +168,8 @@ Solved solve(const Design& d, const Eigen::VectorXd& y, const Eigen::VectorXd& w
   // Null space in unscaled parameter coordinates.
   const Eigen::MatrixXd null_scaled = svd.matrixV().rightCols(p - rank);
   Eigen::VectorXd col_residual(p);
-  for (Eigen::Index c = 0; c < p; ++c) col_residual[c] = null_scaled.row(c).norm();
+  // (No null space, no columns: a row of an empty matrix would offset a null pointer; found by fuzz_lab_data.)
+  for (Eigen::Index c = 0; c < p; ++c) col_residual[c] = rank < p ? null_scaled.row(c).norm() : 0.0;
   for (Eigen::Index c = 0; c < p; ++c) {
     const int param = d.params[static_cast<std::size_t>(c)];
     id.identifiable[param] = col_residual[c] < 1e-8;
