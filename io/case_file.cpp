@@ -419,8 +419,8 @@ void read_dividing_head(Table t, Case& c) {
       for (auto&& [k, v] : *e)
         if (k.str() != "series" && k.str() != "angle_deg")
           t.fail(&v, "positions", "unknown key '" + std::string(k.str()) + "' in a position");
-      h.positions.push_back(validation::series_position(static_cast<int>(s->as_integer()->get()),
-                                                        ang->value<double>().value() * kDeg));
+      h.positions.push_back(validation::series_position_deg(static_cast<int>(s->as_integer()->get()),
+                                                            ang->value<double>().value()));
     }
     h.description = std::to_string(h.positions.size()) + " listed positions";
   } else {

@@ -40,6 +40,9 @@ bad empty 's/^positions_per_series = .*/positions = []/' 'the position set is em
 bad rank 's/^fixed = .*/fixed = { }/' 'rank 11 of 13'
 bad bigint 's/^repeats = .*/repeats = 4294967297/' 'repeats: must be at most'
 bad notarray 's/^positions_per_series = .*/positions = "abc"/' 'positions: expected an array of tables'
+# Issue 13 item 1: a 4-position tumble entered as series/angle_deg at multiples of 90 deg sees no
+# cross term: rank 6 of 9, refused, not k_IP from rounding.
+bad tumble 's/^positions_per_series = .*/positions = [{series=1,angle_deg=0},{series=1,angle_deg=90},{series=1,angle_deg=180},{series=1,angle_deg=270},{series=2,angle_deg=0},{series=2,angle_deg=90},{series=2,angle_deg=180},{series=2,angle_deg=270},{series=3,angle_deg=0},{series=3,angle_deg=90},{series=3,angle_deg=180},{series=3,angle_deg=270}]/; s/^fixed = .*/fixed = { k1_asym = 2.0e-5, k3 = 1.0e-6, k4 = 2.0e-7, k_PP = 0.0 }/' 'rank 6 of 9'
 mkdir -p "$tmp/o/isdir.json"
 expect 2 'cannot write' identify "$cases/ideal-static.toml" --json "$tmp/o/isdir.json"
 ls "$tmp/o" | grep -q 'tmp' && { echo "FAIL: a temporary file was left behind"; fail=$((fail + 1)); }
