@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -83,8 +84,26 @@ class Table {
   const toml::node* get(std::string_view key, bool required) {
     used_.insert(std::string(key));
     const toml::node* n = t_.get(key);
-    if (!n && required) fail(nullptr, key, "missing (required)");
+    if (!n && required) {
+      // A required key missing is most often a typo of it (k_2 for k2, frequency_hz for
+      // frequency_Hz): name the key the file has, on its line, with the match.
+      for (auto&& [k, v] : t_) {
+        const std::string have(k.str());
+        if (used_.count(have)) continue;
+        if (normalised(have) == normalised(key) || (key.size() > 3 && edit_distance(have, key) == 1))
+          fail(&v, have, "unknown key (did you mean '" + std::string(key) + "'?); " + std::string(key) +
+                             " is required");
+      }
+      fail(nullptr, key, "missing (required)");
+    }
     return n;
+  }
+  // Lower case without '_' and '-': keys that differ only so are the same key mistyped.
+  static std::string normalised(std::string_view k) {
+    std::string out;
+    for (char ch : k)
+      if (ch != '_' && ch != '-') out += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    return out;
   }
 
   double number_of(const toml::node* n, std::string_view key) const {
@@ -638,6 +657,17 @@ void read_shake(Table t, Case& c) {
   t.check_unknown({"relative_tolerance", "settle_decay", "blocks", "min_measure_s"});
 }
 
+// A static orientation is gravity in sensor axes, in units of the local g: |a| = 1 g. Within
+// 1e-3: a vector typed with four digits (0.7071) is off by ~1e-4, while a norm of 0 g (no
+// gravity) or 10 g (a centrifuge, or m/s^2 typed for g) is not a static test on the earth.
+constexpr double kGravityNormTolerance = 1e-3;
+void check_gravity(const Table& t, const toml::node* n, std::string_view key, const Vec3& a) {
+  if (!(std::abs(a.norm() - 1) <= kGravityNormTolerance))
+    t.fail(n, key,
+           fmt::format("gravity in sensor axes [IA, PA, OA] in units of g must have norm 1 g (within {:g}), got {:.6g} g",
+                       kGravityNormTolerance, a.norm()));
+}
+
 std::vector<Vec3> vec3_list(Table& t, std::string_view key, bool unit) {
   std::vector<Vec3> out;
   const toml::node* n = t.get(key, false);
@@ -649,6 +679,8 @@ std::vector<Vec3> vec3_list(Table& t, std::string_view key, bool unit) {
     if (unit) {
       if (!(v.norm() > 0)) t.fail(&x, key, "a direction must not be zero");
       v.normalize();
+    } else {
+      check_gravity(t, &x, key, v);  // every unnormalised list is of orientations_g
     }
     out.push_back(v);
   }
@@ -878,6 +910,7 @@ Case read_case(const std::string& path) {
   if (auto t = top.subtable("coefficients", false)) read_coefficients(*t, c);
   if (auto t = top.subtable("orientation", false)) {
     c.orientation_g = t->vec3("a_g");
+    check_gravity(*t, t->raw().get("a_g"), "a_g", *c.orientation_g);
     t->check_unknown({"a_g"});
   }
   if (auto t = top.subtable("vibration", false)) read_vibration(*t, c);

@@ -35,6 +35,15 @@ bad() {  # bad <name> <sed expression> <stderr regex> [case]
 }
 bad typo 's/^angle_sigma_arcsec/angle_sigma_arcsex/' "angle_sigma_arcsex: unknown key \(did you mean 'angle_sigma_arcsec'\?\)"
 bad nocoef '/^k4 = /d' '\[coefficients\] k4: missing'
+# Issue 13 item 10: a typo of a required key is an unknown key with its match, on its line.
+bad typo_required 's/^k2 = /k_2 = /' "typo_required.toml:[0-9]+: \[coefficients\] k_2: unknown key \(did you mean 'k2'\?\); k2 is required"
+# ... and a static orientation is gravity, |a| = 1 g, everywhere (0 g and 10 g refused).
+sed 's/^a_g = .*/a_g = [0.0, 0.0, 0.0]/' "$cases/paper-predict.toml" >"$tmp/g0.toml"
+expect 2 'g0.toml:[0-9]+: \[orientation\] a_g: gravity .* must have norm 1 g .*got 0 g' predict "$tmp/g0.toml"
+sed 's/^a_g = .*/a_g = [10.0, 0.0, 0.0]/' "$cases/paper-predict.toml" >"$tmp/g10.toml"
+expect 2 '\[orientation\] a_g: .*got 10 g' predict "$tmp/g10.toml"
+sed 's/^orientations_g = .*/orientations_g = [[0.0, 0.0, 10.0]]/' "$cases/campaign.toml" >"$tmp/g10c.toml"
+expect 2 '\[campaign\] orientations_g: .*got 10 g' campaign "$tmp/g10c.toml" --out "$tmp/o/g10c"
 bad negative 's/^noise_sigma_ug = .*/noise_sigma_ug = -1.0/' 'noise_sigma_ug: must not be negative'
 bad empty 's/^positions_per_series = .*/positions = []/' 'the position set is empty'
 bad rank 's/^fixed = .*/fixed = { }/' 'rank 11 of 13'
