@@ -78,7 +78,8 @@ class Table {
   }
 
   std::string qualified(std::string_view key) const {
-    return name_.empty() ? std::string(key) : "[" + name_ + "] " + std::string(key);
+    if (name_.empty()) return std::string(key);
+    return key.empty() ? "[" + name_ + "]" : "[" + name_ + "] " + std::string(key);
   }
 
   const toml::node* get(std::string_view key, bool required) {
@@ -548,6 +549,27 @@ void read_effects(Table& t, Case& c) {
   }
 }
 
+// The loop the [plant] keys set must be stable: checked here (the linearised loop's poles at
+// rest), so the message names the file, the table and the keys that set the loop, not only
+// "not stable" from deep inside a run.
+void check_loop_stable(Table& t, const Case& c, const std::vector<std::string_view>& loop_keys) {
+  try {
+    const plant::Accelerometer rest(c.plant, c.orientation_g.value_or(Vec3::UnitX()));
+    (void)rest.slowest_time_constant_s(rest.linearise());
+  } catch (const std::invalid_argument& e) {
+    std::string given;
+    for (auto k : loop_keys)
+      if (const toml::node* n = t.raw().get(k))
+        given += fmt::format("{}{} = {}", given.empty() ? "" : ", ", k,
+                             n->is_number() ? fmt::format("{:g}", n->value<double>().value()) : std::string("..."));
+    std::string all;
+    for (auto k : loop_keys) all += (all.empty() ? "" : ", ") + std::string(k);
+    t.fail(nullptr, "", std::string(e.what()) + "; the loop is set by " + all +
+                            (given.empty() ? " (all at their defaults" : " (given here: " + given) +
+                            ") and any [plant.effects] table");
+  }
+}
+
 // type = "physical": SI parameters (plant/physical.hpp); the model (1) coefficients follow.
 void read_physical_plant(Table& t, Case& c) {
   if (c.coefficients)
@@ -579,9 +601,15 @@ void read_physical_plant(Table& t, Case& c) {
     allowed.push_back(k.name);
   }
   std::string why;
-  if (!p.IsValid(&why)) t.fail(nullptr, why.substr(0, why.find(' ')), why);
+  if (!p.IsValid(&why)) {
+    const std::string key = why.substr(0, why.find(' '));
+    t.fail(t.raw().get(key), key, why.substr(why.find(' ') + 1));
+  }
   c.plant = plant::plant_from_physical(p, c.g_m_per_s2);
   read_effects(t, c);
+  check_loop_stable(t, c, {"inertia_kg_m2", "damping_N_m_s_per_rad", "hinge_stiffness_N_m_per_rad", "pendulosity_kg_m",
+                           "pickoff_V_per_rad", "servo_gain_A_per_V", "lead_zero_Hz", "lead_pole_Hz", "integrator_Hz",
+                           "torquer_N_m_per_A", "antialias_Hz"});
   t.check_unknown(allowed);
   c.coefficients = plant::implied_coefficients(p, c.g_m_per_s2);
   c.physical = p;
@@ -604,7 +632,10 @@ void read_plant(Table t, Case& c) {
   d.integrator_zero_ratio = t.opt_number("integrator_zero_ratio").value_or(d.integrator_zero_ratio);
   d.antialias_Hz = t.non_negative("antialias_Hz", d.antialias_Hz);
   std::string why;
-  if (!d.IsValid(&why)) t.fail(nullptr, "dynamics", why);
+  if (!d.IsValid(&why)) {
+    const std::string key = why.substr(0, why.find(' '));  // IsValid's message starts with the key
+    t.fail(t.raw().get(key), key, why.substr(why.find(' ') + 1));
+  }
   try {
     plant::design_servo(d);
   } catch (const std::invalid_argument& e) {
@@ -632,6 +663,9 @@ void read_plant(Table t, Case& c) {
   }
   read_effects(t, c);
   c.plant.coefficients = *c.coefficients;
+  check_loop_stable(t, c, {"pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g",
+                           "loop_bandwidth_Hz", "phase_margin_deg", "integrator_zero_ratio", "antialias_Hz",
+                           "location"});
   t.check_unknown({"type", "pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g",
                    "loop_bandwidth_Hz", "phase_margin_deg", "integrator", "integrator_zero_ratio", "antialias_Hz",
                    "location", "effects"});
@@ -881,7 +915,10 @@ void read_campaign(Table t, Case& c) {
 }  // namespace
 
 Case read_case(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": cannot open the case file (no such file)");
+  if (std::filesystem::is_directory(path))
+    throw InputError(path + ": cannot open the case file: is a directory (give the .toml file)");
+  if (!std::filesystem::exists(path)) throw InputError(path + ": cannot open the case file (no such file)");
+  if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": cannot open the case file: not a regular file");
   toml::table root;
   try {
     root = toml::parse_file(path);

@@ -68,6 +68,14 @@ expect 2 'relative_tolerance|solver failure in .* at simulated time' shake "$tmp
 sed 's/^\[plant\]/[plant]\nphase_margin_deg = 85.0/' "$cases/shake-sine.toml" >"$tmp/design.toml"
 expect 2 'phase_margin_deg' shake "$tmp/design.toml"
 expect 0 'measured vibration error' shake "$cases/shake-sine.toml" --json "$tmp/o/shake.json"
+# Issue 13 item 8: an unstable loop names the file, the table and the keys that set the loop;
+# integrator_zero_ratio out of its range is a validation error on that key; a directory given
+# as the case file says so.
+sed 's/^integrator_Hz = .*/integrator_Hz = 5000.0/' "$cases/shake-physical.toml" >"$tmp/unstable.toml"
+expect 2 'unstable.toml:[0-9]+: \[plant\]: the closed loop is not stable .*the loop is set by .*integrator_Hz = 5000' shake "$tmp/unstable.toml"
+sed 's/^\[plant\]/[plant]\nintegrator_zero_ratio = 1e-12/' "$cases/shake-sine.toml" >"$tmp/izr.toml"
+expect 2 'izr.toml:[0-9]+: \[plant\] integrator_zero_ratio: must lie in \[1e-4, 0.5\]' shake "$tmp/izr.toml"
+expect 2 'cannot open the case file: is a directory' shake "$cases"
 # A PSD table whose frequencies do not increase: the row is named.
 sed 's/^psd_IA = .*/psd_IA = [[20.0, 0.026], [800.0, 0.16], [50.0, 0.16], [2000.0, 0.026]]/' "$cases/shake-random-gevs.toml" >"$tmp/psd.toml"
 expect 2 'psd_IA: .*row 3' shake "$tmp/psd.toml" --json "$tmp/o/psd.json"
