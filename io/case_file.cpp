@@ -687,7 +687,10 @@ void read_shake(Table t, Case& c) {
   s.blocks = static_cast<int>(t.integer("blocks", false, s.blocks, 2, 1000));
   s.min_measure_s = t.non_negative("min_measure_s", s.min_measure_s);
   std::string why;
-  if (!s.IsValid(&why)) t.fail(t.raw().get(why.substr(0, why.find(' '))), why.substr(0, why.find(' ')), why);
+  if (!s.IsValid(&why)) {
+    const std::string key = why.substr(0, why.find(' '));  // IsValid's message starts with the key
+    t.fail(t.raw().get(key), key, why.substr(why.find(' ') + 1));
+  }
   t.check_unknown({"relative_tolerance", "settle_decay", "blocks", "min_measure_s"});
 }
 

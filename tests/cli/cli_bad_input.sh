@@ -76,6 +76,9 @@ expect 2 'unstable.toml:[0-9]+: \[plant\]: the closed loop is not stable .*the l
 sed 's/^\[plant\]/[plant]\nintegrator_zero_ratio = 1e-12/' "$cases/shake-sine.toml" >"$tmp/izr.toml"
 expect 2 'izr.toml:[0-9]+: \[plant\] integrator_zero_ratio: must lie in \[1e-4, 0.5\]' shake "$tmp/izr.toml"
 expect 2 'cannot open the case file: is a directory' shake "$cases"
+# Issue 13 item 6: min_measure_s = 1e9 overflowed an int and was dropped (4 periods measured).
+sed 's/^min_measure_s = .*/min_measure_s = 1e9/' "$cases/shake-sine-lab.toml" >"$tmp/measure.toml"
+expect 2 'measure.toml:[0-9]+: \[shake\] min_measure_s: must lie in \[0, 1e6\] s' shake "$tmp/measure.toml"
 # A PSD table whose frequencies do not increase: the row is named.
 sed 's/^psd_IA = .*/psd_IA = [[20.0, 0.026], [800.0, 0.16], [50.0, 0.16], [2000.0, 0.026]]/' "$cases/shake-random-gevs.toml" >"$tmp/psd.toml"
 expect 2 'psd_IA: .*row 3' shake "$tmp/psd.toml" --json "$tmp/o/psd.json"
