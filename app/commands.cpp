@@ -2,6 +2,9 @@
 // print its report, write its JSON (io/results_json.hpp).
 #include "app/commands.hpp"
 
+#include <cmath>
+#include <string>
+
 #include "io/case_file.hpp"
 #include "io/output.hpp"
 #include "io/results_json.hpp"
@@ -11,6 +14,25 @@ namespace vrelab::app {
 using namespace vrelab::io;
 
 namespace {
+
+// The first number of a result that is not finite ("" if none), as a JSON path.
+std::string first_non_finite(const nlohmann::json& j, const std::string& at) {
+  if (j.is_number_float() && !std::isfinite(j.get<double>())) return at.empty() ? "/" : at;
+  if (j.is_object())
+    for (auto it = j.begin(); it != j.end(); ++it)
+      if (std::string p = first_non_finite(it.value(), at + "/" + it.key()); !p.empty()) return p;
+  if (j.is_array())
+    for (std::size_t i = 0; i < j.size(); ++i)
+      if (std::string p = first_non_finite(j[i], at + "/" + std::to_string(i)); !p.empty()) return p;
+  return "";
+}
+
+// A result with inf or NaN is not written (nor printed as if it were one): exit 2, naming it.
+void check_finite(const Case& c, const nlohmann::json& j) {
+  if (const std::string p = first_non_finite(j, ""); !p.empty())
+    throw InputError(c.path + ": the result " + p +
+                     " is not a finite number: a value of the case drives the computation out of range");
+}
 
 void write_json(const std::string& path, const nlohmann::json& j) {
   if (!path.empty()) write_atomic(path, j.dump(2) + "\n");
@@ -22,23 +44,29 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
   Case c = read_case(o.case_path);
   if (o.seed) c.seed = *o.seed;
   const IdentifyStudy s = identify(c, o.monte_carlo);
+  const nlohmann::json j = identify_json(c, s);
+  check_finite(c, j);
   out << identify_report(c, s);
-  write_json(o.json_path, identify_json(c, s));
+  write_json(o.json_path, j);
 }
 
 void run_predict(const PredictOptions& o, std::ostream& out) {
   const Case c = read_case(o.case_path);
   const PredictStudy s = predict(c, o.frequency_dependent);
+  const nlohmann::json j = predict_json(c, s);
+  check_finite(c, j);
   out << predict_report(c, s);
-  write_json(o.json_path, predict_json(c, s));
+  write_json(o.json_path, j);
 }
 
 void run_shake(const ShakeOptions& o, std::ostream& out) {
   Case c = read_case(o.case_path);
   if (o.seed) c.seed = *o.seed, c.shake.readout.seed = *o.seed;
   const ShakeStudy s = shake(c, o.series_path);
+  const nlohmann::json j = shake_json(c, s);
+  check_finite(c, j);
   out << shake_report(c, s);
-  write_json(o.json_path, shake_json(c, s));
+  write_json(o.json_path, j);
 }
 
 void run_measure(const MeasureOptions& o, std::ostream& out) {

@@ -196,16 +196,38 @@ class Table {
   std::set<std::string> used_;
 };
 
+// Physical ranges of model (1)'s coefficients. K1 in (0, 1e6] output units per g (mA/g, V/g:
+// navigation instruments are ~1); every other coefficient within 1 in its unit (1 g of bias,
+// 1/g, 1/g^2, 1 rad: orders beyond any accelerometer, whose values are <= 1e-2). Beyond these
+// the results overflow (K1 = 1e308 gave inf with exit 0) or mean nothing.
+constexpr double kMaxK1 = 1e6, kMaxCoefficient = 1.0;
+void check_coefficient(const Table& t, int i, double x) {
+  const std::string_view name = plant::coefficient_name(i);
+  if (i == plant::K1 && !(x > 0 && x <= kMaxK1))
+    t.fail(t.raw().get(name), name, fmt::format("must lie in (0, {:g}] output units per g, got {:g}", kMaxK1, x));
+  if (i != plant::K1 && !(std::abs(x) <= kMaxCoefficient))
+    t.fail(t.raw().get(name), name,
+           fmt::format("must lie in [-{0:g}, {0:g}] in its unit (beyond any accelerometer), got {1:g}", kMaxCoefficient, x));
+}
+
 void read_coefficients(Table t, Case& c) {
   plant::Coefficients k;
   std::vector<std::string_view> names;
   for (int i = 0; i < plant::kNumCoefficients; ++i) {
     names.push_back(plant::coefficient_name(i));
     k[i] = t.number(plant::coefficient_name(i));
+    check_coefficient(t, i, k[i]);
   }
-  if (k[plant::K1] <= 0) t.fail(t.raw().get("K1"), "K1", "must be positive (output units per g)");
   t.check_unknown(names);
   c.coefficients = k;
+}
+
+// Vibration amplitudes: at most 1000 g (shakers reach ~100 g); beyond, eq. (3)'s k3 a^3 and the
+// plant's states leave any meaning (and overflow near 1e100 g).
+constexpr double kMaxAmplitude_g = 1e3;
+void check_amplitude(const Table& t, std::string_view key, double a) {
+  if (!(a <= kMaxAmplitude_g))
+    t.fail(t.raw().get(key), key, fmt::format("amplitudes must be at most {:g} g, got {:g} g", kMaxAmplitude_g, a));
 }
 
 vibration::SineVibration read_sine_part(Table& t, bool frequency_required) {
@@ -214,6 +236,7 @@ vibration::SineVibration read_sine_part(Table& t, bool frequency_required) {
   v.phase_rad = t.opt_vec3("phase_deg").value_or(Vec3::Zero()) * kDeg;
   v.frequency_Hz = frequency_required ? t.number("frequency_Hz") : t.non_negative("frequency_Hz", 0.0);
   if (frequency_required && !(v.frequency_Hz > 0)) t.fail(t.raw().get("frequency_Hz"), "frequency_Hz", "must be positive");
+  for (int i = 0; i < 3; ++i) check_amplitude(t, "amplitude_g", v.amplitude_g[i]);
   for (int i = 0; i < 3; ++i)
     if (v.amplitude_g[i] < 0)
       t.fail(t.raw().get("amplitude_g"), "amplitude_g",
@@ -275,6 +298,7 @@ void read_random_part(Table& t, VibrationSpec& v, bool psd_required) {
   if (psd_required) t.fail(nullptr, "psd_IA", "a shaken random profile needs PSD tables psd_IA / psd_PA / psd_OA");
   vibration::RandomVibration g;
   g.rms_g = t.vec3("rms_g");
+  for (int i = 0; i < 3; ++i) check_amplitude(t, "rms_g", std::abs(g.rms_g[i]));
   if (const toml::node* n = t.get("correlation", false)) {
     const toml::array* rows = n->as_array();
     if (!rows || rows->size() != 3) t.fail(n, "correlation", "expected a 3 x 3 array of numbers");
@@ -480,9 +504,8 @@ void read_identification(Table t, Case& c) {
         f->check_unknown(names);
       }
       c.fixed[*idx] = f->number(k.str());
+      check_coefficient(*f, *idx, *c.fixed[*idx]);
     }
-    if (c.fixed[plant::K1] && *c.fixed[plant::K1] <= 0)
-      f->fail(f->raw().get("K1"), "K1", "must be positive (output units per g)");
   }
   t.check_unknown({"fixed"});
 }
@@ -701,7 +724,7 @@ constexpr double kGravityNormTolerance = 1e-3;
 void check_gravity(const Table& t, const toml::node* n, std::string_view key, const Vec3& a) {
   if (!(std::abs(a.norm() - 1) <= kGravityNormTolerance))
     t.fail(n, key,
-           fmt::format("gravity in sensor axes [IA, PA, OA] in units of g must have norm 1 g (within {:g}), got {:.6g} g",
+           fmt::format("a static orientation is gravity in sensor axes [IA, PA, OA], |a| = 1 g (within {:g}); got |a| = {:.6g} g",
                        kGravityNormTolerance, a.norm()));
 }
 
@@ -752,6 +775,7 @@ void read_sweep(Table t, Case& c) {
   if (g.amplitudes_g.empty()) t.fail(nullptr, "amplitudes_g", "missing (required)");
   for (double a : g.amplitudes_g)
     if (!(a >= 0)) t.fail(t.raw().get("amplitudes_g"), "amplitudes_g", "amplitudes must not be negative");
+  for (double a : g.amplitudes_g) check_amplitude(t, "amplitudes_g", a);
   g.directions = vec3_list(t, "directions", true);
   if (g.directions.empty()) t.fail(nullptr, "directions", "missing (required)");
   g.orientations_g = vec3_list(t, "orientations_g", false);
@@ -780,6 +804,7 @@ void read_frequency_study(Table t, Case& c) {
   if (ode_points > 0) f.ode_frequencies_Hz = rectification::spaced(from, to, static_cast<int>(ode_points), true);
   f.amplitude_g = t.opt_number("amplitude_g").value_or(f.amplitude_g);
   if (!(f.amplitude_g > 0)) t.fail(t.raw().get("amplitude_g"), "amplitude_g", "must be positive");
+  check_amplitude(t, "amplitude_g", f.amplitude_g);
   if (auto d = t.opt_vec3("direction")) {
     if (!(d->norm() > 0)) t.fail(t.raw().get("direction"), "direction", "must not be zero");
     f.direction = d->normalized();
@@ -817,6 +842,7 @@ void read_reproduce(Table t, Case& c) {
   if (r.amplitudes_g.empty()) t.fail(nullptr, "amplitudes_g", "missing (required)");
   for (double a : r.amplitudes_g)
     if (!(a > 0)) t.fail(t.raw().get("amplitudes_g"), "amplitudes_g", "amplitudes must be positive");
+  for (double a : r.amplitudes_g) check_amplitude(t, "amplitudes_g", a);
   r.directions = named_vectors(t, "directions", "direction_names", true);
   r.orientations = named_vectors(t, "orientations_g", "orientation_names", false);
   for (const auto& o : r.orientations)
@@ -835,6 +861,7 @@ void read_reproduce(Table t, Case& c) {
   r.confirmation_orientation = r.orientations[index("orientation", r.orientations.size())];
   r.confirmation_direction = r.directions[index("direction", r.directions.size())];
   r.confirmation_amplitude_g = conf->number("amplitude_g");
+  check_amplitude(*conf, "amplitude_g", r.confirmation_amplitude_g);
   if (!(r.confirmation_amplitude_g > 0)) conf->fail(conf->raw().get("amplitude_g"), "amplitude_g", "must be positive");
   r.confirmation_record_s = conf->number("record_s");
   if (!(r.confirmation_record_s > 0)) conf->fail(conf->raw().get("record_s"), "record_s", "must be positive");
@@ -895,6 +922,7 @@ void read_campaign(Table t, Case& c) {
     if (!(f > 0)) t.fail(t.raw().get("frequencies_Hz"), "frequencies_Hz", "frequencies must be positive");
   for (double a : d.amplitudes_g)
     if (!(a > 0)) t.fail(t.raw().get("amplitudes_g"), "amplitudes_g", "amplitudes must be positive");
+  for (double a : d.amplitudes_g) check_amplitude(t, "amplitudes_g", a);
   d.run_sigma_g = t.non_negative("run_sigma_ug", d.run_sigma_g * 1e6) * 1e-6;
   if (!(d.run_sigma_g > 0)) t.fail(t.raw().get("run_sigma_ug"), "run_sigma_ug", "must be positive");
   d.positions_per_series = static_cast<int>(t.integer("positions_per_series", false, d.positions_per_series, 8, 360));
