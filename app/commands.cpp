@@ -43,6 +43,7 @@ void write_json(const std::string& path, const nlohmann::json& j) {
 void run_identify(const IdentifyOptions& o, std::ostream& out) {
   Case c = read_case(o.case_path);
   if (o.seed) c.seed = *o.seed;
+  if (o.work_limit) check_identify_work(c, o.monte_carlo);
   const IdentifyStudy s = identify(c, o.monte_carlo);
   const nlohmann::json j = identify_json(c, s);
   check_finite(c, j);
@@ -62,6 +63,7 @@ void run_predict(const PredictOptions& o, std::ostream& out) {
 void run_shake(const ShakeOptions& o, std::ostream& out) {
   Case c = read_case(o.case_path);
   if (o.seed) c.seed = *o.seed, c.shake.readout.seed = *o.seed;
+  if (o.work_limit) check_shake_work(c);
   const ShakeStudy s = shake(c, o.series_path);
   const nlohmann::json j = shake_json(c, s);
   check_finite(c, j);
@@ -82,6 +84,7 @@ void run_measure(const MeasureOptions& o, std::ostream& out) {
 
 int run_sweep(const SweepOptions& o, std::ostream& out) {
   const Case c = read_case(o.case_path);
+  if (o.work_limit) check_sweep_work(c);
   const SweepStudy s = sweep(c, o.out_path, o.restart, o.threads, o.progress, out);
   out << sweep_report(s, o.out_path);
   return static_cast<int>(s.failures.size());
@@ -89,6 +92,7 @@ int run_sweep(const SweepOptions& o, std::ostream& out) {
 
 void run_frequency(const FrequencyOptions& o, std::ostream& out) {
   const Case c = read_case(o.case_path);
+  if (o.work_limit) check_frequency_work(c);
   const FrequencyStudy s = frequency(c);
   out << frequency_report(c, s);
   write_frequency_data(c, s, o.out_dir);

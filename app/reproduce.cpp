@@ -23,6 +23,7 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
   validation::ReproduceSettings s = *c.reproduce;
   if (o.threads >= 0) s.threads = o.threads;
   if (std::string why; !s.IsValid(&why)) throw InputError(c.path + ": " + why);
+  if (o.work_limit) check_reproduce_work(c);
   const std::string& dir = o.out_dir;
   const auto start = std::chrono::steady_clock::now();
   out << fmt::format("vrelab {} ({}) reproduce {}  [seed {}] -> {}\n", kProgramVersion, kGitDescribe, c.path, c.seed, dir);

@@ -85,6 +85,17 @@ bad bigk2 's/^k2 = .*/k2 = 5.0/' '\[coefficients\] k2: must lie in \[-1, 1\] in 
 bad fixedk1 's/^fixed = .*/fixed = { k1_asym = 1e300, k_PP = 0.0, k_OO = 0.0 }/' '\[identification.fixed\] k1_asym: must lie in'
 sed 's/^amplitude_g = .*/amplitude_g = [1e6, 0.0, 0.0]/' "$cases/shake-sine.toml" >"$tmp/amp.toml"
 expect 2 '\[vibration\] amplitude_g: amplitudes must be at most 1000 g, got 1e\+06 g' shake "$tmp/amp.toml"
+# Issue 13 item 5: absurd finite values are estimated before the run and refused with the
+# estimate, the key and the flag (they ran with no end and no word).
+sed 's/^frequency_Hz = .*/frequency_Hz = 1e9/' "$cases/shake-sine.toml" >"$tmp/f9.toml"
+expect 2 'f9.toml: this would take ~1.08e\+09 ODE steps .*from \[vibration\] frequency_Hz.*--no-work-limit' shake "$tmp/f9.toml"
+sed 's/^duration_s = .*/duration_s = 1e9/' "$cases/shake-random-gevs.toml" >"$tmp/dur.toml"
+expect 2 'would take ~4e\+13 ODE steps.*set by \[vibration\] duration_s' shake "$tmp/dur.toml"
+sed 's/^sample_rate_Hz = .*/sample_rate_Hz = 1e12/' "$cases/shake-sine-lab.toml" >"$tmp/rate.toml"
+expect 2 'from \[readout\] sample_rate_Hz.*--no-work-limit' shake "$tmp/rate.toml"
+sed 's/^type = "from_coefficients".*/type = "from_coefficients"\n[plant.effects.mechanical_mode]\nfrequency_Hz = 1e8\ndamping_ratio = 0.02/' "$cases/shake-sine.toml" >"$tmp/mode.toml"
+expect 2 "highest frequency 1e\\+08 Hz, from the plant's fastest pole" shake "$tmp/mode.toml"
+expect 2 'samples.*set by --monte-carlo' identify "$cases/ideal-static.toml" --monte-carlo 1000000000
 # Issue 13 item 6: min_measure_s = 1e9 overflowed an int and was dropped (4 periods measured).
 sed 's/^min_measure_s = .*/min_measure_s = 1e9/' "$cases/shake-sine-lab.toml" >"$tmp/measure.toml"
 expect 2 'measure.toml:[0-9]+: \[shake\] min_measure_s: must lie in \[0, 1e6\] s' shake "$tmp/measure.toml"
