@@ -2,6 +2,9 @@
 // print its report, write its JSON (io/results_json.hpp).
 #include "app/commands.hpp"
 
+#include <cmath>
+#include <string>
+
 #include "io/case_file.hpp"
 #include "io/output.hpp"
 #include "io/results_json.hpp"
@@ -12,6 +15,25 @@ using namespace vrelab::io;
 
 namespace {
 
+// The first number of a result that is not finite ("" if none), as a JSON path.
+std::string first_non_finite(const nlohmann::json& j, const std::string& at) {
+  if (j.is_number_float() && !std::isfinite(j.get<double>())) return at.empty() ? "/" : at;
+  if (j.is_object())
+    for (auto it = j.begin(); it != j.end(); ++it)
+      if (std::string p = first_non_finite(it.value(), at + "/" + it.key()); !p.empty()) return p;
+  if (j.is_array())
+    for (std::size_t i = 0; i < j.size(); ++i)
+      if (std::string p = first_non_finite(j[i], at + "/" + std::to_string(i)); !p.empty()) return p;
+  return "";
+}
+
+// A result with inf or NaN is not written (nor printed as if it were one): exit 2, naming it.
+void check_finite(const Case& c, const nlohmann::json& j) {
+  if (const std::string p = first_non_finite(j, ""); !p.empty())
+    throw InputError(c.path + ": the result " + p +
+                     " is not a finite number: a value of the case drives the computation out of range");
+}
+
 void write_json(const std::string& path, const nlohmann::json& j) {
   if (!path.empty()) write_atomic(path, json_text(j));
 }
@@ -21,24 +43,32 @@ void write_json(const std::string& path, const nlohmann::json& j) {
 void run_identify(const IdentifyOptions& o, std::ostream& out) {
   Case c = read_case(o.case_path);
   if (o.seed) c.seed = *o.seed;
+  if (o.work_limit) check_identify_work(c, o.monte_carlo);
   const IdentifyStudy s = identify(c, o.monte_carlo);
+  const nlohmann::json j = identify_json(c, s);
+  check_finite(c, j);
   out << identify_report(c, s);
-  write_json(o.json_path, identify_json(c, s));
+  write_json(o.json_path, j);
 }
 
 void run_predict(const PredictOptions& o, std::ostream& out) {
   const Case c = read_case(o.case_path);
   const PredictStudy s = predict(c, o.frequency_dependent);
+  const nlohmann::json j = predict_json(c, s);
+  check_finite(c, j);
   out << predict_report(c, s);
-  write_json(o.json_path, predict_json(c, s));
+  write_json(o.json_path, j);
 }
 
 void run_shake(const ShakeOptions& o, std::ostream& out) {
   Case c = read_case(o.case_path);
   if (o.seed) c.seed = *o.seed, c.shake.readout.seed = *o.seed;
+  if (o.work_limit) check_shake_work(c);
   const ShakeStudy s = shake(c, o.series_path);
+  const nlohmann::json j = shake_json(c, s);
+  check_finite(c, j);
   out << shake_report(c, s);
-  write_json(o.json_path, shake_json(c, s));
+  write_json(o.json_path, j);
 }
 
 void run_measure(const MeasureOptions& o, std::ostream& out) {
@@ -54,6 +84,7 @@ void run_measure(const MeasureOptions& o, std::ostream& out) {
 
 int run_sweep(const SweepOptions& o, std::ostream& out) {
   const Case c = read_case(o.case_path);
+  if (o.work_limit) check_sweep_work(c);
   const SweepStudy s = sweep(c, o.out_path, o.restart, o.threads, o.progress, out);
   out << sweep_report(s, o.out_path);
   return static_cast<int>(s.failures.size());
@@ -61,6 +92,7 @@ int run_sweep(const SweepOptions& o, std::ostream& out) {
 
 void run_frequency(const FrequencyOptions& o, std::ostream& out) {
   const Case c = read_case(o.case_path);
+  if (o.work_limit) check_frequency_work(c);
   const FrequencyStudy s = frequency(c);
   out << frequency_report(c, s);
   write_frequency_data(c, s, o.out_dir);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "io/case_file.hpp"
 #include "io/diagnosis.hpp"
 #include "validation/diagnosis/blind.hpp"
 
@@ -18,6 +19,7 @@ struct IdentifyOptions {
   std::string json_path;
   int monte_carlo = 0;
   std::optional<std::uint64_t> seed;
+  bool work_limit = true;  // false: --no-work-limit
 };
 void run_identify(const IdentifyOptions& o, std::ostream& out);
 
@@ -33,6 +35,7 @@ struct ShakeOptions {
   std::string json_path;
   std::string series_path;  // CSV of the sampled record
   std::optional<std::uint64_t> seed;
+  bool work_limit = true;
 };
 void run_shake(const ShakeOptions& o, std::ostream& out);
 
@@ -53,6 +56,7 @@ struct SweepOptions {
   bool restart = false;  // discard an existing file
   int threads = -1;      // -1: the case's [sweep] threads (0: all cores)
   bool progress = true;
+  bool work_limit = true;
 };
 // Returns the number of conditions that failed (their rows are not written).
 int run_sweep(const SweepOptions& o, std::ostream& out);
@@ -60,6 +64,7 @@ int run_sweep(const SweepOptions& o, std::ostream& out);
 struct FrequencyOptions {
   std::string case_path;
   std::string out_dir;
+  bool work_limit = true;
 };
 void run_frequency(const FrequencyOptions& o, std::ostream& out);
 
@@ -68,6 +73,7 @@ struct ReproduceOptions {
   std::string out_dir = "out/paper";
   int threads = -1;   // -1: the case's [reproduce] threads (0: all cores)
   bool plots = true;  // false: data and report without figures
+  bool work_limit = true;
 };
 // The paper's experiment end to end: report.html, report.md, figures, CSV/JSON (app/reproduce.cpp).
 void run_reproduce(const ReproduceOptions& o, std::ostream& out);
@@ -92,5 +98,14 @@ struct BlindOptions {
   bool progress = true;  // on stderr
 };
 void run_blind(const BlindOptions& o, std::ostream& out);
+
+// app/work_limit.cpp: a run's work estimated before it starts; InputError beyond the limits
+// of rectification/simulation/work_estimate.hpp, naming the estimate, the key and
+// --no-work-limit.
+void check_shake_work(const io::Case& c);
+void check_sweep_work(const io::Case& c);
+void check_reproduce_work(const io::Case& c);
+void check_frequency_work(const io::Case& c);
+void check_identify_work(const io::Case& c, int monte_carlo);
 
 }  // namespace vrelab::app

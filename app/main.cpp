@@ -37,6 +37,9 @@ Command add_identify(CLI::App& app) {
   cmd->add_option("--monte-carlo", o.monte_carlo, "Also run N simulated tests for Monte Carlo uncertainty")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--seed", o.seed, "Override the case's [run] seed");
+  cmd->add_flag_callback(
+      "--no-work-limit", [&o] { o.work_limit = false; },
+      "Run even if the estimated work exceeds the limits (docs/case-files.md, Limits)");
   return {cmd, [owned] {
             run_identify(*owned, std::cout);
             return 0;
@@ -66,6 +69,9 @@ Command add_shake(CLI::App& app) {
   cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
   cmd->add_option("--series", o.series_path, "Write the sampled record as CSV to this file");
   cmd->add_option("--seed", o.seed, "Override the case's [run] seed");
+  cmd->add_flag_callback(
+      "--no-work-limit", [&o] { o.work_limit = false; },
+      "Run even if the estimated work exceeds the limits (docs/case-files.md, Limits)");
   return {cmd, [owned] {
             run_shake(*owned, std::cout);
             return 0;
@@ -104,6 +110,9 @@ Command add_sweep(CLI::App& app) {
   cmd->add_option("--threads", o.threads, "Threads (default: the case's, 0 = all cores)");
   cmd->add_flag_callback(
       "--no-progress", [&o] { o.progress = false; }, "No progress bar");
+  cmd->add_flag_callback(
+      "--no-work-limit", [&o] { o.work_limit = false; },
+      "Run even if the estimated work exceeds the limits (docs/case-files.md, Limits)");
   return {cmd, [owned] { return run_sweep(*owned, std::cout) > 0 ? 2 : 0; }};
 }
 
@@ -118,6 +127,9 @@ Command add_frequency(CLI::App& app) {
                   "[frequency_study]")
       ->required();
   cmd->add_option("--out", o.out_dir, "Output folder (CSV, JSON, Markdown table, PNG/SVG figure)")->required();
+  cmd->add_flag_callback(
+      "--no-work-limit", [&o] { o.work_limit = false; },
+      "Run even if the estimated work exceeds the limits (docs/case-files.md, Limits)");
   return {cmd, [owned] {
             run_frequency(*owned, std::cout);
             return 0;
@@ -136,6 +148,9 @@ Command add_reproduce(CLI::App& app) {
   cmd->add_option("--threads", o.threads, "Threads (default: the case's, 0 = all cores)");
   cmd->add_flag_callback(
       "--no-plots", [&o] { o.plots = false; }, "Write the data and the report without figures");
+  cmd->add_flag_callback(
+      "--no-work-limit", [&o] { o.work_limit = false; },
+      "Run even if the estimated work exceeds the limits (docs/case-files.md, Limits)");
   return {cmd, [owned] {
             run_reproduce(*owned, std::cout);
             return 0;

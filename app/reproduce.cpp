@@ -15,6 +15,7 @@ using namespace vrelab::io;
 
 void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
   const Case c = read_case(o.case_path);
+  if (o.work_limit) check_reproduce_work(c);
   // The header line before the first progress line: after the checks, so bad input prints nothing.
   bool header = false;
   const auto print_header = [&] {

@@ -4,6 +4,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -77,14 +78,33 @@ class Table {
   }
 
   std::string qualified(std::string_view key) const {
-    return name_.empty() ? std::string(key) : "[" + name_ + "] " + std::string(key);
+    if (name_.empty()) return std::string(key);
+    return key.empty() ? "[" + name_ + "]" : "[" + name_ + "] " + std::string(key);
   }
 
   const toml::node* get(std::string_view key, bool required) {
     used_.insert(std::string(key));
     const toml::node* n = t_.get(key);
-    if (!n && required) fail(nullptr, key, "missing (required)");
+    if (!n && required) {
+      // A required key missing is most often a typo of it (k_2 for k2, frequency_hz for
+      // frequency_Hz): name the key the file has, on its line, with the match.
+      for (auto&& [k, v] : t_) {
+        const std::string have(k.str());
+        if (used_.count(have)) continue;
+        if (normalised(have) == normalised(key) || (key.size() > 3 && edit_distance(have, key) == 1))
+          fail(&v, have, "unknown key (did you mean '" + std::string(key) + "'?); " + std::string(key) +
+                             " is required");
+      }
+      fail(nullptr, key, "missing (required)");
+    }
     return n;
+  }
+  // Lower case without '_' and '-': keys that differ only so are the same key mistyped.
+  static std::string normalised(std::string_view k) {
+    std::string out;
+    for (char ch : k)
+      if (ch != '_' && ch != '-') out += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    return out;
   }
 
   double number_of(const toml::node* n, std::string_view key) const {
@@ -176,16 +196,38 @@ class Table {
   std::set<std::string> used_;
 };
 
+// Physical ranges of model (1)'s coefficients. K1 in (0, 1e6] output units per g (mA/g, V/g:
+// navigation instruments are ~1); every other coefficient within 1 in its unit (1 g of bias,
+// 1/g, 1/g^2, 1 rad: orders beyond any accelerometer, whose values are <= 1e-2). Beyond these
+// the results overflow (K1 = 1e308 gave inf with exit 0) or mean nothing.
+constexpr double kMaxK1 = 1e6, kMaxCoefficient = 1.0;
+void check_coefficient(const Table& t, int i, double x) {
+  const std::string_view name = plant::coefficient_name(i);
+  if (i == plant::K1 && !(x > 0 && x <= kMaxK1))
+    t.fail(t.raw().get(name), name, fmt::format("must lie in (0, {:g}] output units per g, got {:g}", kMaxK1, x));
+  if (i != plant::K1 && !(std::abs(x) <= kMaxCoefficient))
+    t.fail(t.raw().get(name), name,
+           fmt::format("must lie in [-{0:g}, {0:g}] in its unit (beyond any accelerometer), got {1:g}", kMaxCoefficient, x));
+}
+
 void read_coefficients(Table t, Case& c) {
   plant::Coefficients k;
   std::vector<std::string_view> names;
   for (int i = 0; i < plant::kNumCoefficients; ++i) {
     names.push_back(plant::coefficient_name(i));
     k[i] = t.number(plant::coefficient_name(i));
+    check_coefficient(t, i, k[i]);
   }
-  if (k[plant::K1] <= 0) t.fail(t.raw().get("K1"), "K1", "must be positive (output units per g)");
   t.check_unknown(names);
   c.coefficients = k;
+}
+
+// Vibration amplitudes: at most 1000 g (shakers reach ~100 g); beyond, eq. (3)'s k3 a^3 and the
+// plant's states leave any meaning (and overflow near 1e100 g).
+constexpr double kMaxAmplitude_g = 1e3;
+void check_amplitude(const Table& t, std::string_view key, double a) {
+  if (!(a <= kMaxAmplitude_g))
+    t.fail(t.raw().get(key), key, fmt::format("amplitudes must be at most {:g} g, got {:g} g", kMaxAmplitude_g, a));
 }
 
 vibration::SineVibration read_sine_part(Table& t, bool frequency_required) {
@@ -194,6 +236,7 @@ vibration::SineVibration read_sine_part(Table& t, bool frequency_required) {
   v.phase_rad = t.opt_vec3("phase_deg").value_or(Vec3::Zero()) * kDeg;
   v.frequency_Hz = frequency_required ? t.number("frequency_Hz") : t.non_negative("frequency_Hz", 0.0);
   if (frequency_required && !(v.frequency_Hz > 0)) t.fail(t.raw().get("frequency_Hz"), "frequency_Hz", "must be positive");
+  for (int i = 0; i < 3; ++i) check_amplitude(t, "amplitude_g", v.amplitude_g[i]);
   for (int i = 0; i < 3; ++i)
     if (v.amplitude_g[i] < 0)
       t.fail(t.raw().get("amplitude_g"), "amplitude_g",
@@ -255,6 +298,7 @@ void read_random_part(Table& t, VibrationSpec& v, bool psd_required) {
   if (psd_required) t.fail(nullptr, "psd_IA", "a shaken random profile needs PSD tables psd_IA / psd_PA / psd_OA");
   vibration::RandomVibration g;
   g.rms_g = t.vec3("rms_g");
+  for (int i = 0; i < 3; ++i) check_amplitude(t, "rms_g", std::abs(g.rms_g[i]));
   if (const toml::node* n = t.get("correlation", false)) {
     const toml::array* rows = n->as_array();
     if (!rows || rows->size() != 3) t.fail(n, "correlation", "expected a 3 x 3 array of numbers");
@@ -419,8 +463,8 @@ void read_dividing_head(Table t, Case& c) {
       for (auto&& [k, v] : *e)
         if (k.str() != "series" && k.str() != "angle_deg")
           t.fail(&v, "positions", "unknown key '" + std::string(k.str()) + "' in a position");
-      h.positions.push_back(validation::series_position(static_cast<int>(s->as_integer()->get()),
-                                                        ang->value<double>().value() * kDeg));
+      h.positions.push_back(validation::series_position_deg(static_cast<int>(s->as_integer()->get()),
+                                                            ang->value<double>().value()));
     }
     h.description = std::to_string(h.positions.size()) + " listed positions";
   } else {
@@ -460,9 +504,8 @@ void read_identification(Table t, Case& c) {
         f->check_unknown(names);
       }
       c.fixed[*idx] = f->number(k.str());
+      check_coefficient(*f, *idx, *c.fixed[*idx]);
     }
-    if (c.fixed[plant::K1] && *c.fixed[plant::K1] <= 0)
-      f->fail(f->raw().get("K1"), "K1", "must be positive (output units per g)");
   }
   t.check_unknown({"fixed"});
 }
@@ -529,6 +572,27 @@ void read_effects(Table& t, Case& c) {
   }
 }
 
+// The loop the [plant] keys set must be stable: checked here (the linearised loop's poles at
+// rest), so the message names the file, the table and the keys that set the loop, not only
+// "not stable" from deep inside a run.
+void check_loop_stable(Table& t, const Case& c, const std::vector<std::string_view>& loop_keys) {
+  try {
+    const plant::Accelerometer rest(c.plant, c.orientation_g.value_or(Vec3::UnitX()));
+    (void)rest.slowest_time_constant_s(rest.linearise());
+  } catch (const std::invalid_argument& e) {
+    std::string given;
+    for (auto k : loop_keys)
+      if (const toml::node* n = t.raw().get(k))
+        given += fmt::format("{}{} = {}", given.empty() ? "" : ", ", k,
+                             n->is_number() ? fmt::format("{:g}", n->value<double>().value()) : std::string("..."));
+    std::string all;
+    for (auto k : loop_keys) all += (all.empty() ? "" : ", ") + std::string(k);
+    t.fail(nullptr, "", std::string(e.what()) + "; the loop is set by " + all +
+                            (given.empty() ? " (all at their defaults" : " (given here: " + given) +
+                            ") and any [plant.effects] table");
+  }
+}
+
 // type = "physical": SI parameters (plant/physical.hpp); the model (1) coefficients follow.
 void read_physical_plant(Table& t, Case& c) {
   if (c.coefficients)
@@ -560,9 +624,15 @@ void read_physical_plant(Table& t, Case& c) {
     allowed.push_back(k.name);
   }
   std::string why;
-  if (!p.IsValid(&why)) t.fail(nullptr, why.substr(0, why.find(' ')), why);
+  if (!p.IsValid(&why)) {
+    const std::string key = why.substr(0, why.find(' '));
+    t.fail(t.raw().get(key), key, why.substr(why.find(' ') + 1));
+  }
   c.plant = plant::plant_from_physical(p, c.g_m_per_s2);
   read_effects(t, c);
+  check_loop_stable(t, c, {"inertia_kg_m2", "damping_N_m_s_per_rad", "hinge_stiffness_N_m_per_rad", "pendulosity_kg_m",
+                           "pickoff_V_per_rad", "servo_gain_A_per_V", "lead_zero_Hz", "lead_pole_Hz", "integrator_Hz",
+                           "torquer_N_m_per_A", "antialias_Hz"});
   t.check_unknown(allowed);
   c.coefficients = plant::implied_coefficients(p, c.g_m_per_s2);
   c.physical = p;
@@ -585,7 +655,10 @@ void read_plant(Table t, Case& c) {
   d.integrator_zero_ratio = t.opt_number("integrator_zero_ratio").value_or(d.integrator_zero_ratio);
   d.antialias_Hz = t.non_negative("antialias_Hz", d.antialias_Hz);
   std::string why;
-  if (!d.IsValid(&why)) t.fail(nullptr, "dynamics", why);
+  if (!d.IsValid(&why)) {
+    const std::string key = why.substr(0, why.find(' '));  // IsValid's message starts with the key
+    t.fail(t.raw().get(key), key, why.substr(why.find(' ') + 1));
+  }
   try {
     plant::design_servo(d);
   } catch (const std::invalid_argument& e) {
@@ -613,6 +686,9 @@ void read_plant(Table t, Case& c) {
   }
   read_effects(t, c);
   c.plant.coefficients = *c.coefficients;
+  check_loop_stable(t, c, {"pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g",
+                           "loop_bandwidth_Hz", "phase_margin_deg", "integrator_zero_ratio", "antialias_Hz",
+                           "location"});
   t.check_unknown({"type", "pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g",
                    "loop_bandwidth_Hz", "phase_margin_deg", "integrator", "integrator_zero_ratio", "antialias_Hz",
                    "location", "effects"});
@@ -634,8 +710,22 @@ void read_shake(Table t, Case& c) {
   s.blocks = static_cast<int>(t.integer("blocks", false, s.blocks, 2, 1000));
   s.min_measure_s = t.non_negative("min_measure_s", s.min_measure_s);
   std::string why;
-  if (!s.IsValid(&why)) t.fail(t.raw().get(why.substr(0, why.find(' '))), why.substr(0, why.find(' ')), why);
+  if (!s.IsValid(&why)) {
+    const std::string key = why.substr(0, why.find(' '));  // IsValid's message starts with the key
+    t.fail(t.raw().get(key), key, why.substr(why.find(' ') + 1));
+  }
   t.check_unknown({"relative_tolerance", "settle_decay", "blocks", "min_measure_s"});
+}
+
+// A static orientation is gravity in sensor axes, in units of the local g: |a| = 1 g. Within
+// 1e-3: a vector typed with four digits (0.7071) is off by ~1e-4, while a norm of 0 g (no
+// gravity) or 10 g (a centrifuge, or m/s^2 typed for g) is not a static test on the earth.
+constexpr double kGravityNormTolerance = 1e-3;
+void check_gravity(const Table& t, const toml::node* n, std::string_view key, const Vec3& a) {
+  if (!(std::abs(a.norm() - 1) <= kGravityNormTolerance))
+    t.fail(n, key,
+           fmt::format("a static orientation is gravity in sensor axes [IA, PA, OA], |a| = 1 g (within {:g}); got |a| = {:.6g} g",
+                       kGravityNormTolerance, a.norm()));
 }
 
 std::vector<Vec3> vec3_list(Table& t, std::string_view key, bool unit) {
@@ -649,6 +739,8 @@ std::vector<Vec3> vec3_list(Table& t, std::string_view key, bool unit) {
     if (unit) {
       if (!(v.norm() > 0)) t.fail(&x, key, "a direction must not be zero");
       v.normalize();
+    } else {
+      check_gravity(t, &x, key, v);  // every unnormalised list is of orientations_g
     }
     out.push_back(v);
   }
@@ -683,6 +775,7 @@ void read_sweep(Table t, Case& c) {
   if (g.amplitudes_g.empty()) t.fail(nullptr, "amplitudes_g", "missing (required)");
   for (double a : g.amplitudes_g)
     if (!(a >= 0)) t.fail(t.raw().get("amplitudes_g"), "amplitudes_g", "amplitudes must not be negative");
+  for (double a : g.amplitudes_g) check_amplitude(t, "amplitudes_g", a);
   g.directions = vec3_list(t, "directions", true);
   if (g.directions.empty()) t.fail(nullptr, "directions", "missing (required)");
   g.orientations_g = vec3_list(t, "orientations_g", false);
@@ -711,6 +804,7 @@ void read_frequency_study(Table t, Case& c) {
   if (ode_points > 0) f.ode_frequencies_Hz = rectification::spaced(from, to, static_cast<int>(ode_points), true);
   f.amplitude_g = t.opt_number("amplitude_g").value_or(f.amplitude_g);
   if (!(f.amplitude_g > 0)) t.fail(t.raw().get("amplitude_g"), "amplitude_g", "must be positive");
+  check_amplitude(t, "amplitude_g", f.amplitude_g);
   if (auto d = t.opt_vec3("direction")) {
     if (!(d->norm() > 0)) t.fail(t.raw().get("direction"), "direction", "must not be zero");
     f.direction = d->normalized();
@@ -748,6 +842,7 @@ void read_reproduce(Table t, Case& c) {
   if (r.amplitudes_g.empty()) t.fail(nullptr, "amplitudes_g", "missing (required)");
   for (double a : r.amplitudes_g)
     if (!(a > 0)) t.fail(t.raw().get("amplitudes_g"), "amplitudes_g", "amplitudes must be positive");
+  for (double a : r.amplitudes_g) check_amplitude(t, "amplitudes_g", a);
   r.directions = named_vectors(t, "directions", "direction_names", true);
   r.orientations = named_vectors(t, "orientations_g", "orientation_names", false);
   for (const auto& o : r.orientations)
@@ -766,6 +861,7 @@ void read_reproduce(Table t, Case& c) {
   r.confirmation_orientation = r.orientations[index("orientation", r.orientations.size())];
   r.confirmation_direction = r.directions[index("direction", r.directions.size())];
   r.confirmation_amplitude_g = conf->number("amplitude_g");
+  check_amplitude(*conf, "amplitude_g", r.confirmation_amplitude_g);
   if (!(r.confirmation_amplitude_g > 0)) conf->fail(conf->raw().get("amplitude_g"), "amplitude_g", "must be positive");
   r.confirmation_record_s = conf->number("record_s");
   if (!(r.confirmation_record_s > 0)) conf->fail(conf->raw().get("record_s"), "record_s", "must be positive");
@@ -826,6 +922,7 @@ void read_campaign(Table t, Case& c) {
     if (!(f > 0)) t.fail(t.raw().get("frequencies_Hz"), "frequencies_Hz", "frequencies must be positive");
   for (double a : d.amplitudes_g)
     if (!(a > 0)) t.fail(t.raw().get("amplitudes_g"), "amplitudes_g", "amplitudes must be positive");
+  for (double a : d.amplitudes_g) check_amplitude(t, "amplitudes_g", a);
   d.run_sigma_g = t.non_negative("run_sigma_ug", d.run_sigma_g * 1e6) * 1e-6;
   if (!(d.run_sigma_g > 0)) t.fail(t.raw().get("run_sigma_ug"), "run_sigma_ug", "must be positive");
   d.positions_per_series = static_cast<int>(t.integer("positions_per_series", false, d.positions_per_series, 8, 360));
@@ -849,7 +946,10 @@ void read_campaign(Table t, Case& c) {
 }  // namespace
 
 Case read_case(const std::string& path) {
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": cannot open the case file (no such file)");
+  if (std::filesystem::is_directory(path))
+    throw InputError(path + ": cannot open the case file: is a directory (give the .toml file)");
+  if (!std::filesystem::exists(path)) throw InputError(path + ": cannot open the case file (no such file)");
+  if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": cannot open the case file: not a regular file");
   toml::table root;
   try {
     root = toml::parse_file(path);
@@ -878,6 +978,7 @@ Case read_case(const std::string& path) {
   if (auto t = top.subtable("coefficients", false)) read_coefficients(*t, c);
   if (auto t = top.subtable("orientation", false)) {
     c.orientation_g = t->vec3("a_g");
+    check_gravity(*t, t->raw().get("a_g"), "a_g", *c.orientation_g);
     t->check_unknown({"a_g"});
   }
   if (auto t = top.subtable("vibration", false)) read_vibration(*t, c);

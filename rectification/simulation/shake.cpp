@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <limits>
 #include <numbers>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 
 #include <Eigen/Dense>
@@ -120,6 +122,10 @@ class SampledRecorder {
 
 }  // namespace
 
+namespace {
+constexpr double kMaxMeasure_s = 1e6;
+}  // namespace
+
 bool ShakeSettings::IsValid(std::string* error) const {
   auto fail = [&](const std::string& m) {
     if (error) *error = m;
@@ -128,7 +134,9 @@ bool ShakeSettings::IsValid(std::string* error) const {
   if (!(relative_tolerance > 0 && relative_tolerance < 1e-3)) return fail("relative_tolerance must lie in (0, 1e-3)");
   if (!(settle_decay > 0 && settle_decay < 1)) return fail("settle_decay must lie in (0, 1)");
   if (blocks < 2) return fail("blocks must be at least 2");
-  if (!(min_measure_s >= 0)) return fail("min_measure_s must not be negative");
+  // 1e6 s (11.6 days of simulated vibration) is far beyond any run (the shipped cases ask 2 s).
+  if (!(min_measure_s >= 0 && min_measure_s <= kMaxMeasure_s))
+    return fail("min_measure_s must lie in [0, 1e6] s");
   return true;
 }
 
@@ -179,9 +187,21 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
   solver.max_step_s = period / 8;
 
   // Settling: whole periods covering ln(1/decay) slowest time constants.
-  const int settle_periods = static_cast<int>(std::ceil(std::log(1 / s.settle_decay) * r.slowest_time_constant_s / period));
+  // Counted in double and refused beyond int (a silent overflow dropped min_measure_s = 1e9).
+  const double settle_count = std::ceil(std::log(1 / s.settle_decay) * r.slowest_time_constant_s / period);
+  const double block_count = std::max(1.0, std::ceil(s.min_measure_s / (s.blocks * period)));
+  constexpr double kMaxPeriods = std::numeric_limits<int>::max() / 2;
+  const auto too_many = [&](const char* key, double setting, double count) {
+    std::ostringstream m;
+    m << key << " = " << setting << ": " << count << " periods of " << v.frequency_Hz << " Hz (slowest time constant "
+      << r.slowest_time_constant_s << " s), more than " << kMaxPeriods;
+    return std::invalid_argument(m.str());
+  };
+  if (!(settle_count <= kMaxPeriods)) throw too_many("settle_decay", s.settle_decay, settle_count);
+  if (!(block_count * s.blocks <= kMaxPeriods)) throw too_many("min_measure_s", s.min_measure_s, block_count * s.blocks);
+  const int settle_periods = static_cast<int>(settle_count);
   r.settle_s = settle_periods * period;
-  const int per_block = std::max(1, static_cast<int>(std::ceil(s.min_measure_s / (s.blocks * period))));
+  const int per_block = static_cast<int>(block_count);
   r.periods = per_block * s.blocks;
 
   plant::OdeSolver ode(shaken, 0.0, x0, solver);

@@ -35,11 +35,23 @@ bad() {  # bad <name> <sed expression> <stderr regex> [case]
 }
 bad typo 's/^angle_sigma_arcsec/angle_sigma_arcsex/' "angle_sigma_arcsex: unknown key \(did you mean 'angle_sigma_arcsec'\?\)"
 bad nocoef '/^k4 = /d' '\[coefficients\] k4: missing'
+# Issue 13 item 10: a typo of a required key is an unknown key with its match, on its line.
+bad typo_required 's/^k2 = /k_2 = /' "typo_required.toml:[0-9]+: \[coefficients\] k_2: unknown key \(did you mean 'k2'\?\); k2 is required"
+# ... and a static orientation is gravity, |a| = 1 g, everywhere (0 g and 10 g refused).
+sed 's/^a_g = .*/a_g = [0.0, 0.0, 0.0]/' "$cases/paper-predict.toml" >"$tmp/g0.toml"
+expect 2 'g0.toml:[0-9]+: \[orientation\] a_g: a static orientation is gravity .*\|a\| = 1 g .*got \|a\| = 0 g' predict "$tmp/g0.toml"
+sed 's/^a_g = .*/a_g = [10.0, 0.0, 0.0]/' "$cases/paper-predict.toml" >"$tmp/g10.toml"
+expect 2 '\[orientation\] a_g: .*got \|a\| = 10 g' predict "$tmp/g10.toml"
+sed 's/^orientations_g = .*/orientations_g = [[0.0, 0.0, 10.0]]/' "$cases/campaign.toml" >"$tmp/g10c.toml"
+expect 2 '\[campaign\] orientations_g: .*got \|a\| = 10 g' campaign "$tmp/g10c.toml" --out "$tmp/o/g10c"
 bad negative 's/^noise_sigma_ug = .*/noise_sigma_ug = -1.0/' 'noise_sigma_ug: must not be negative'
 bad empty 's/^positions_per_series = .*/positions = []/' 'the position set is empty'
 bad rank 's/^fixed = .*/fixed = { }/' 'rank 11 of 13'
 bad bigint 's/^repeats = .*/repeats = 4294967297/' 'repeats: must be at most'
 bad notarray 's/^positions_per_series = .*/positions = "abc"/' 'positions: expected an array of tables'
+# Issue 13 item 1: a 4-position tumble entered as series/angle_deg at multiples of 90 deg sees no
+# cross term: rank 6 of 9, refused, not k_IP from rounding.
+bad tumble 's/^positions_per_series = .*/positions = [{series=1,angle_deg=0},{series=1,angle_deg=90},{series=1,angle_deg=180},{series=1,angle_deg=270},{series=2,angle_deg=0},{series=2,angle_deg=90},{series=2,angle_deg=180},{series=2,angle_deg=270},{series=3,angle_deg=0},{series=3,angle_deg=90},{series=3,angle_deg=180},{series=3,angle_deg=270}]/; s/^fixed = .*/fixed = { k1_asym = 2.0e-5, k3 = 1.0e-6, k4 = 2.0e-7, k_PP = 0.0 }/' 'rank 6 of 9'
 mkdir -p "$tmp/o/isdir.json"
 expect 2 'cannot write' identify "$cases/ideal-static.toml" --json "$tmp/o/isdir.json"
 ls "$tmp/o" | grep -q 'tmp' && { echo "FAIL: a temporary file was left behind"; fail=$((fail + 1)); }
@@ -56,6 +68,37 @@ expect 2 'relative_tolerance|solver failure in .* at simulated time' shake "$tmp
 sed 's/^\[plant\]/[plant]\nphase_margin_deg = 85.0/' "$cases/shake-sine.toml" >"$tmp/design.toml"
 expect 2 'phase_margin_deg' shake "$tmp/design.toml"
 expect 0 'measured vibration error' shake "$cases/shake-sine.toml" --json "$tmp/o/shake.json"
+# Issue 13 item 8: an unstable loop names the file, the table and the keys that set the loop;
+# integrator_zero_ratio out of its range is a validation error on that key; a directory given
+# as the case file says so.
+sed 's/^integrator_Hz = .*/integrator_Hz = 5000.0/' "$cases/shake-physical.toml" >"$tmp/unstable.toml"
+expect 2 'unstable.toml:[0-9]+: \[plant\]: the closed loop is not stable .*the loop is set by .*integrator_Hz = 5000' shake "$tmp/unstable.toml"
+sed 's/^\[plant\]/[plant]\nintegrator_zero_ratio = 1e-12/' "$cases/shake-sine.toml" >"$tmp/izr.toml"
+expect 2 'izr.toml:[0-9]+: \[plant\] integrator_zero_ratio: must lie in \[1e-4, 0.5\]' shake "$tmp/izr.toml"
+expect 2 'cannot open the case file: is a directory' shake "$cases"
+# Issue 13 item 4: values that made results inf/NaN with exit 0 are range errors on their key;
+# campaign writes nothing.
+sed 's/^K1 = .*/K1 = 1e308/' "$cases/campaign.toml" >"$tmp/k1.toml"
+expect 2 'k1.toml:[0-9]+: \[coefficients\] K1: must lie in \(0, 1e\+06\] output units per g, got 1e\+308' campaign "$tmp/k1.toml" --out "$tmp/o/k1"
+[ -e "$tmp/o/k1/static.csv" ] && { echo "FAIL: campaign wrote static.csv for K1 = 1e308"; fail=$((fail + 1)); }
+bad bigk2 's/^k2 = .*/k2 = 5.0/' '\[coefficients\] k2: must lie in \[-1, 1\] in its unit'
+bad fixedk1 's/^fixed = .*/fixed = { k1_asym = 1e300, k_PP = 0.0, k_OO = 0.0 }/' '\[identification.fixed\] k1_asym: must lie in'
+sed 's/^amplitude_g = .*/amplitude_g = [1e6, 0.0, 0.0]/' "$cases/shake-sine.toml" >"$tmp/amp.toml"
+expect 2 '\[vibration\] amplitude_g: amplitudes must be at most 1000 g, got 1e\+06 g' shake "$tmp/amp.toml"
+# Issue 13 item 5: absurd finite values are estimated before the run and refused with the
+# estimate, the key and the flag (they ran with no end and no word).
+sed 's/^frequency_Hz = .*/frequency_Hz = 1e9/' "$cases/shake-sine.toml" >"$tmp/f9.toml"
+expect 2 'f9.toml: this would take ~1.08e\+09 ODE steps .*from \[vibration\] frequency_Hz.*--no-work-limit' shake "$tmp/f9.toml"
+sed 's/^duration_s = .*/duration_s = 1e9/' "$cases/shake-random-gevs.toml" >"$tmp/dur.toml"
+expect 2 'would take ~4e\+13 ODE steps.*set by \[vibration\] duration_s' shake "$tmp/dur.toml"
+sed 's/^sample_rate_Hz = .*/sample_rate_Hz = 1e12/' "$cases/shake-sine-lab.toml" >"$tmp/rate.toml"
+expect 2 'from \[readout\] sample_rate_Hz.*--no-work-limit' shake "$tmp/rate.toml"
+sed 's/^type = "from_coefficients".*/type = "from_coefficients"\n[plant.effects.mechanical_mode]\nfrequency_Hz = 1e8\ndamping_ratio = 0.02/' "$cases/shake-sine.toml" >"$tmp/mode.toml"
+expect 2 "highest frequency 1e\\+08 Hz, from the plant's fastest pole" shake "$tmp/mode.toml"
+expect 2 'samples.*set by --monte-carlo' identify "$cases/ideal-static.toml" --monte-carlo 1000000000
+# Issue 13 item 6: min_measure_s = 1e9 overflowed an int and was dropped (4 periods measured).
+sed 's/^min_measure_s = .*/min_measure_s = 1e9/' "$cases/shake-sine-lab.toml" >"$tmp/measure.toml"
+expect 2 'measure.toml:[0-9]+: \[shake\] min_measure_s: must lie in \[0, 1e6\] s' shake "$tmp/measure.toml"
 # A PSD table whose frequencies do not increase: the row is named.
 sed 's/^psd_IA = .*/psd_IA = [[20.0, 0.026], [800.0, 0.16], [50.0, 0.16], [2000.0, 0.026]]/' "$cases/shake-random-gevs.toml" >"$tmp/psd.toml"
 expect 2 'psd_IA: .*row 3' shake "$tmp/psd.toml" --json "$tmp/o/psd.json"

@@ -12,6 +12,7 @@
 #include "support/files.hpp"
 #include "io/case_file.hpp"
 #include "app/commands.hpp"
+#include "rectification/simulation/work_estimate.hpp"
 
 using namespace vrelab::app;
 using namespace vrelab::io;
@@ -392,4 +393,37 @@ TEST(CliFrequency, WritesTheStudyAndItsOdePointsAgreeWithThePrediction) {
   EXPECT_TRUE(fs::exists(d.path / "freq" / "frequency.csv"));
   EXPECT_TRUE(fs::exists(d.path / "freq" / "ode_points.csv"));
   EXPECT_TRUE(fs::exists(d.path / "freq" / "summary.md"));
+}
+
+// Issue 13 item 5: the work estimate. A 100 Hz sine for 1 s on a plant whose fastest pole is
+// at 1 kHz: 1 s x 20 steps per period x 1 kHz = 2e4 steps (the plant, not the drive, sets the
+// step); the same at 1e9 Hz (a Hz/kHz slip taken far) is 2e10 steps, refused naming the key
+// and the flag. The figures are the estimate's definition, hence exact.
+TEST(WorkEstimate, StepsFollowTheHighestFrequencyAndTheLimitNamesTheKey) {
+  using namespace vrelab::rectification;
+  PlantTimescales plant;
+  plant.fastest_pole_Hz = 1000;
+  plant.slowest_time_constant_s = 0.01;
+  WorkRequest r;
+  r.simulated_s = 1;
+  r.drive_Hz = 100;
+  r.drive_key = "[vibration] frequency_Hz";
+  WorkEstimate e = estimate_work(r, plant);
+  EXPECT_DOUBLE_EQ(e.steps, 2e4);
+  EXPECT_NO_THROW(check_work(e));
+  r.sample_rate_Hz = 1e5;  // sampled: one step per sample at least; 16 bytes each
+  e = estimate_work(r, plant);
+  EXPECT_DOUBLE_EQ(e.steps, 1e6);
+  EXPECT_DOUBLE_EQ(e.bytes, 1.6e6);
+  r.sample_rate_Hz = 0;
+  r.drive_Hz = 1e9;
+  e = estimate_work(r, plant);
+  EXPECT_DOUBLE_EQ(e.steps, 2e10);
+  try {
+    check_work(e);
+    FAIL() << "2e10 steps accepted";
+  } catch (const std::invalid_argument& x) {
+    EXPECT_NE(std::string(x.what()).find("from [vibration] frequency_Hz"), std::string::npos) << x.what();
+    EXPECT_NE(std::string(x.what()).find("--no-work-limit"), std::string::npos) << x.what();
+  }
 }

@@ -204,3 +204,56 @@ TEST(PaperTable, AveragesRepeatsAndRejectsOtherSets) {
   EXPECT_EQ((*t)[1][2], 8 + 2 + 1.0);
   EXPECT_FALSE(paper_table(equally_spaced_positions(12), r).has_value());
 }
+
+// Issue 13, item 1: a 4-position tumble per series (0, 90, 180, 270 deg) sees no product of
+// two axes, so with k1_asym, k3, k4 and k_PP held the 9 free coefficients have rank 6 (k_IP,
+// k_IO and k_PO affect no reading). cos 90 deg computed in radians is 6e-17, and column
+// scaling made those rounding columns full size: rank 9 was reported and k_IP came out
+// from rounding. Angles in degrees are exact at multiples of 90 deg, and the rank is decided
+// on the unscaled design.
+TEST(Identifiability, AFourPositionTumbleHasRank6NotRoundingColumns) {
+  for (double deg : {0.0, 90.0, 180.0, 270.0, -90.0, 450.0, 720.0}) {
+    const auto [c, s] = cos_sin_deg(deg);
+    EXPECT_EQ(c, std::cos(deg * std::numbers::pi / 180) > 0.5 ? 1.0 : std::cos(deg * std::numbers::pi / 180) < -0.5 ? -1.0 : 0.0) << deg;
+    EXPECT_EQ(std::abs(s), std::abs(c) == 1 ? 0.0 : 1.0) << deg;
+  }
+  EXPECT_EQ(series_orientation_deg(1, 90)[IA], 0.0);
+  EXPECT_EQ(series_orientation_deg(1, 90)[PA], -1.0);
+  EXPECT_NEAR(cos_sin_deg(30).second, 0.5, 1e-16);
+  EXPECT_NEAR(cos_sin_deg(-135).first, -r2 / 2, 1e-16);
+  std::vector<Position> p;
+  for (int s : {1, 2, 3})
+    for (double deg : {0.0, 90.0, 180.0, 270.0}) p.push_back(series_position_deg(s, deg));
+  FixedSet f{};
+  f[k1_asym] = 2e-5, f[k3] = 1e-6, f[k4] = 2e-7, f[k_PP] = 0.0;
+  const Identifiability id = identifiability(p, f);
+  EXPECT_EQ(id.parameters, 9);
+  EXPECT_EQ(id.rank, 6);
+  EXPECT_FALSE(id.identifiable[k_IP]);
+  // The same set with the rounding of radians put back (a user's 6e-17): still rank 6.
+  std::vector<Position> rounded;
+  for (int s : {1, 2, 3})
+    for (double deg : {0.0, 90.0, 180.0, 270.0}) rounded.push_back(vector_position(series_orientation(s, deg * std::numbers::pi / 180)));
+  EXPECT_EQ(identifiability(rounded, f).rank, 6);
+  // equally_spaced_positions(4) is the same tumble.
+  EXPECT_EQ(identifiability(equally_spaced_positions(4), f).rank, 6);
+}
+
+// An accepted identification must reproduce its readings and give physical coefficients.
+TEST(FitCheck, RefusesAbsurdCoefficientsAndResidualsBeyondSigma) {
+  std::mt19937_64 rng(7);
+  const Coefficients c = test::random_coefficients(rng);
+  const auto p = equally_spaced_positions(8);
+  const auto r = exact_readings(c, p);
+  Estimate e;
+  e.value = c;
+  const std::vector<double> var(r.size(), std::pow(c[K1] * 1e-6, 2));
+  EXPECT_EQ(check_fit(p, r, e, var, 11).problem, "");
+  Estimate absurd = e;
+  absurd.value[k_IP] = 1e10;
+  EXPECT_NE(check_fit(p, r, absurd, var, 11).problem.find("k_IP = 1e+10 lies beyond"), std::string::npos);
+  Estimate off = e;
+  off.value[k0] += 1e-3;  // 1 mg off against 1 ug noise: 1000 sigma
+  const FitCheck f = check_fit(p, r, off, var, 11);
+  EXPECT_NE(f.problem.find("does not reproduce its readings"), std::string::npos) << f.problem;
+}

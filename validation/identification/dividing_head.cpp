@@ -20,10 +20,8 @@ Vec3 series_orientation_derivative(int series, double phi) {
   return series_orientation(series, phi + std::numbers::pi / 2);  // d/dphi (-cos, -sin) = (sin, -cos)
 }
 
-}  // namespace
-
-Vec3 series_orientation(int series, double phi) {
-  const double u = -std::cos(phi), v = -std::sin(phi);
+// (u, v) placed on the two axes of series s that lie in the vertical plane.
+Vec3 place(int series, double u, double v) {
   switch (series) {
     case 1: return Vec3(u, v, 0.0);
     case 2: return Vec3(u, 0.0, v);
@@ -32,8 +30,36 @@ Vec3 series_orientation(int series, double phi) {
   }
 }
 
+}  // namespace
+
+std::pair<double, double> cos_sin_deg(double angle_deg) {
+  // remquo: angle = 90 q + r with |r| <= 45 exactly (no rounding: fmod-like reductions are
+  // exact), and the low bits of q give the quadrant. At r = 0, cos and sin are exactly 1, 0.
+  int q = 0;
+  const double r = std::remquo(angle_deg, 90.0, &q);
+  const double rad = r * (std::numbers::pi / 180.0);
+  const double c = r == 0 ? 1.0 : std::cos(rad), s = r == 0 ? 0.0 : std::sin(rad);
+  switch (q & 3) {
+    case 0: return {c, s};
+    case 1: return {-s, c};
+    case 2: return {-c, -s};
+    default: return {s, -c};
+  }
+}
+
+Vec3 series_orientation(int series, double phi) { return place(series, -std::cos(phi), -std::sin(phi)); }
+
+Vec3 series_orientation_deg(int series, double angle_deg) {
+  const auto [c, s] = cos_sin_deg(angle_deg);
+  return place(series, -c, -s);
+}
+
 Position series_position(int series, double angle_rad) {
   return Position{series, angle_rad, series_orientation(series, angle_rad)};
+}
+
+Position series_position_deg(int series, double angle_deg) {
+  return Position{series, angle_deg * (std::numbers::pi / 180.0), series_orientation_deg(series, angle_deg)};
 }
 
 Position vector_position(const Vec3& a_g) { return Position{0, 0.0, a_g}; }
@@ -57,8 +83,10 @@ bool is_paper_set(const std::vector<Position>& p) {
 }
 
 Vec3 realised_orientation(const Position& p, const Vec3& initial_error_rad, const Vec3& d_angle) {
-  const Vec3 head = p.series == 0 ? Vec3(rotation(d_angle).transpose() * p.nominal_g)
-                                  : series_orientation(p.series, p.angle_rad + d_angle[0]);
+  // Without a set-angle error the nominal orientation (exact at multiples of 90 deg).
+  const Vec3 head = p.series == 0     ? Vec3(rotation(d_angle).transpose() * p.nominal_g)
+                    : d_angle[0] == 0 ? p.nominal_g
+                                      : series_orientation(p.series, p.angle_rad + d_angle[0]);
   return rotation(initial_error_rad).transpose() * head;
 }
 

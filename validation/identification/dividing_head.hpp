@@ -25,6 +25,7 @@
 #include <cstdint>
 #include <functional>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "plant/model1.hpp"
@@ -39,9 +40,17 @@ struct Position {
 
 // Gravity in sensor axes for series s at angle phi, g (convention above).
 Vec3 series_orientation(int series, double angle_rad);
-// N equally spaced positions per series, phi = (j - 1) 360/N deg, for the given series.
+// The same from an angle in degrees, exact at multiples of 90 deg (cos 90 deg = 0, not
+// 6e-17): a rounding column would otherwise look like a real one to the identification.
+Vec3 series_orientation_deg(int series, double angle_deg);
+// cos and sin of an angle in degrees, reduced exactly to [-45, 45] deg first.
+std::pair<double, double> cos_sin_deg(double angle_deg);
+// N equally spaced positions per series, phi = (j - 1) 360/N deg, for the given series
+// (computed in radians, as the shipped results were: the identification decides its rank on
+// the unscaled design, where the 1e-16 rounding columns count as zero).
 std::vector<Position> equally_spaced_positions(int per_series, const std::vector<int>& series = {1, 2, 3});
 Position series_position(int series, double angle_rad);
+Position series_position_deg(int series, double angle_deg);  // exact at multiples of 90 deg
 Position vector_position(const Vec3& a_g);  // unit vector expected
 // True when `p` is the paper's 3 x 8 set in the paper's order.
 bool is_paper_set(const std::vector<Position>& p);

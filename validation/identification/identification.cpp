@@ -1,11 +1,14 @@
 #include "validation/identification/identification.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+
+#include <fmt/format.h>
 
 #include <Eigen/Dense>
 #include <Eigen/SVD>
@@ -19,6 +22,16 @@ constexpr int N = kNumCoefficients;
 // design of an exactly confounded set has its smallest singular value at ~1e-16; a
 // set that is merely ill-conditioned (e.g. positions 1 degree apart) stays above 1e-6.
 constexpr double kRankTolerance = 1e-10;
+// The rank is decided first on the unscaled, unweighted design: its entries are the basis
+// values of model (1) in g^n (a coefficient in its natural unit moves a reading by K1 times
+// the entry), so an entry or a direction of size 1e-10 g^n is one that a coefficient of 1
+// in its unit (far beyond any accelerometer: k2 = 1/g rectifies 1 g per g^2) would change a
+// reading by 1e-10 g: below any reading noise a lab can reach (>= ~1e-8 g, 0.01 ug), so the
+// coefficient's uncertainty along it would exceed its whole physical range (sigma_g / 1e-10
+// > 1). Rounding in an orientation (cos 90 deg = 6e-17) lies 6 orders below; real geometry
+// (positions 1 degree apart) 4 orders above. Column scaling alone would make a rounding
+// column full size and report it identifiable (issue 13, item 1).
+constexpr double kUnscaledRankTolerance = 1e-10;
 
 struct Design {
   std::vector<int> params;  // theta indices being estimated (0 = K1)
@@ -118,17 +131,30 @@ struct Solved {
   Identifiability id;
 };
 
+int unscaled_rank(const Eigen::MatrixXd& a) {
+  if (a.cols() == 0 || a.rows() == 0) return 0;
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(a);
+  svd.setThreshold(kUnscaledRankTolerance);  // relative to the largest singular value
+  return static_cast<int>(svd.rank());
+}
+
 Solved solve(const Design& d, const Eigen::VectorXd& y, const Eigen::VectorXd& w,
              const std::vector<Position>& positions) {
   const Eigen::VectorXd sw = w.cwiseSqrt();
   Eigen::MatrixXd aw = sw.asDiagonal() * d.A;
   const Eigen::Index p = aw.cols();
-  Eigen::VectorXd scale(p);
-  for (Eigen::Index c = 0; c < p; ++c) {
-    scale[c] = aw.col(c).norm();
-    if (scale[c] == 0) scale[c] = 1;  // an all-zero column: a null direction by itself
-    aw.col(c) /= scale[c];
-  }
+  const int rank_unscaled = unscaled_rank(d.A);
+  // Column scaling conditions the solution of a well-posed set; when the unscaled problem
+  // has a smaller rank, scaling would blow rounding columns up, so the set is solved and its
+  // null directions found unscaled.
+  Eigen::VectorXd scale = Eigen::VectorXd::Ones(p);
+  const bool scaled = rank_unscaled == p;
+  if (scaled)
+    for (Eigen::Index c = 0; c < p; ++c) {
+      scale[c] = aw.col(c).norm();
+      if (scale[c] == 0) scale[c] = 1;  // an all-zero column: a null direction by itself
+      aw.col(c) /= scale[c];
+    }
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(aw, Eigen::ComputeThinU | Eigen::ComputeFullV);
   const Eigen::VectorXd s = svd.singularValues();
   Solved out;
@@ -139,6 +165,7 @@ Solved solve(const Design& d, const Eigen::VectorXd& y, const Eigen::VectorXd& w
   int rank = 0;
   for (Eigen::Index i = 0; i < s.size(); ++i)
     if (s[i] > kRankTolerance * smax) ++rank;
+  rank = std::min(rank, rank_unscaled);
   id.rank = rank;
   id.condition_number = rank == p && rank > 0 ? smax / s[p - 1] : std::numeric_limits<double>::infinity();
   id.condition_number_identifiable = rank > 0 ? smax / s[rank - 1] : std::numeric_limits<double>::infinity();
@@ -235,6 +262,45 @@ LeastSquaresResult least_squares(const std::vector<Position>& positions,
       e.assumed[i] = true;
     }
   }
+  return out;
+}
+
+FitCheck check_fit(const std::vector<Position>& positions, const std::vector<Reading>& readings,
+                   const Estimate& e, const std::vector<double>& variance, int free_parameters) {
+  FitCheck out;
+  const double k1 = e.value[K1];
+  for (int i = 0; i < N; ++i)
+    if (!std::isfinite(e.value[i])) {
+      out.problem = std::string(coefficient_name(i)) + " is not a finite number";
+      return out;
+    }
+  if (!(k1 > 0)) {
+    out.problem = fmt::format("K1 = {:g} is not positive", k1);
+    return out;
+  }
+  for (int i = 1; i < N; ++i)
+    if (std::abs(e.value[i]) > kAbsurdCoefficient) {
+      out.problem = fmt::format("{} = {:.3g} lies beyond any accelerometer's range (|{}| <= {:g} in its unit)",
+                                coefficient_name(i), e.value[i], coefficient_name(i), kAbsurdCoefficient);
+      return out;
+    }
+  const double floor = std::pow(k1 * kFitFloor_g, 2);
+  double chi2 = 0, worst = 0;
+  std::size_t worst_i = 0;
+  for (std::size_t i = 0; i < readings.size(); ++i) {
+    const double r = readings[i].output - plant::output(e.value, positions.at(readings[i].position).nominal_g);
+    const double var = std::max(i < variance.size() ? variance[i] : 0.0, floor);
+    chi2 += r * r / var;
+    if (std::abs(r) > out.max_abs_residual) out.max_abs_residual = std::abs(r);
+    if (r * r / var > worst) worst = r * r / var, worst_i = i;
+  }
+  const int dof = std::max<int>(1, static_cast<int>(readings.size()) - free_parameters);
+  out.chi2_per_dof = chi2 / dof;
+  if (!(out.chi2_per_dof <= kMaxChi2PerDof))
+    out.problem = fmt::format(
+        "the estimate does not reproduce its readings: chi^2 per degree of freedom {:.3g} (at most {:g}); "
+        "the worst is reading {} (position {}) off by {:.3g} sigma",
+        out.chi2_per_dof, kMaxChi2PerDof, worst_i + 1, readings[worst_i].position + 1, std::sqrt(worst));
   return out;
 }
 

@@ -54,6 +54,23 @@ LeastSquaresResult least_squares(const std::vector<Position>& positions,
                                  const std::vector<Reading>& readings,
                                  const std::vector<double>& weights, const FixedSet& fixed);
 
+// Whether an accepted identification reproduces its readings: each reading's residual
+// against model (1) at the estimate, over its standard deviation (`variance`, one per
+// reading, output units^2; floored at (K1 * kFitFloor_g)^2, so noise-free tests are judged
+// against a resolution far below any lab's noise and far above rounding), and no estimate
+// beyond its physical range (|k| > kAbsurdCoefficient in its unit). Empty when it does;
+// else the reason in words (the worst reading or coefficient, and the figure).
+inline constexpr double kFitFloor_g = 1e-7;         // 0.1 ug
+inline constexpr double kMaxChi2PerDof = 1e4;       // an rms residual of 100 sigma
+inline constexpr double kAbsurdCoefficient = 1.0;   // 1 g bias, 1/g, 1 rad, ...
+struct FitCheck {
+  double chi2_per_dof = 0;  // over readings - free coefficients (readings if none left)
+  double max_abs_residual = 0;  // output units
+  std::string problem;          // empty: accepted
+};
+FitCheck check_fit(const std::vector<Position>& positions, const std::vector<Reading>& readings,
+                   const Estimate& estimate, const std::vector<double>& variance, int free_parameters);
+
 // Identifiability of a position set with the given fixed coefficients (equal weights).
 Identifiability identifiability(const std::vector<Position>& positions, const FixedSet& fixed);
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <random>
+#include <stdexcept>
 #include <string>
 
 namespace vrelab::validation {
@@ -59,6 +60,10 @@ StaticTestReport run_static_test(const plant::Coefficients& truth, const std::ve
     report.methods.push_back(m);
     fns.push_back(fn);
   }
+  // An accepted identification must reproduce its readings (identification.hpp).
+  report.fit = check_fit(positions, report.readings, report.methods.back().estimate, budget.variance,
+                         report.identifiability.parameters);
+  if (!report.fit.problem.empty()) throw std::invalid_argument("least squares: " + report.fit.problem);
   if (settings.monte_carlo_trials > 0) {
     const auto stats = monte_carlo(fns, truth, source, positions, errors, settings.monte_carlo_trials, settings.seed + 1);
     for (std::size_t i = 0; i < stats.size(); ++i) report.methods[i].monte_carlo = stats[i];

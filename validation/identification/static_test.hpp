@@ -49,6 +49,7 @@ struct StaticTestReport {
   Identifiability identifiability;
   std::vector<MethodResult> methods;
   std::vector<std::string> notes;
+  FitCheck fit;  // of least squares; run_static_test throws std::invalid_argument if not accepted
 };
 
 StaticTestReport run_static_test(const plant::Coefficients& truth, const std::vector<Position>& positions,
