@@ -97,7 +97,12 @@ toml::table to_toml_table(const py::dict& d, const std::string& where) {
 template <class Insert>
 void put_toml(const py::handle& v, const std::string& where, Insert&& insert) {
   if (py::isinstance<py::bool_>(v)) return insert(v.cast<bool>());
-  if (py::isinstance<py::int_>(v)) return insert(v.cast<std::int64_t>());
+  if (py::isinstance<py::int_>(v)) {
+    int overflow = 0;
+    const long long i = PyLong_AsLongLongAndOverflow(v.ptr(), &overflow);
+    if (overflow != 0) throw io::InputError(where + ": the integer does not fit in 64 bits (TOML's range)");
+    return insert(static_cast<std::int64_t>(i));
+  }
   if (py::isinstance<py::float_>(v)) return insert(v.cast<double>());
   if (py::isinstance<py::str>(v)) return insert(v.cast<std::string>());
   if (py::isinstance<py::dict>(v)) return insert(to_toml_table(v.cast<py::dict>(), where));
