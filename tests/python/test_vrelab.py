@@ -92,6 +92,20 @@ def test_diagnose_equals_cli(tmp_path):
     assert r.verdict and r.runs > 0
 
 
+def test_frequency_equals_cli_summary(tmp_path):
+    with open(case("frequency.toml"), "rb") as f:
+        d = tomllib.load(f)
+    d["frequency_study"].update(points=6, ode_points=2)  # a small grid: two ODE runs
+    path = tmp_path / "frequency-small.toml"
+    path.write_text(vrelab.case_toml(d))
+    r = vrelab.frequency(str(path))
+    cli("frequency", str(path), "--out", str(tmp_path / "f"))
+    with open(tmp_path / "f" / "summary.json") as f:
+        summary = json.load(f)
+    assert strip_times(r.to_dict()) == strip_times(summary)
+    assert r.mechanisms
+
+
 def test_dict_case_is_the_file_case():
     path = case("paper-predict.toml")
     with open(path, "rb") as f:
