@@ -32,13 +32,20 @@ cmake --build build -j"$(nproc)"
 # `import vrelab` for Debian's /usr/bin/python3: a .pth file in its site directory for local
 # installs (/usr/local/lib/python3.X/dist-packages, not dpkg's) naming build/python, so every
 # rebuild is what Python imports (README, "Python").
-if [ -d build/python/vrelab ]; then
+# Only when this build made the module (pybind11-dev missing or -DVRELAB_PYTHON=OFF: no module,
+# nothing written); sudo only when the file changes, so a rerun asks for nothing.
+if compgen -G "build/python/vrelab/_core*.so" >/dev/null && ! grep -q '^VRELAB_PYTHON:BOOL=OFF' build/CMakeCache.txt; then
   site=$(/usr/bin/python3 -c 'import site; print(site.getsitepackages()[0])')
-  sudo=""
-  [ "$(id -u)" -ne 0 ] && sudo="sudo"
-  $sudo mkdir -p "$site"
-  echo "$PWD/build/python" | $sudo tee "$site/vrelab.pth" >/dev/null
+  if [ "$(cat "$site/vrelab.pth" 2>/dev/null)" != "$PWD/build/python" ]; then
+    sudo=""
+    [ "$(id -u)" -ne 0 ] && sudo="sudo"
+    $sudo mkdir -p "$site"
+    echo "$PWD/build/python" | $sudo tee "$site/vrelab.pth" >/dev/null
+  fi
   echo "== Python: $site/vrelab.pth -> $PWD/build/python"
+  (cd / && /usr/bin/python3 -c 'import vrelab' 2>/dev/null) || echo "== Python: warning: /usr/bin/python3 cannot import vrelab (docs/python.md)"
+else
+  echo "== Python: no module in this build (pybind11-dev, python3-dev; docs/python.md)"
 fi
 
 if [ "$run_main" -eq 1 ]; then

@@ -97,7 +97,12 @@ toml::table to_toml_table(const py::dict& d, const std::string& where) {
 template <class Insert>
 void put_toml(const py::handle& v, const std::string& where, Insert&& insert) {
   if (py::isinstance<py::bool_>(v)) return insert(v.cast<bool>());
-  if (py::isinstance<py::int_>(v)) return insert(v.cast<std::int64_t>());
+  if (py::isinstance<py::int_>(v)) {
+    int overflow = 0;
+    const long long i = PyLong_AsLongLongAndOverflow(v.ptr(), &overflow);
+    if (overflow != 0) throw io::InputError(where + ": the integer does not fit in 64 bits (TOML's range)");
+    return insert(static_cast<std::int64_t>(i));
+  }
   if (py::isinstance<py::float_>(v)) return insert(v.cast<double>());
   if (py::isinstance<py::str>(v)) return insert(v.cast<std::string>());
   if (py::isinstance<py::dict>(v)) return insert(to_toml_table(v.cast<py::dict>(), where));
@@ -360,13 +365,13 @@ PYBIND11_MODULE(_core, m) {
                              "The paper's estimate: slope of the running integral, g.")
       .def_property_readonly("method", [](const ShakeResult& r) { return r.s.result.method; }, "\"continuous integral\" or \"sampled record\".")
       .def_property_readonly("sample_rate_Hz", [](const ShakeResult& r) { return r.s.result.sample_rate_Hz; }, "Sampled record's rate, Hz.")
-      .def_property_readonly("samples", [](const ShakeResult& r) { return r.s.result.samples; })
+      .def_property_readonly("samples", [](const ShakeResult& r) { return r.s.result.samples; }, "Samples in the sampled record.")
       .def_property_readonly("baseline_g", [](const ShakeResult& r) { return r.s.result.baseline_g; }, "U/K1 at rest, g.")
       .def_property_readonly("settle_s", [](const ShakeResult& r) { return r.s.result.settle_s; }, "Settling skipped before measuring, s.")
-      .def_property_readonly("slowest_time_constant_s", [](const ShakeResult& r) { return r.s.result.slowest_time_constant_s; }, "s.")
+      .def_property_readonly("slowest_time_constant_s", [](const ShakeResult& r) { return r.s.result.slowest_time_constant_s; }, "The plant's slowest time constant, s (sets the settling).")
       .def_property_readonly("periods", [](const ShakeResult& r) { return r.s.result.periods; }, "Periods measured (periodic runs).")
       .def_property_readonly("steps", [](const ShakeResult& r) { return r.s.result.steps; }, "Solver steps.")
-      .def_property_readonly("rhs_evaluations", [](const ShakeResult& r) { return r.s.result.rhs_evaluations; })
+      .def_property_readonly("rhs_evaluations", [](const ShakeResult& r) { return r.s.result.rhs_evaluations; }, "Right-hand-side evaluations of the ODE.")
       .def_property_readonly("wall_s", [](const ShakeResult& r) { return r.s.wall_s; }, "The solver's wall time in the library call, s.")
       .def_property_readonly("series", [](const ShakeResult& r) -> py::object {
         if (!r.series) return py::none();
@@ -417,9 +422,9 @@ PYBIND11_MODULE(_core, m) {
 
   // ------------------------------------------------------------ sweep
   py::class_<SweepResult>(m, "SweepRun", "A sweep's counts (the rows are in the CSV file at .path).")
-      .def_property_readonly("conditions", [](const SweepResult& r) { return r.s.conditions; })
-      .def_property_readonly("ran", [](const SweepResult& r) { return r.s.ran; })
-      .def_property_readonly("written", [](const SweepResult& r) { return r.s.written; })
+      .def_property_readonly("conditions", [](const SweepResult& r) { return r.s.conditions; }, "Conditions of the grid.")
+      .def_property_readonly("ran", [](const SweepResult& r) { return r.s.ran; }, "Conditions run now (not resumed from the file).")
+      .def_property_readonly("written", [](const SweepResult& r) { return r.s.written; }, "Rows this call wrote (failed conditions write none).")
       .def_property_readonly("failures", [](const SweepResult& r) { return r.s.failures; }, "Failed conditions, with the solver's message.")
       .def_property_readonly("wall_s", [](const SweepResult& r) { return r.s.wall_s; }, "s.")
       .def_readonly("path", &SweepResult::path)
@@ -492,12 +497,12 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("chosen", [](const io::FolderDiagnosis& f) { return f.diagnosis.chosen; }, "The best effect (or \"A + B\").")
       .def_property_readonly("explained", [](const io::FolderDiagnosis& f) { return f.diagnosis.explained; })
       .def_property_readonly("gap_significant", [](const io::FolderDiagnosis& f) { return f.diagnosis.gap_significant; })
-      .def_property_readonly("significant_runs", [](const io::FolderDiagnosis& f) { return f.diagnosis.significant_runs; })
+      .def_property_readonly("significant_runs", [](const io::FolderDiagnosis& f) { return f.diagnosis.significant_runs; }, "Runs whose gap exceeds significance_sigma.")
       .def_property_readonly("runs", [](const io::FolderDiagnosis& f) { return f.diagnosis.runs.size(); })
-      .def_property_readonly("max_abs_z", [](const io::FolderDiagnosis& f) { return f.diagnosis.max_abs_z; })
+      .def_property_readonly("max_abs_z", [](const io::FolderDiagnosis& f) { return f.diagnosis.max_abs_z; }, "Largest |z| over the runs: the gap the static test's coefficient errors cannot take up, over the run's sigma (1).")
       .def_property_readonly("rms_before_g", [](const io::FolderDiagnosis& f) { return f.diagnosis.rms_before_g; }, "Held-out rms gap, g.")
       .def_property_readonly("rms_after_g", [](const io::FolderDiagnosis& f) { return f.diagnosis.rms_after_g; }, "With the chosen effect, g.")
-      .def_property_readonly("identified", [](const io::FolderDiagnosis& f) { return coefficient_dict(f.diagnosis.identified); })
+      .def_property_readonly("identified", [](const io::FolderDiagnosis& f) { return coefficient_dict(f.diagnosis.identified); }, "Model (1)'s coefficients from the static readings (K1 output units/g, k0 g, k2 1/g, ...).")
       .def("report", &io::FolderDiagnosis::FullReport, "The text `vrelab diagnose` prints (without the program's name).")
       .def("brief_report", &io::FolderDiagnosis::BriefReport)
       .def("to_dict", [](const io::FolderDiagnosis& f) { return to_py(io::to_json(f)); }, "`vrelab diagnose --json` as a dict.");

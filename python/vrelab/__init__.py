@@ -87,6 +87,10 @@ def _wrap(fn):
     @functools.wraps(fn)
     def call(case, *args, **kwargs):
         return fn(load_case(case), *args, **kwargs)
+    call.__doc__ = (fn.__doc__ or "") + (
+        "\n\ncase: a vrelab.Case, a case file path (str or os.PathLike) or a dict of tables "
+        "(vrelab.load_case). Bad input raises vrelab.InputError (a ValueError) with the CLI's "
+        "message; a failure of the ODE solver raises vrelab.SolverError (.call, .flag, .t_s in s).")
     return call
 
 

@@ -92,6 +92,20 @@ def test_diagnose_equals_cli(tmp_path):
     assert r.verdict and r.runs > 0
 
 
+def test_frequency_equals_cli_summary(tmp_path):
+    with open(case("frequency.toml"), "rb") as f:
+        d = tomllib.load(f)
+    d["frequency_study"].update(points=6, ode_points=2)  # a small grid: two ODE runs
+    path = tmp_path / "frequency-small.toml"
+    path.write_text(vrelab.case_toml(d))
+    r = vrelab.frequency(str(path))
+    cli("frequency", str(path), "--out", str(tmp_path / "f"))
+    with open(tmp_path / "f" / "summary.json") as f:
+        summary = json.load(f)
+    assert strip_times(r.to_dict()) == strip_times(summary)
+    assert r.mechanisms
+
+
 def test_dict_case_is_the_file_case():
     path = case("paper-predict.toml")
     with open(path, "rb") as f:
@@ -173,9 +187,33 @@ def test_bad_dict_names_the_dict_and_the_key():
         vrelab.load_case({"run": {"seed": object()}})
 
 
-def test_solver_error_is_its_own_type():
+def test_solver_error_is_its_own_type_with_the_cli_message(tmp_path):
     assert issubclass(vrelab.SolverError, RuntimeError)
     assert not issubclass(vrelab.SolverError, ValueError)
+    # a tolerance CVODE refuses at its first step: a real solver failure, raised by the library
+    text = open(case("shake-sine.toml")).read()
+    bad = tmp_path / "too-accurate.toml"
+    bad.write_text(_with_shake_key(text, "relative_tolerance = 1e-18"))
+    p = cli("shake", str(bad), check=False)
+    assert p.returncode == 2
+    with pytest.raises(vrelab.SolverError) as e:
+        vrelab.shake(str(bad))
+    assert p.stderr.strip() == "vrelab: error: " + str(e.value)
+    assert e.value.call == "CVode" and e.value.flag < 0 and e.value.t_s == 0.0
+
+
+def _with_shake_key(text, line):
+    """The case text with `line` in its [shake] table (added when the case has none)."""
+    lines = text.splitlines()
+    if "[shake]" in lines:
+        i = lines.index("[shake]")
+        return "\n".join(lines[:i + 1] + [line] + lines[i + 1:]) + "\n"
+    return text + "\n[shake]\n" + line + "\n"
+
+
+def test_huge_int_in_a_dict_is_input_error():
+    with pytest.raises(vrelab.InputError, match="run.seed: the integer does not fit in 64 bits"):
+        vrelab.load_case({"run": {"seed": 2 ** 70}})
 
 
 # ---- threads
@@ -198,6 +236,33 @@ def test_two_threads_shake_at_once():
         t.join()
     assert not errors
     assert strip_times(results[0]) == strip_times(alone) == strip_times(results[1])
+
+
+def test_shake_releases_the_gil():
+    """While a shake runs on a thread, the main thread keeps running Python: no gap in its
+    loop as long as the run (with the GIL held, the loop would stop for the whole run)."""
+    import time
+    c = vrelab.load_case(case("shake-sine-lab.toml"))
+    done, gaps = threading.Event(), []
+    start = {}
+
+    def run():
+        start["t"] = time.perf_counter()
+        vrelab.shake(c)
+        start["wall"] = time.perf_counter() - start["t"]
+        done.set()
+
+    t = threading.Thread(target=run)
+    t.start()
+    last = time.perf_counter()
+    while not done.is_set():
+        time.sleep(0.001)
+        now = time.perf_counter()
+        gaps.append(now - last)
+        last = now
+    t.join()
+    assert start["wall"] > 0.05  # a run long enough to tell
+    assert max(gaps) < 0.5 * start["wall"]
 
 
 # ---- Ctrl-C
