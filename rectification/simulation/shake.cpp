@@ -142,6 +142,14 @@ class DeviationFromLinear final : public plant::OdeSystem {
       dy[k] -= w_ * (p.real() * cs - p.imag() * sn);
     }
   }
+  // The linearisation's A: the loop is linear but for small terms, so it serves CVODE's
+  // Newton iteration as the Jacobian (a difference quotient on the deviation, 1e-5 of the
+  // state it is added to, would lose its digits to rounding).
+  bool has_jacobian() const override { return jacobian_ != nullptr; }
+  void jacobian(double, const double*, double* j) const override {
+    Eigen::Map<Eigen::MatrixXd>(j, jacobian_->rows(), jacobian_->cols()) = *jacobian_;
+  }
+  void use_jacobian(const Eigen::MatrixXd* a) { jacobian_ = a; }
   double output_g(double t, const double* y) const {
     const double sn = std::sin(w_ * t), cs = std::cos(w_ * t);
     for (std::size_t k = 0; k < x_.size(); ++k) x_[k] = linear(k, sn, cs) + y[k];
@@ -157,6 +165,7 @@ class DeviationFromLinear final : public plant::OdeSystem {
   const std::vector<double>& x_eq_;
   const Eigen::VectorXcd& phasor_;
   double w_;
+  const Eigen::MatrixXd* jacobian_ = nullptr;
   mutable std::vector<double> x_;  // scratch (one run per object, one thread)
 };
 
@@ -258,7 +267,8 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
     // periodic solution, either settled for ln(1/decay) time constants when that is shorter
     // than a period, or found by shooting (Newton on the one-period map, its Jacobian the
     // linearisation's monodromy e^{AT}); then one period measured stands for all of them.
-    const DeviationFromLinear dev(shaken, x_eq, phasor, w);
+    DeviationFromLinear dev(shaken, x_eq, phasor, w);
+    dev.use_jacobian(&lin.A);
     const double dt = sampled ? 1 / r.sample_rate_Hz : 0.0;
     long steps = 0, rhs_evaluations = 0;
     double simulated = 0;
@@ -308,8 +318,9 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
     const double q_tolerance =
         0.1 * s.relative_tolerance * std::max(std::abs(phasor[Accelerometer::kQuadrature]) / period, amplitude);
     Eigen::VectorXd res(m);
-    // Is the pass periodic to the tolerance? Sets res; returns the scaled residual or -1 if
-    // the measured mean would be off by more than q_tolerance.
+    // Is the pass periodic to the tolerance? Sets res and *q_err (the mean's error from the
+    // start being off the orbit); returns the largest residual per typical state size and
+    // whether the pass is accepted.
     auto periodic = [&](const PeriodPass& p, double* q_err) {
       double scaled = 0;
       for (Eigen::Index i = 0; i < m; ++i) {
@@ -321,39 +332,43 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
       return std::pair<double, bool>(scaled, scaled <= 100 * s.relative_tolerance && std::abs(*q_err) <= q_tolerance);
     };
     const std::vector<double> y_zero(static_cast<std::size_t>(n), 0.0);
-    if (raw_settle_s <= period) {
-      r.path = "settle + one period";
-      measured_t0 = sampled ? std::ceil(raw_settle_s / dt) * dt : raw_settle_s;
-      PeriodPass p = pass(0.0, y_zero, measured_t0);
-      double q_err = 0;
-      if (periodic(p, &q_err).second) {
-        measured = std::move(p);
-        correction_g = -q_err;
-        residual_g = std::abs(q_err);
-      }
-    } else {
-      r.path = "shooting";
-      const Eigen::MatrixXd monodromy = (a_act * period).exp();
-      const Eigen::PartialPivLU<Eigen::MatrixXd> newton((Eigen::MatrixXd::Identity(m, m) - monodromy).eval());
-      std::vector<double> y = y_zero;
-      double previous = std::numeric_limits<double>::infinity();
-      constexpr int kMaxIterations = 8;
-      for (int it = 1; it <= kMaxIterations; ++it) {
-        PeriodPass p = pass(0.0, y, 0.0);
-        r.shooting_iterations = it;
+    try {
+      if (raw_settle_s <= period) {
+        r.path = "settle + one period";
+        measured_t0 = sampled ? std::ceil(raw_settle_s / dt) * dt : raw_settle_s;
+        PeriodPass p = pass(0.0, y_zero, measured_t0);
         double q_err = 0;
-        const auto [scaled, done] = periodic(p, &q_err);
-        if (done) {
+        if (periodic(p, &q_err).second) {
           measured = std::move(p);
           correction_g = -q_err;
           residual_g = std::abs(q_err);
-          break;
         }
-        if (!(scaled < 0.5 * previous)) break;  // not contracting: leave it to the transient path
-        previous = scaled;
-        const Eigen::VectorXd step = newton.solve(res);
-        for (Eigen::Index i = 0; i < m; ++i) y[static_cast<std::size_t>(act[static_cast<std::size_t>(i)])] += step[i];
+      } else {
+        r.path = "shooting";
+        const Eigen::MatrixXd monodromy = (a_act * period).exp();
+        const Eigen::PartialPivLU<Eigen::MatrixXd> newton((Eigen::MatrixXd::Identity(m, m) - monodromy).eval());
+        std::vector<double> y = y_zero;
+        double previous = std::numeric_limits<double>::infinity();
+        constexpr int kMaxIterations = 8;
+        for (int it = 1; it <= kMaxIterations; ++it) {
+          PeriodPass p = pass(0.0, y, 0.0);
+          r.shooting_iterations = it;
+          double q_err = 0;
+          const auto [scaled, done] = periodic(p, &q_err);
+          if (done) {
+            measured = std::move(p);
+            correction_g = -q_err;
+            residual_g = std::abs(q_err);
+            break;
+          }
+          if (!(scaled < 0.5 * previous)) break;  // not contracting: leave it to the transient path
+          previous = scaled;
+          const Eigen::VectorXd step = newton.solve(res);
+          for (Eigen::Index i = 0; i < m; ++i) y[static_cast<std::size_t>(act[static_cast<std::size_t>(i)])] += step[i];
+        }
       }
+    } catch (const plant::SolverError&) {
+      measured.reset();  // e.g. Newton on the linear Jacobian failing in a far nonlinear loop
     }
     if (measured) {
       if (!sampled) {

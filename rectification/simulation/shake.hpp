@@ -13,6 +13,10 @@
 //    transient that the nonlinear terms cause remains;
 //  - settling rule: skip ln(1/settle_decay) slowest closed-loop time constants, rounded up
 //    to whole periods;
+//  - shake_sine by default reaches the periodic steady state directly and measures one
+//    period that stands for the `periods` of the layout (docs/performance.md: the deviation
+//    from the linear periodic solution, settled or found by shooting); ShakeResult::path
+//    says which path ran, "transient" being the rule above;
 //  - the paper's integral: Q(t) = integral of (U/K1 - baseline) is a state of the ODE, so
 //    the mean over whole periods is (Q(t2) - Q(t1)) / (t2 - t1) to the solver's tolerance;
 //  - uncertainty: the measuring interval is cut into `blocks` equal runs of whole periods;
