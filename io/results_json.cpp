@@ -250,7 +250,13 @@ json shake_json(const Case& c, const ShakeStudy& s) {
                       {"samples", r.samples},
                       {"sample_rate_Hz", r.sample_rate_Hz}};
   j["settings"] = shake_settings_json(c.shake);
-  j["solver_stats"] = {{"steps", r.steps}, {"rhs_evaluations", r.rhs_evaluations}, {"wall_s", s.wall_s}};
+  j["solver_stats"] = {{"steps", r.steps},
+                       {"rhs_evaluations", r.rhs_evaluations},
+                       {"wall_s", s.wall_s},
+                       {"cpu_s", s.cpu_s},
+                       {"path", r.path},
+                       {"shooting_iterations", r.shooting_iterations},
+                       {"simulated_s", r.simulated_s}};
   j["units"] = {{"measured_g", "g"}, {"sigma_g", "g"}, {"predicted_eq3_g", "g"}};
   return j;
 }

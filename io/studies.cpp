@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -32,6 +33,13 @@ constexpr double kArcsec = std::numbers::pi / (180.0 * 3600.0);
 
 std::string cell(double x) { return fmt::format(" {:>10.3e}", x); }
 std::string text_cell(const std::string& s) { return fmt::format(" {:>10}", s); }
+
+// CPU seconds of the calling thread (not the process: other threads may run beside it).
+double thread_cpu_s() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -322,11 +330,13 @@ ShakeStudy shake_with(const Case& c, const std::function<rectification::SampleSi
   s.table = shake_motion(c);
   const rectification::SampleSink sink = make_sink();
   const auto start = std::chrono::steady_clock::now();
+  const double cpu_start = thread_cpu_s();
   const Vec3& a = *c.orientation_g;
   s.result = s.table.periodic ? rectification::shake_sine(c.plant, a, vs.sine, c.shake, sink,
                                                           c.shaker.imperfect() ? s.table.motion.get() : nullptr)
                               : rectification::shake_excitation(c.plant, a, *s.table.motion, vs.duration_s, c.shake, sink);
   s.wall_s = seconds_since(start);
+  s.cpu_s = thread_cpu_s() - cpu_start;
   s.predicted_g = predict_terms(c).total_g();
   done();
   return s;
@@ -374,7 +384,8 @@ std::string shake_report(const Case& c, const ShakeStudy& s) {
   out += fmt::format("  eq. (3) corrected, truth   {:>14.6f} ug\n", p * 1e6);
   out += fmt::format("  measured - eq. (3)         {:>14.6f} ug ({:+.4g} %)\n", (r.measured_g - p) * 1e6,
                      p != 0 ? 100 * (r.measured_g / p - 1) : 0.0);
-  out += fmt::format("  solver: {} steps, {} right-hand sides, {:.3g} s wall\n", r.steps, r.rhs_evaluations, s.wall_s);
+  out += fmt::format("  solver: {} steps, {} right-hand sides, {:.3g} s wall, {:.3g} s CPU; path: {}\n", r.steps,
+                     r.rhs_evaluations, s.wall_s, s.cpu_s, r.path);
   return out;
 }
 

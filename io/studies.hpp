@@ -55,6 +55,7 @@ struct ShakeStudy {
   rectification::ShakeResult result;
   double predicted_g = 0;  // eq. (3) corrected, the truth's coefficients
   double wall_s = 0;
+  double cpu_s = 0;  // CPU time of the run's own thread (CLOCK_THREAD_CPUTIME_ID)
 };
 // `series_path` non-empty: the sampled record is written there (atomically).
 ShakeStudy shake(const Case& c, const std::string& series_path);

@@ -85,6 +85,17 @@ struct OdeSolver::Impl {
     }
   }
 
+  static int jac(realtype t, N_Vector y, N_Vector, SUNMatrix j, void* user, N_Vector, N_Vector, N_Vector) {
+    auto* self = static_cast<Impl*>(user);
+    try {
+      self->system.jacobian(t, N_VGetArrayPointer(y), SUNDenseMatrix_Data(j));  // column-major
+      return 0;
+    } catch (...) {
+      self->rhs_error = std::current_exception();
+      return -1;
+    }
+  }
+
   static void on_error(int, const char*, const char* function, char* msg, void* user) {
     auto* self = static_cast<Impl*>(user);
     self->last_message = std::string(function) + ": " + msg;
@@ -117,6 +128,7 @@ OdeSolver::OdeSolver(const OdeSystem& system, double t0, const std::vector<doubl
   m.ls = SUNLinSol_Dense(m.y, m.a, m.ctx);
   if (!m.a || !m.ls) throw SolverError("SUNLinSol_Dense", 0, t0, "allocation failed");
   m.check(CVodeSetLinearSolver(m.mem, m.ls, m.a), "CVodeSetLinearSolver", t0);
+  if (system.has_jacobian()) m.check(CVodeSetJacFn(m.mem, &Impl::jac), "CVodeSetJacFn", t0);
   m.check(CVodeSetMaxNumSteps(m.mem, s.max_steps), "CVodeSetMaxNumSteps", t0);
   if (s.max_step_s > 0) m.check(CVodeSetMaxStep(m.mem, s.max_step_s), "CVodeSetMaxStep", t0);
 }

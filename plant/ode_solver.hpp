@@ -24,6 +24,10 @@ class OdeSystem {
   virtual ~OdeSystem() = default;
   virtual int size() const = 0;
   virtual void rhs(double t_s, const double* x, double* dx) const = 0;
+  // The Jacobian d(dx)/dx at (t, x), column-major n x n into j; false (the default): CVODE
+  // forms it by difference quotients.
+  virtual bool has_jacobian() const { return false; }
+  virtual void jacobian(double /*t_s*/, const double* /*x*/, double* /*j*/) const {}
 };
 
 struct SolverSettings {

@@ -13,6 +13,10 @@
 //    transient that the nonlinear terms cause remains;
 //  - settling rule: skip ln(1/settle_decay) slowest closed-loop time constants, rounded up
 //    to whole periods;
+//  - shake_sine by default reaches the periodic steady state directly and measures one
+//    period that stands for the `periods` of the layout (docs/performance.md: the deviation
+//    from the linear periodic solution, settled or found by shooting); ShakeResult::path
+//    says which path ran, "transient" being the rule above;
 //  - the paper's integral: Q(t) = integral of (U/K1 - baseline) is a state of the ODE, so
 //    the mean over whole periods is (Q(t2) - Q(t1)) / (t2 - t1) to the solver's tolerance;
 //  - uncertainty: the measuring interval is cut into `blocks` equal runs of whole periods;
@@ -49,6 +53,9 @@ struct ShakeSettings {
   double settle_decay = 1e-7;  // fraction to which transients decay before measuring
   int blocks = 4;              // batch means for the uncertainty
   double min_measure_s = 0.0;  // measure at least this long (whole periods)
+  // shake_sine: reach the periodic steady state directly (docs/performance.md) instead of
+  // integrating the settling; false forces the transient path (settle, then measure).
+  bool periodic_steady_state = true;
   bool IsValid(std::string* error) const;
 };
 
@@ -67,6 +74,12 @@ struct ShakeResult {
   double slowest_time_constant_s = 0;
   int periods = 0;                 // measured
   long steps = 0, rhs_evaluations = 0;
+  // How the run reached the state it measured (docs/performance.md): "transient" (settled
+  // for settle_s, measured `periods` periods), "settle + one period" or "shooting" (the
+  // periodic steady state; one period stands for all, the record is replayed).
+  std::string path = "transient";
+  int shooting_iterations = 0;  // one-period maps evaluated by the shooting
+  double simulated_s = 0;       // time the ODE actually integrated
 };
 
 // Called for every sample of the record (time s, dynamic input g, output in output units):

@@ -4,9 +4,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "plant/accelerometer.hpp"
+#include "plant/effects/current_saturation.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "rectification/simulation/shaker_motion.hpp"
@@ -144,4 +146,33 @@ TEST(ShakerMotion, SineIsPeriodicWithItsDemandAndImperfectionsNeedATone) {
   EXPECT_THROW(rectification::shaker_motion(random, none, Vec3(1, 0, 0), 9.81, 1), std::invalid_argument);
   v.sine.frequency_Hz = 0;
   EXPECT_THROW(rectification::shaker_motion(v, none, Vec3(1, 0, 0), 9.81, 1), std::invalid_argument);
+}
+
+TEST(ShakePeriodic, SteadyStatePathsAgreeWithTheSettledTransient) {
+  // The periodic steady state reached directly (settled deviation below ~100 Hz, shooting
+  // above) against the transient path (settle 16 time constants, measure 4 periods): both
+  // are the ODE's answer; the transient path's own error at rtol 1e-10 is up to ~5e-10 g at
+  // 5 g (docs/performance.md), so 1e-9 g.
+  PlantConfig cfg = test::paper_like_plant();
+  const Vec3 a(0.5, std::sqrt(0.75), 0);
+  rectification::ShakeSettings transient;
+  transient.periodic_steady_state = false;
+  for (double f : {2.0, 120.0, 1500.0}) {
+    const auto o = rectification::shake_sine(cfg, a, sine(f, 5), transient);
+    const auto p = rectification::shake_sine(cfg, a, sine(f, 5));
+    EXPECT_EQ(o.path, "transient");
+    EXPECT_EQ(p.path, f < 10 ? "settle + one period" : "shooting") << f << " Hz";
+    EXPECT_NEAR(p.measured_g, o.measured_g, 1e-9) << f << " Hz";
+    EXPECT_LT(p.steps, o.steps) << f << " Hz";
+  }
+}
+
+TEST(ShakePeriodic, AStronglyNonlinearLoopFallsBackToTheTransient) {
+  // Current saturation clips 4.7 g of demand at 3 g: the linear monodromy does not describe
+  // the loop, the one-period check fails and the transient path measures, as before.
+  PlantConfig cfg = test::paper_like_linear_plant();
+  cfg.effects.push_back(std::make_shared<CurrentSaturation>(3.0));
+  const auto r = rectification::shake_sine(cfg, Vec3(std::sqrt(0.5), 0, std::sqrt(0.5)), sine(10, 4));
+  EXPECT_EQ(r.path, "transient");
+  EXPECT_NEAR(r.measured_g, 0.0, 1e-7);
 }
