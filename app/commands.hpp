@@ -83,6 +83,7 @@ struct CampaignOptions {
   std::string case_path, out_dir, key_path;  // key: default <out_dir>.key.json
   std::optional<std::uint64_t> seed;
   bool progress = true;
+  bool work_limit = true;
 };
 void run_campaign(const CampaignOptions& o, std::ostream& out);
 
@@ -107,5 +108,6 @@ void check_sweep_work(const io::Case& c);
 void check_reproduce_work(const io::Case& c);
 void check_frequency_work(const io::Case& c);
 void check_identify_work(const io::Case& c, int monte_carlo);
+void check_campaign_work(const io::Case& c);
 
 }  // namespace vrelab::app

@@ -23,6 +23,7 @@ std::string program() { return fmt::format("vrelab {} ({}) ", kProgramVersion, k
 }  // namespace
 
 void run_campaign(const CampaignOptions& o, std::ostream& out) {
+  if (o.work_limit) check_campaign_work(io::read_case(o.case_path));
   const io::CampaignWritten w = io::write_virtual_campaign({o.case_path, o.out_dir, o.key_path, o.seed, o.progress});
   out << program() << w.FullReport();
 }

@@ -168,6 +168,9 @@ Command add_campaign(CLI::App& app) {
   cmd->add_option("--key", o.key_path, "Answer key (JSON; default <out>.key.json); diagnose never reads it");
   cmd->add_option("--seed", o.seed, "Seed (default: the case's [run] seed)");
   cmd->add_flag_callback("--no-progress", [&o] { o.progress = false; }, "No progress bar");
+  cmd->add_flag_callback(
+      "--no-work-limit", [&o] { o.work_limit = false; },
+      "Run even if the estimated work exceeds the limits (docs/case-files.md, Limits)");
   return {cmd, [owned] {
             run_campaign(*owned, std::cout);
             return 0;

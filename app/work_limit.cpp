@@ -136,4 +136,22 @@ void check_identify_work(const io::Case& c, int monte_carlo) {
   check(c, r, Vec3::UnitX());
 }
 
+void check_campaign_work(const io::Case& c) {
+  if (!c.campaign || !c.coefficients) return;  // write_virtual_campaign reports the missing table
+  const validation::CampaignDesign& d = c.campaign->design;
+  if (d.frequencies_Hz.empty() || d.orientations_g.empty()) return;
+  const auto [fmin, fmax] = std::minmax_element(d.frequencies_Hz.begin(), d.frequencies_Hz.end());
+  const auto p = rectification::plant_timescales(c.plant, d.orientations_g.front());
+  WorkRequest r;
+  r.drive_Hz = *fmax * harmonic_factor(c);
+  r.drive_key = "[campaign] frequencies_Hz";
+  r.simulated_s = settle_s(c, p) + std::max(measure_s(c, *fmin), d.raw_sample_rate_Hz > 0 ? d.raw_record_s : 0.0);
+  r.time_key = "[shake] min_measure_s and settle_decay, [campaign] raw_record_s";
+  r.sample_rate_Hz = d.raw_sample_rate_Hz > 0 ? std::max(d.raw_sample_rate_Hz, 20 * *fmax) : 0.0;  // raised to 20 per period
+  r.runs = static_cast<double>(d.frequencies_Hz.size() * d.amplitudes_g.size() * d.directions.size() *
+                               d.orientations_g.size());
+  r.runs_key = "[campaign] frequencies_Hz x amplitudes_g x directions x orientations_g";
+  check(c, r, d.orientations_g.front());
+}
+
 }  // namespace vrelab::app
