@@ -6,7 +6,8 @@
 // Takes: the number of items, the threads (0: all cores), the work per item, and an optional
 //        callback run under a lock after each item (results in order of completion, progress).
 // Gives: nothing; an exception thrown by an item is caught and rethrown after all threads
-//        have joined (the first one), unless the item handles its own failures.
+//        have joined (the first one), unless the item handles its own failures. The caller's
+//        cancel flag (core/cancel.hpp) is current in every worker and checked before each item.
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
@@ -15,6 +16,8 @@
 #include <mutex>
 #include <thread>
 #include <vector>
+
+#include "core/cancel.hpp"
 
 namespace vrelab::core {
 
@@ -31,9 +34,12 @@ inline void parallel_for(std::size_t n, int threads, const std::function<void(st
   std::atomic<std::size_t> next{0};
   std::mutex lock;
   std::exception_ptr failure;
+  const std::atomic<bool>* cancel = current_cancel_flag();
   auto worker = [&] {
+    CancelScope scope(cancel);
     for (std::size_t i = next++; i < n; i = next++) {
       try {
+        throw_if_cancelled();
         work(i);
         if (after_each) {
           std::lock_guard<std::mutex> g(lock);

@@ -10,6 +10,8 @@
 #include <sunlinsol/sunlinsol_dense.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
+#include "core/cancel.hpp"
+
 namespace vrelab::plant {
 namespace {
 
@@ -138,6 +140,7 @@ OdeSolver::~OdeSolver() = default;
 const std::vector<double>& OdeSolver::advance(double t_out) {
   Impl& m = *impl_;
   if (t_out < t_) throw SolverError("OdeSolver::advance", 0, t_, "output times must not decrease");
+  core::throw_if_cancelled();  // a caller's cancel flag (core/cancel.hpp): Ctrl-C in Python
   if (t_out > t_) {
     realtype t_reached = t_;
     const int flag = CVode(m.mem, t_out, m.y, &t_reached, CV_NORMAL);

@@ -8,20 +8,23 @@
 //
 // Errors: io::InputError and std::invalid_argument (the CLI's exit code 2) raise
 // vrelab.InputError (a ValueError) with the same message; plant::SolverError raises
-// vrelab.SolverError (call, flag, t_s). Calls that simulate release the GIL; shake with
-// series=True checks for Ctrl-C every few thousand samples (the sample sink is the library's
-// only callback on that path).
+// vrelab.SolverError (call, flag, t_s). Calls that simulate run with the GIL released and can
+// be stopped with Ctrl-C (interruptible below: the library's cancel flag, core/cancel.hpp).
 #include <Python.h>
 
+#include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <random>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <pybind11/numpy.h>
@@ -29,6 +32,7 @@
 #include <pybind11/stl.h>
 #include <toml++/toml.h>
 
+#include "core/cancel.hpp"
 #include "io/case_file.hpp"
 #include "io/diagnosis.hpp"
 #include "io/diagnosis_json.hpp"
@@ -226,9 +230,53 @@ const validation::MethodResult& method_named(const IdentifyResult& r, const std:
   throw py::key_error("no method \"" + name + "\" (the methods: " + known + ")");
 }
 
-// Ctrl-C during a long call with a sample sink: every `kCheckEvery` samples the sink takes the
-// GIL and runs Python's signal handlers; a KeyboardInterrupt unwinds the run (nothing written).
-constexpr long kCheckEvery = 1 << 14;
+// A long library call, interruptible with Ctrl-C: it runs on a thread of its own with the GIL
+// released, while the calling thread runs Python's signal handlers every 50 ms. A
+// KeyboardInterrupt sets the call's cancel flag (core/cancel.hpp); the call ends at its next
+// check (the next ODE output time or work item) with core::Cancelled, before what it writes at
+// its end, and the KeyboardInterrupt is raised here. Signals reach Python's main thread only:
+// called from another thread, the call runs to its end.
+template <class F>
+auto interruptible(F&& f) -> decltype(f()) {
+  using R = decltype(f());
+  std::atomic<bool> cancel{false};
+  std::optional<R> result;
+  std::exception_ptr failure;
+  bool interrupted = false;
+  {
+    py::gil_scoped_release nogil;
+    std::mutex m;
+    std::condition_variable cv;
+    bool done = false;
+    std::thread worker([&] {
+      core::CancelScope scope(&cancel);
+      try {
+        result.emplace(f());
+      } catch (...) {
+        failure = std::current_exception();
+      }
+      std::lock_guard<std::mutex> g(m);
+      done = true;
+      cv.notify_one();
+    });
+    std::unique_lock<std::mutex> lock(m);
+    while (!cv.wait_for(lock, std::chrono::milliseconds(50), [&] { return done; })) {
+      if (interrupted) continue;
+      lock.unlock();
+      {
+        py::gil_scoped_acquire gil;
+        interrupted = PyErr_CheckSignals() != 0;  // the handler's exception stays set
+      }
+      if (interrupted) cancel = true;
+      lock.lock();
+    }
+    lock.unlock();
+    worker.join();
+  }
+  if (interrupted) throw py::error_already_set();
+  if (failure) std::rethrow_exception(failure);
+  return std::move(*result);
+}
 
 }  // namespace
 
@@ -313,8 +361,7 @@ PYBIND11_MODULE(_core, m) {
       "identify",
       [](io::Case c, int monte_carlo, std::optional<std::uint64_t> seed) {
         if (seed) c.seed = *seed;
-        py::gil_scoped_release nogil;
-        io::IdentifyStudy s = io::identify(c, monte_carlo);
+        io::IdentifyStudy s = interruptible([&] { return io::identify(c, monte_carlo); });
         return IdentifyResult{std::move(c), std::move(s)};
       },
       py::arg("case"), py::arg("monte_carlo") = 0, py::arg("seed") = py::none(),
@@ -393,23 +440,16 @@ PYBIND11_MODULE(_core, m) {
         if (seed) c.seed = *seed, c.shake.readout.seed = *seed;
         ShakeResult r{std::move(c), {}, {}};
         if (!series) {
-          py::gil_scoped_release nogil;
-          r.s = io::shake(r.c, std::string());
+          r.s = interruptible([&] { return io::shake(r.c, std::string()); });
           return r;
         }
         r.series = std::make_shared<Series>();
         Series& out = *r.series;
-        long n = 0;
-        const rectification::SampleSink sink = [&out, &n](double t, const Vec3& in, double u) {
+        const rectification::SampleSink sink = [&out](double t, const Vec3& in, double u) {
           out.t_s.push_back(t), out.in_IA.push_back(in[0]), out.in_PA.push_back(in[1]), out.in_OA.push_back(in[2]);
           out.out.push_back(u);
-          if (++n % kCheckEvery == 0) {
-            py::gil_scoped_acquire gil;
-            if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-          }
         };
-        py::gil_scoped_release nogil;
-        r.s = io::shake(r.c, sink);
+        r.s = interruptible([&] { return io::shake(r.c, sink); });
         return r;
       },
       py::arg("case"), py::arg("series") = false, py::arg("seed") = py::none(),
@@ -417,7 +457,7 @@ PYBIND11_MODULE(_core, m) {
       "One run on the virtual shaker: the ODE accelerometer (SUNDIALS CVODE) under the case's [vibration] (sine, "
       "random PSD, sine on random, swept sine) in the static orientation [orientation] a_g (g). Gives the measured "
       "vibration error and its sigma (g) beside eq. (3). series=True also records the sampled output (like `vrelab "
-      "shake --series`: the run is then a sampled record) as NumPy arrays in .series, and Ctrl-C interrupts it. "
+      "shake --series`: the run is then a sampled record) as NumPy arrays in .series. Ctrl-C interrupts it. "
       "Releases the GIL. Same as `vrelab shake CASE [--seed S]`.");
 
   // ------------------------------------------------------------ sweep
@@ -432,9 +472,10 @@ PYBIND11_MODULE(_core, m) {
   m.def(
       "_sweep",
       [](const io::Case& c, const std::string& out_path, bool restart, int threads, bool progress) {
-        py::gil_scoped_release nogil;
-        std::ostringstream announce;
-        io::SweepStudy s = io::sweep(c, out_path, restart, threads, progress, announce);
+        io::SweepStudy s = interruptible([&] {
+          std::ostringstream announce;
+          return io::sweep(c, out_path, restart, threads, progress, announce);
+        });
         return SweepResult{std::move(s), out_path};
       },
       py::arg("case"), py::arg("out_path"), py::arg("restart") = false, py::arg("threads") = -1, py::arg("progress") = false);
@@ -458,8 +499,7 @@ PYBIND11_MODULE(_core, m) {
   m.def(
       "frequency",
       [](const io::Case& c) {
-        py::gil_scoped_release nogil;
-        return FrequencyResult{c, io::frequency(c)};
+        return FrequencyResult{c, interruptible([&] { return io::frequency(c); })};
       },
       py::arg("case"),
       "frequency(case) -> FrequencyResult\n\nEq. (3) through the plant's dynamics against the ODE, per term and place, "
@@ -484,8 +524,7 @@ PYBIND11_MODULE(_core, m) {
   m.def(
       "_campaign",
       [](const std::string& case_path, const std::string& out_dir, const std::string& key_path, std::optional<std::uint64_t> seed) {
-        py::gil_scoped_release nogil;
-        return io::write_virtual_campaign({case_path, out_dir, key_path, seed, false});
+        return interruptible([&] { return io::write_virtual_campaign({case_path, out_dir, key_path, seed, false}); });
       },
       py::arg("case_path"), py::arg("out_dir"), py::arg("key_path") = "", py::arg("seed") = py::none());
 
@@ -511,8 +550,7 @@ PYBIND11_MODULE(_core, m) {
       [](const std::string& dir, std::optional<double> model_accuracy, std::optional<double> significance_sigma,
          std::optional<double> explained_shrinkage, std::optional<int> resimulate_runs, std::optional<bool> try_pairs) {
         io::DiagnoseOverrides o{model_accuracy, significance_sigma, explained_shrinkage, resimulate_runs, try_pairs};
-        py::gil_scoped_release nogil;
-        return io::diagnose_folder(dir, o);
+        return interruptible([&] { return io::diagnose_folder(dir, o); });
       },
       py::arg("dir"), py::kw_only(), py::arg("model_accuracy") = py::none(), py::arg("significance_sigma") = py::none(),
       py::arg("explained_shrinkage") = py::none(), py::arg("resimulate_runs") = py::none(), py::arg("try_pairs") = py::none(),
@@ -539,8 +577,7 @@ PYBIND11_MODULE(_core, m) {
   m.def(
       "reproduce",
       [](const io::Case& c, const std::string& out_dir, int threads, bool plots) {
-        py::gil_scoped_release nogil;
-        return ReproduceResult{c, io::reproduce_to_folder(c, out_dir, threads, plots)};
+        return ReproduceResult{c, interruptible([&] { return io::reproduce_to_folder(c, out_dir, threads, plots); })};
       },
       py::arg("case"), py::arg("out_dir"), py::arg("threads") = -1, py::arg("plots") = true,
       "reproduce(case, out_dir, threads=-1, plots=True) -> ReproduceResult\n\n"

@@ -268,21 +268,48 @@ def test_shake_releases_the_gil():
 
 # ---- Ctrl-C
 
-def test_ctrl_c_interrupts_a_shake_with_its_series():
+def _interrupt_after(seconds, call):
+    """Sends Ctrl-C (SIGINT) to this process after `seconds`; `call` must raise
+    KeyboardInterrupt, within a few seconds of the signal. Returns the seconds it took."""
     import signal
     import time
-    with open(case("shake-random-gevs.toml"), "rb") as f:
-        d = tomllib.load(f)
-    d["vibration"]["duration_s"] = 600.0  # ten minutes of random record: about a minute uninterrupted
-    c = vrelab.load_case(d)
-    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer = threading.Timer(seconds, lambda: os.kill(os.getpid(), signal.SIGINT))
     timer.start()
     start = time.perf_counter()
     with pytest.raises(KeyboardInterrupt):
-        vrelab.shake(c, series=True)
+        call()
     timer.join()
-    # the sink looks at Python's signals every 2^14 samples (< 1 s of record, well under 1 s of work)
-    assert time.perf_counter() - start < 10
+    return time.perf_counter() - start
+
+
+def long_random_case():
+    with open(case("shake-random-gevs.toml"), "rb") as f:
+        d = tomllib.load(f)
+    d["vibration"]["duration_s"] = 600.0  # ten minutes of random record: about a minute uninterrupted
+    return vrelab.load_case(d)
+
+
+@pytest.mark.parametrize("series", [True, False])
+def test_ctrl_c_interrupts_a_shake(series):
+    # the ODE looks at the cancel flag at every output time; the binding at Python's signals every 50 ms
+    assert _interrupt_after(0.5, lambda: vrelab.shake(long_random_case(), series=series)) < 5
+
+
+def test_ctrl_c_interrupts_reproduce_and_writes_no_report(tmp_path):
+    out = tmp_path / "paper"
+    # reproduce takes about a minute; interrupted within seconds, before its data and report
+    assert _interrupt_after(1.0, lambda: vrelab.reproduce(case("paper.toml"), str(out), plots=False)) < 10
+    assert not (out / "report.html").exists() and not (out / "summary.json").exists()
+
+
+def test_ctrl_c_interrupts_a_campaign_and_writes_nothing(tmp_path):
+    # raw records of 20 s per run: a campaign of tens of seconds (summaries alone take < 1 s)
+    text = open(case("campaign.toml")).read().replace("[campaign]", "[campaign]\nraw_series = true\nraw_record_s = 20.0", 1)
+    long_campaign = tmp_path / "long-campaign.toml"
+    long_campaign.write_text(text)
+    out = tmp_path / "c1"
+    assert _interrupt_after(0.5, lambda: vrelab.campaign(str(long_campaign), str(out))) < 10
+    assert not (out / "runs.csv").exists()
 
 
 # ---- a campaign in memory
