@@ -6,21 +6,7 @@ bin=$1
 cases=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-fail=0
-pass=0
-
-expect() {  # expect <want rc> <stderr regex> <args...>
-  local want=$1 pattern=$2
-  shift 2
-  "$bin" "$@" >"$tmp/out" 2>"$tmp/err"
-  local rc=$?
-  if [ "$rc" -ne "$want" ] || ! grep -Eq -- "$pattern" "$tmp/err" "$tmp/out"; then
-    echo "FAIL: vrelab $* -> rc $rc (want $want), stderr: $(cat "$tmp/err")"
-    fail=$((fail + 1))
-  else
-    pass=$((pass + 1))
-  fi
-}
+. "$(dirname "$0")/expect.sh"
 
 sed 's/^k2 = .*/k2 = nan/' "$cases/ideal-static.toml" >"$tmp/nan.toml"
 expect 2 'k2: must be a finite number' identify "$tmp/nan.toml" --json "$tmp/o/nan.json"
