@@ -34,27 +34,27 @@ std::string md_cell(const std::string& s) {
 
 }  // namespace
 
-void Report::heading(const std::string& text) { blocks_.push_back({Block::heading, text, {}, "", "", true}); }
-void Report::paragraph(const std::string& text) { blocks_.push_back({Block::paragraph, text, {}, "", "", true}); }
-void Report::list(const std::vector<std::string>& items) { blocks_.push_back({Block::list, "", {items}, "", "", true}); }
+void Report::heading(const std::string& text) { blocks_.push_back({Block::kHeading, text, {}, "", "", true}); }
+void Report::paragraph(const std::string& text) { blocks_.push_back({Block::kParagraph, text, {}, "", "", true}); }
+void Report::list(const std::vector<std::string>& items) { blocks_.push_back({Block::kList, "", {items}, "", "", true}); }
 void Report::table(const std::vector<std::vector<std::string>>& rows) {
-  blocks_.push_back({Block::table, "", rows, "", "", true});
+  blocks_.push_back({Block::kTable, "", rows, "", "", true});
 }
 void Report::figure(const std::string& stem, const std::string& caption, bool present, const std::string& missing_reason) {
-  blocks_.push_back({Block::figure, caption, {}, stem, missing_reason, present});
+  blocks_.push_back({Block::kFigure, caption, {}, stem, missing_reason, present});
 }
 
 std::string Report::markdown() const {
   std::string o = fmt::format("# {}\n\n", title_);
   for (const Block& b : blocks_) {
     switch (b.kind) {
-      case Block::heading: o += fmt::format("## {}\n\n", b.text); break;
-      case Block::paragraph: o += fmt::format("{}\n\n", b.text); break;
-      case Block::list:
+      case Block::kHeading: o += fmt::format("## {}\n\n", b.text); break;
+      case Block::kParagraph: o += fmt::format("{}\n\n", b.text); break;
+      case Block::kList:
         for (const auto& item : b.rows[0]) o += fmt::format("- {}\n", item);
         o += "\n";
         break;
-      case Block::table:
+      case Block::kTable:
         for (std::size_t r = 0; r < b.rows.size(); ++r) {
           o += "|";
           for (const auto& c : b.rows[r]) o += fmt::format(" {} |", md_cell(c));
@@ -67,7 +67,7 @@ std::string Report::markdown() const {
         }
         o += "\n";
         break;
-      case Block::figure:
+      case Block::kFigure:
         if (b.present)
           o += fmt::format("![{0}]({1}.png)\n\n*{0}* ([SVG]({1}.svg))\n\n", b.text, b.stem);
         else
@@ -91,14 +91,14 @@ std::string Report::html() const {
   o += fmt::format("<h1>{}</h1>\n", escape(title_));
   for (const Block& b : blocks_) {
     switch (b.kind) {
-      case Block::heading: o += fmt::format("<h2>{}</h2>\n", escape(b.text)); break;
-      case Block::paragraph: o += fmt::format("<p>{}</p>\n", escape(b.text)); break;
-      case Block::list:
+      case Block::kHeading: o += fmt::format("<h2>{}</h2>\n", escape(b.text)); break;
+      case Block::kParagraph: o += fmt::format("<p>{}</p>\n", escape(b.text)); break;
+      case Block::kList:
         o += "<ul>\n";
         for (const auto& item : b.rows[0]) o += fmt::format("<li>{}</li>\n", escape(item));
         o += "</ul>\n";
         break;
-      case Block::table:
+      case Block::kTable:
         o += "<table>\n";
         for (std::size_t r = 0; r < b.rows.size(); ++r) {
           o += "<tr>";
@@ -107,7 +107,7 @@ std::string Report::html() const {
         }
         o += "</table>\n";
         break;
-      case Block::figure:
+      case Block::kFigure:
         if (b.present)
           o += fmt::format("<figure><a href=\"{0}.svg\"><img src=\"{0}.png\" alt=\"{1}\"></a><figcaption>{1} (click for "
                            "SVG)</figcaption></figure>\n",

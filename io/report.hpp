@@ -27,7 +27,7 @@ class Report {
 
  private:
   struct Block {
-    enum Kind { heading, paragraph, list, table, figure } kind;
+    enum Kind { kHeading, kParagraph, kList, kTable, kFigure } kind;
     std::string text;
     std::vector<std::vector<std::string>> rows;  // table rows; list items in rows[0]
     std::string stem, note;

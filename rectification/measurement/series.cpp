@@ -74,7 +74,7 @@ void SeriesMeasurer::add(double t, double output) {
 
 SeriesResult SeriesMeasurer::finish() const {
   SeriesResult r;
-  auto stats = [this](const Window& w, const char* what, long& n_total) {
+  auto stats = [](const Window& w, const char* what, long& n_total) {
     double mean = 0;
     std::vector<double> means;
     n_total = 0;
