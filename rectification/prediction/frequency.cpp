@@ -34,8 +34,21 @@ LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
   const Accelerometer::Linear lin = plant.linearise();
   const int n = plant.size();
   const double w = 2 * std::numbers::pi * frequency_Hz;
-  const Eigen::MatrixXcd m = std::complex<double>(0, w) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
-  const Eigen::MatrixXcd x = m.fullPivLu().solve(lin.B.cast<std::complex<double>>());  // n x 3: per unit input axis
+  // (s I - A) x = B solved in the plant's state scales (x = S y, S = diag(state_scale)): a
+  // mechanical mode's states are ~1/w_m^2 g s^2, so unscaled A spans 1e-4 .. 1e11 and a full-pivot
+  // LU's rank threshold (eps n max|pivot|) took real pivots for zero and returned a zero response
+  // for a mode above the drive (issue 15: a mode at 2.5 kHz gave |I| = 0 at 800 Hz).
+  const std::vector<double> scale = plant.state_scale();
+  Eigen::VectorXd sc(n);
+  for (int k = 0; k < n; ++k) sc[k] = scale[static_cast<std::size_t>(k)];
+  const Eigen::MatrixXcd a_scaled = (sc.cwiseInverse().asDiagonal() * lin.A * sc.asDiagonal()).cast<std::complex<double>>();
+  const Eigen::MatrixXcd b_scaled = (sc.cwiseInverse().asDiagonal() * lin.B).cast<std::complex<double>>();
+  const auto solve_at = [&](double w_solve, const Eigen::MatrixXcd& rhs) {
+    const Eigen::MatrixXcd m = std::complex<double>(0, w_solve) * Eigen::MatrixXcd::Identity(n, n) - a_scaled;
+    Eigen::MatrixXcd y = m.partialPivLu().solve(rhs);
+    return Eigen::MatrixXcd(sc.cast<std::complex<double>>().asDiagonal() * y);
+  };
+  const Eigen::MatrixXcd x = solve_at(w, b_scaled);  // n x 3: per unit input axis
   // The rebalance current of the linear plant: i = k G theta + (1 - k) q + w_i r, with
   // k = lead pole / lead zero (plant/accelerometer.cpp, the servo's realisation).
   const plant::Servo& sv = plant.servo();
@@ -50,8 +63,7 @@ LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
   // the current: exactly 1 with the integrator, L0 / (1 + L0) without (L0 = b G / w_p^2).
   // Evaluated at 0.01 Hz: within O((f / f_c)^2) ~ 1e-9 of DC, and clear of the pivot
   // threshold that the quadrature and inert states (zero poles) would hit at f = 0.
-  const Eigen::MatrixXcd m_dc = std::complex<double>(0, 2 * std::numbers::pi * 0.01) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
-  const Eigen::VectorXcd x_dc = m_dc.fullPivLu().solve(lin.B.col(IA).cast<std::complex<double>>());
+  const Eigen::VectorXcd x_dc = solve_at(2 * std::numbers::pi * 0.01, b_scaled.col(IA)).col(0);
   out.dc_gain = std::abs(lead_ratio * sv.gain_g_per_rad * x_dc[Accelerometer::kTheta] +
                          (1 - lead_ratio) * x_dc[Accelerometer::kLead] + sv.integrator_rad_per_s * x_dc[Accelerometer::kIntegral]);
   return out;
