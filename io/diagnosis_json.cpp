@@ -78,6 +78,15 @@ json campaign_row(const validation::BlindCampaign& k) {
   return row;
 }
 
+json families_json(const validation::BlindScores& s) {
+  json j = json::object();
+  for (const auto& [name, f] : s.families)
+    j[name] = {{"n", f.n},         {"right", f.right},         {"right_physics", f.family}, {"unexplained", f.unexplained},
+               {"no_gap", f.no_gap}, {"confidently_wrong", f.wrong}, {"ambiguous", f.ambiguous},   {"ambiguous_right_among", f.right_among},
+               {"error", f.error}};
+  return j;
+}
+
 }  // namespace
 
 json to_json(const validation::DiagnoseSettings& s) {
@@ -85,7 +94,9 @@ json to_json(const validation::DiagnoseSettings& s) {
           {"significance_sigma", s.significance_sigma},
           {"explained_shrinkage", s.explained_shrinkage},
           {"resimulate_runs", s.resimulate_runs},
-          {"try_pairs", s.try_pairs}};
+          {"try_pairs", s.try_pairs},
+          {"structure_sigma", s.structure_sigma},
+          {"ambiguity_evidence", s.ambiguity_evidence}};
 }
 
 json to_json(const validation::BlindSettings& s) {
@@ -100,6 +111,31 @@ json to_json(const plant::Dynamics& d) {
           {"phase_margin_deg", d.phase_margin_deg},
           {"integrator", d.integrator},
           {"integrator_zero_ratio", d.integrator_zero_ratio}};
+}
+
+json nuisances_json(const validation::Diagnosis& d) {
+  json a = json::array();
+  for (const auto& x : d.nuisances)
+    a.push_back({{"name", x.name},
+                 {"value", x.estimated ? json(x.value) : json(nullptr)},
+                 {"sigma", finite_or_null(x.sigma)},
+                 {"unit", x.unit},
+                 {"estimated", x.estimated},
+                 {"applied", x.applied},
+                 {"note", x.note}});
+  return a;
+}
+
+json next_runs_json(const validation::Diagnosis& d) {
+  json a = json::array();
+  for (const auto& x : d.next_runs)
+    a.push_back({{"frequency_Hz", x.frequency_Hz},
+                 {"amplitude_g", x.amplitude_g},
+                 {"direction", {x.direction[0], x.direction[1], x.direction[2]}},
+                 {"orientation_g", {x.orientation_g[0], x.orientation_g[1], x.orientation_g[2]}},
+                 {"separation_sigma", x.separation_sigma},
+                 {"between", x.between}});
+  return a;
 }
 
 json to_json(const validation::Diagnosis& d, const validation::Campaign& c) {
@@ -120,6 +156,9 @@ json to_json(const validation::Diagnosis& d, const validation::Campaign& c) {
           {"rms_z_by_direction", rms_z},
           {"odd_in_a_IA_fraction", finite_or_null(d.odd_in_a_IA_fraction)},
           {"effects", effects_json(d)},
+          {"nuisances", nuisances_json(d)},
+          {"ambiguous_with", d.ambiguous_with},
+          {"next_runs", next_runs_json(d)},
           {"shrinkage",
            {{"rms_before_g", d.rms_before_g},
             {"rms_after_g", d.rms_after_g},
@@ -179,6 +218,7 @@ json to_json(const validation::BlindResult& r) {
           {"two_effect_campaigns", s.two},
           {"median_shrinkage", s.median_shrinkage},
           {"median_shrinkage_in_sigma", s.median_shrinkage_in_sigma},
+          {"families", families_json(s)},
           {"wrong", r.wrong},
           {"confusion", r.confusion},
           {"campaigns", rows}};

@@ -458,6 +458,11 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       }
       r.measured_g = *mu * 1e-6, r.sigma_g = *su * 1e-6;
     }
+    // Optional: the run's time and the rest reading before it (a bias drift, docs/data-format.md).
+    if (rn.has("time_h"))
+      if (const auto t = get("time_h")) r.time_h = *t;
+    if (rn.has("rest_ug"))
+      if (const auto x = get("rest_ug")) r.rest_g = *x * 1e-6;
     c.runs.push_back(r);
   }
   if (manifest_out) *manifest_out = m;

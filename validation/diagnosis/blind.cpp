@@ -44,12 +44,19 @@ BlindCampaign draw_campaign(int i, std::uint64_t seed, const std::vector<std::st
   BlindCampaign k;
   k.index = i, k.seed = seed * 1000003u + static_cast<std::uint64_t>(i);
   std::mt19937_64 rng(k.seed);
-  const int slot = i % 10;  // 2 clean, 1 out of library, 1 with two effects, 6 single in 10
+  const int slot = i % 12;  // 2 clean, 1 out of library, 1 pair, 1 sigma understated, 1 drift, 6 single in 12
   if (slot < 2) {
     k.category = "clean";
   } else if (slot == 2) {
     k.category = "out_of_library";
-    k.hidden.push_back(draw_effect(i / 10 % 2 == 0 ? "shaker_third_harmonic" : "readout_clipping", rng));
+    k.hidden.push_back(draw_effect(i / 12 % 2 == 0 ? "shaker_third_harmonic" : "readout_clipping", rng));
+  } else if (slot == 4) {
+    k.category = "sigma_understated";
+    k.noise_scale = std::uniform_real_distribution<double>(1.8, 3.0)(rng);
+  } else if (slot == 5) {
+    k.category = "drift";
+    const double s = std::bernoulli_distribution(0.5)(rng) ? 1 : -1;
+    k.drift_g_per_h = s * std::exp(std::uniform_real_distribution<double>(std::log(0.2e-6), std::log(2e-6))(rng));
   } else if (slot == 3) {
     k.category = "two";
     std::vector<std::string> pick = library;
@@ -62,13 +69,29 @@ BlindCampaign draw_campaign(int i, std::uint64_t seed, const std::vector<std::st
   return k;
 }
 
+// The lab's log of campaign k: each run's time (3 min a run, in the design's order) and a rest
+// reading before it (sigma 0.3 ug); the drift in both; the scatter beyond the stated sigma.
+void apply_lab_log(Campaign& camp, const BlindCampaign& k) {
+  std::mt19937_64 rng(k.seed + 29);
+  std::normal_distribution<double> n01;
+  constexpr double kRunTime_h = 0.05, kRestSigma_g = 0.3e-6;
+  for (std::size_t j = 0; j < camp.runs.size(); ++j) {
+    RunRecord& r = camp.runs[j];
+    r.time_h = kRunTime_h * static_cast<double>(j);
+    const double drift = k.drift_g_per_h * r.time_h;
+    r.rest_g = drift + kRestSigma_g * n01(rng);
+    r.measured_g += drift + std::sqrt(k.noise_scale * k.noise_scale - 1) * r.sigma_g * n01(rng);
+  }
+}
+
 // Simulates campaign k from its truth and hidden effects, diagnoses it without the key.
 void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
   const auto t0 = Clock::now();
   try {
     std::mt19937_64 rng(k.seed + 17);
     const plant::PlantConfig truth = random_truth(rng);
-    const Campaign camp = simulate_campaign(truth, k.hidden, default_design(), k.seed, 1);
+    Campaign camp = simulate_campaign(truth, k.hidden, default_design(), k.seed, 1);
+    apply_lab_log(camp, k);
     k.simulate_s = seconds_since(t0);
     k.diagnosis = diagnose(camp, settings);  // the key (k.hidden) is not passed
     if (k.category == "single") {
@@ -83,7 +106,11 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
   }
   k.wall_s = seconds_since(t0);
   const Diagnosis& d = k.diagnosis;
-  k.called = !k.error.empty() ? "error" : !d.gap_significant ? "clean" : d.explained ? d.chosen : "unexplained";
+  k.called = !k.error.empty()           ? "error"
+             : !d.ambiguous_with.empty() ? "ambiguous"
+             : !d.gap_significant        ? "clean"
+             : d.explained               ? d.chosen
+                                         : "unexplained";
   k.top = k.error.empty() ? d.effects.front().name : "";
 }
 
@@ -92,11 +119,91 @@ double median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
+// The physics an effect belongs to (what it acts on); "" for none.
+std::string physics_of(const std::string& name) {
+  const Effect* e = find_effect(name);
+  return e ? to_string(e->acts_on) : "";
+}
+
+// Campaign k's outcome in its family (FamilyScore), and why when not right.
+void score_family(const BlindCampaign& k, BlindResult& r) {
+  // Single effects below 5 sigma in every run are a family apart (the issue scores >= 5 sigma).
+  FamilyScore& f = r.scores.families[k.category == "single" && k.error.empty() && k.effect_max_sigma < 5 ? "single_below_5_sigma" : k.category];
+  ++f.n;
+  if (!k.error.empty()) {
+    ++f.error;
+    r.wrong.push_back(fmt::format("[{}] campaign {} (seed {}): error: {}", k.category, k.index, k.seed, k.error));
+    return;
+  }
+  const Diagnosis& d = k.diagnosis;
+  std::vector<std::string> truth;
+  for (const auto& h : k.hidden) truth.push_back(h.name);
+  const auto is_truth = [&](const std::string& n) { return std::find(truth.begin(), truth.end(), n) != truth.end(); };
+  std::string key = k.category;
+  for (const auto& h : k.hidden) key += fmt::format(" {} = {:.4g}", h.name, h.parameter);
+  if (k.category == "sigma_understated") key += fmt::format(" (scatter x{:.2f})", k.noise_scale);
+  if (k.category == "drift") key += fmt::format(" ({:.3g} ug/h)", k.drift_g_per_h * 1e6);
+  const std::string why = fmt::format("[{}] campaign {} (seed {}): {}; called \"{}\" (top {})", k.category, k.index, k.seed, key,
+                                      d.verdict, k.top);
+  if (!d.ambiguous_with.empty()) {
+    ++f.ambiguous;
+    const bool among = std::any_of(d.ambiguous_with.begin(), d.ambiguous_with.end(), is_truth);
+    f.right_among += among;
+    if (!among) r.wrong.push_back(why + " (ambiguous, the truth not among them)");
+    return;
+  }
+  // What was called: the effects of an "explained" verdict.
+  std::vector<std::string> called;
+  if (d.explained) {
+    const std::string& c = d.chosen;
+    const auto plus = c.find(" + ");
+    if (plus == std::string::npos) called = {c};
+    else called = {c.substr(0, plus), c.substr(plus + 3)};
+  }
+  const Nuisance* scale = d.nuisance("sigma_scale");
+  const Nuisance* drift = d.nuisance("bias_drift");
+  bool right = false, family = false;
+  if (k.category == "clean") right = !d.gap_significant;
+  else if (k.category == "out_of_library") right = d.gap_significant && !d.explained;
+  else if (k.category == "sigma_understated") right = !d.explained && scale && scale->applied;
+  else if (k.category == "drift")
+    right = !d.explained && drift && drift->estimated && std::abs(drift->value) > 3 * drift->sigma &&
+            std::abs(drift->value - k.drift_g_per_h * 1e6) < 3 * drift->sigma + 0.1 * std::abs(k.drift_g_per_h * 1e6);
+  else if (k.category == "two") {
+    right = called.size() == 2 && is_truth(called[0]) && is_truth(called[1]);
+    family = !right && std::any_of(called.begin(), called.end(), is_truth);
+  } else {  // single
+    right = called.size() == 1 && is_truth(called[0]);
+    family = !right && !called.empty() && std::all_of(called.begin(), called.end(), [&](const std::string& c) {
+      return physics_of(c) == physics_of(truth.front());
+    });
+  }
+  if (right) {
+    ++f.right;
+    return;
+  }
+  if (family) {
+    ++f.family;
+  } else if (d.explained) {
+    ++f.wrong;  // explained by an effect of another physics (or of none hidden)
+  } else if (d.gap_significant) {
+    ++f.unexplained;
+  } else {
+    ++f.no_gap;
+  }
+  r.wrong.push_back(why);
+}
+
 // Scores one campaign against its key into r (counts, confusion, the wrong ones).
 void score(const BlindCampaign& k, BlindResult& r, std::vector<double>& shrink, std::vector<double>& shrink_sigma) {
   BlindScores& s = r.scores;
   const Diagnosis& d = k.diagnosis;
   const std::string& called = k.called;
+  score_family(k, r);
+  if (k.category == "sigma_understated" || k.category == "drift") {
+    ++r.confusion[k.category][called];
+    return;
+  }
   ++r.confusion[k.category == "single" ? k.hidden[0].name : k.category][called];
   if (k.category == "single" && k.error.empty() && k.effect_max_sigma < 5) {
     ++s.small;  // below the issue's "gap >= 5 sigma somewhere": reported, not scored
@@ -112,20 +219,15 @@ void score(const BlindCampaign& k, BlindResult& r, std::vector<double>& shrink, 
     s.single_top_right += k.error.empty() && d.gap_significant && k.top == k.hidden[0].name;
     if (k.error.empty() && d.rms_before_g > 0) shrink.push_back(1 - d.rms_after_g / d.rms_before_g);
     if (k.error.empty() && d.rms_before_sigma > 0) shrink_sigma.push_back(1 - d.rms_after_sigma / d.rms_before_sigma);
-    if (!right)
-      r.wrong.push_back(fmt::format("campaign {} (seed {}): {} = {:.4g} hidden; called {} (top {}){}", k.index, k.seed,
-                                    k.hidden[0].name, k.hidden[0].parameter, called, k.top,
-                                    k.error.empty() ? "" : ": " + k.error));
+
   } else if (k.category == "clean") {
     ++s.clean;
     s.false_alarms += called != "clean";
-    if (called != "clean") r.wrong.push_back(fmt::format("campaign {} (seed {}): clean, called {}", k.index, k.seed, called));
+
   } else if (k.category == "out_of_library") {
     ++s.out_of_library;
     s.out_of_library_unexplained += called == "unexplained";
-    if (called != "unexplained")
-      r.wrong.push_back(fmt::format("campaign {} (seed {}): out of library ({} = {:.3g}), called {}", k.index, k.seed,
-                                    k.hidden[0].name, k.hidden[0].parameter, called));
+
   } else {
     ++s.two;
     const std::string& a = k.hidden[0].name;
@@ -185,6 +287,22 @@ std::string BlindResult::BriefReport() const {
                    s.two);
   t += fmt::format("  median held-out shrinkage of the gap rms: {:.0f} % (in each run's sigma: {:.0f} %)\n",
                    100 * s.median_shrinkage, 100 * s.median_shrinkage_in_sigma);
+  t += "Per family (right; right physics, not the right effect; unexplained; no gap; WRONG: explained by another physics):\n";
+  return t + FamilyTable();
+}
+
+std::string BlindResult::FamilyTable() const {
+  std::string t = fmt::format("  {:<22}{:>4}{:>7}{:>8}{:>8}{:>8}{:>8}{:>8}{:>11}{:>7}\n", "family", "n", "right", "family", "unexpl",
+                              "no gap", "WRONG", "ambig", "(right in)", "error");
+  static const std::vector<std::string> order = {"single", "single_below_5_sigma", "two", "out_of_library", "sigma_understated",
+                                                 "drift", "clean"};
+  for (const auto& name : order) {
+    const auto it = scores.families.find(name);
+    if (it == scores.families.end()) continue;
+    const FamilyScore& f = it->second;
+    t += fmt::format("  {:<22}{:>4}{:>7}{:>8}{:>8}{:>8}{:>8}{:>8}{:>11}{:>7}\n", name, f.n, f.right, f.family, f.unexplained, f.no_gap,
+                     f.wrong, f.ambiguous, f.right_among, f.error);
+  }
   return t;
 }
 

@@ -10,8 +10,14 @@
 //        matrix, and the campaigns scored wrong with why. The draw depends on the seed only:
 //        campaign i is seeded seed * 1000003 + i whatever the threads.
 //
-// The mix, per 10 campaigns: 2 clean, 1 out of library (shaker_third_harmonic, or
-// readout_clipping every other ten), 1 with two library effects, 6 with one library effect.
+// The mix, per 12 campaigns (the families, scored apart): 2 clean, 1 out of library
+// (shaker_third_harmonic, or readout_clipping every other twelve), 1 with two library effects
+// ("pair"), 1 whose stated sigma is understated (the scatter 1.8-3 times it, no effect),
+// 1 with a bias drift (0.2-2 ug/h either sign over the campaign, no effect), 6 with one
+// library effect in its default form ("single"). Every campaign's runs carry their time
+// (3 min a run, in the design's order) and a rest reading before each (sigma 0.3 ug), as a
+// lab's log would. The nuisances are the lab's data acquisition's: applied to the runs'
+// summaries, not to the physics (which stays the ODE's).
 // A single effect whose own gap (the first-order simulation with it - without it, on the
 // truth's coefficients) stays below 5 sigma in every run is reported, not scored.
 #include <cstddef>
@@ -40,6 +46,8 @@ struct BlindCampaign {
   std::uint64_t seed = 0;
   std::string category;  // clean, single, two, out_of_library
   std::vector<HiddenEffect> hidden;
+  double noise_scale = 1;     // the runs' scatter over their stated sigma (sigma_understated)
+  double drift_g_per_h = 0;   // the bias drift (drift)
   Diagnosis diagnosis;
   std::string error;     // the simulation or diagnosis failed: why ("" otherwise)
   std::string called;    // clean, <effect>, "<A> + <B>", unexplained, or error
@@ -53,6 +61,18 @@ struct BlindCampaign {
   double effect_max_sigma = 0;
 };
 
+// One family's outcomes (a campaign counts in exactly one of right .. wrong, error apart):
+//  right: the right effect (single; pair: both; a nuisance family: the nuisance reported and
+//         no effect called; clean: no gap; out of library: unexplained);
+//  family: an effect of the right physics (what it acts on: instrument, table motion, data
+//          acquisition) but not the right one, or one of a pair;
+//  unexplained, no_gap: those verdicts where they are not right;
+//  wrong: explained by an effect of another physics (confidently wrong);
+//  ambiguous: "ambiguous between" verdicts, counted apart (right_among: the truth among them).
+struct FamilyScore {
+  int n = 0, right = 0, family = 0, unexplained = 0, no_gap = 0, wrong = 0, ambiguous = 0, right_among = 0, error = 0;
+};
+
 struct BlindScores {
   int single = 0, single_right = 0;  // scored single in-library effects; called right ("explained by" it)
   int single_top_right = 0;          // ... ranked first whatever the verdict
@@ -61,6 +81,7 @@ struct BlindScores {
   int out_of_library = 0, out_of_library_unexplained = 0;
   int two = 0, two_by_one = 0, two_by_both = 0;
   double median_shrinkage = 0, median_shrinkage_in_sigma = 0;  // held-out gap rms, single effects
+  std::map<std::string, FamilyScore> families;  // per family (category)
   static double rate(int k, int of) { return of ? static_cast<double>(k) / of : 0.0; }
 };
 
@@ -78,6 +99,7 @@ struct BlindResult {
   // puts it first); FullReport adds the campaigns scored wrong.
   std::string BriefReport() const;
   std::string FullReport() const;
+  std::string FamilyTable() const;  // the per-family outcomes, one line each
 };
 
 // Called after each campaign (under the pool's lock): campaigns done, of total.

@@ -360,7 +360,172 @@ double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effec
   return rectification::periodic_rectification(cfg, r.orientation_g, periodic_input(m, r.frequency_Hz), h).total_g();
 }
 
-Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
+namespace {
+Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s);
+}  // namespace
+
+const Nuisance* Diagnosis::nuisance(const std::string& name) const {
+  for (const Nuisance& x : nuisances)
+    if (x.name == name) return &x;
+  return nullptr;
+}
+
+namespace {
+
+// Bias drift: a line through the rest readings over the campaign's time (unweighted least
+// squares; its scatter gives the readings' sigma), removed from every run with a time, the
+// line's own variance added to the run's. The runs without time are left as they are.
+Nuisance remove_drift(Campaign& c) {
+  Nuisance nu;
+  nu.name = "bias_drift", nu.unit = "ug/h";
+  std::vector<const RunRecord*> rest;
+  for (const RunRecord& r : c.runs)
+    if (std::isfinite(r.time_h) && std::isfinite(r.rest_g)) rest.push_back(&r);
+  if (rest.size() < 3) {
+    nu.note = "not estimable: fewer than 3 runs with a time and a rest reading (runs.csv columns time_h, rest_ug)";
+    return nu;
+  }
+  const double m = static_cast<double>(rest.size());
+  double tm = 0, ym = 0;
+  for (const RunRecord* r : rest) tm += r->time_h / m, ym += r->rest_g / m;
+  double stt = 0, sty = 0;
+  for (const RunRecord* r : rest) stt += std::pow(r->time_h - tm, 2), sty += (r->time_h - tm) * (r->rest_g - ym);
+  if (!(stt > 0)) {
+    nu.note = "not estimable: the rest readings are all at one time";
+    return nu;
+  }
+  const double b = sty / stt, a = ym - b * tm;
+  double rss = 0;
+  for (const RunRecord* r : rest) rss += std::pow(r->rest_g - a - b * r->time_h, 2);
+  const double s2 = rest.size() > 2 ? rss / (m - 2) : 0.0;
+  nu.estimated = true, nu.applied = true;
+  nu.value = b * 1e6, nu.sigma = std::sqrt(s2 / stt) * 1e6;
+  for (RunRecord& r : c.runs) {
+    if (!std::isfinite(r.time_h)) continue;
+    r.measured_g -= a + b * r.time_h;
+    r.sigma_g = std::sqrt(r.sigma_g * r.sigma_g + s2 * (1 / m + std::pow(r.time_h - tm, 2) / stt));
+  }
+  char buf[200];
+  std::snprintf(buf, sizeof buf, "the rest readings' line over %d runs (%.3g h), removed; the readings scatter by %.3g ug",
+                static_cast<int>(rest.size()), rest.back()->time_h - rest.front()->time_h, std::sqrt(s2) * 1e6);
+  nu.note = buf;
+  return nu;
+}
+
+// Runs alike but for one step of frequency or of amplitude (same direction, orientation and
+// the other): how alike their gaps z are, as the correlation of neighbours, and how many pairs.
+std::pair<double, int> neighbour_correlation(const Campaign& c, const std::vector<double>& z) {
+  const auto key = [](const Vec3& v) { return std::to_string(std::lround(v[0] * 1e3)) + "," + std::to_string(std::lround(v[1] * 1e3)) + "," + std::to_string(std::lround(v[2] * 1e3)); };
+  std::map<std::string, std::vector<std::pair<double, int>>> by_f, by_a;
+  for (std::size_t k = 0; k < c.runs.size(); ++k) {
+    const RunRecord& r = c.runs[k];
+    const std::string g = key(r.direction) + "|" + key(r.orientation_g);
+    by_f[g + "|" + std::to_string(r.amplitude_g)].emplace_back(r.frequency_Hz, static_cast<int>(k));
+    by_a[g + "|" + std::to_string(r.frequency_Hz)].emplace_back(r.amplitude_g, static_cast<int>(k));
+  }
+  double sxy = 0, sxx = 0, syy = 0;
+  int pairs = 0;
+  for (auto* groups : {&by_f, &by_a})
+    for (auto& [g, v] : *groups) {
+      std::sort(v.begin(), v.end());
+      for (std::size_t i = 1; i < v.size(); ++i) {
+        if (v[i].first == v[i - 1].first) continue;  // repeats: not neighbours
+        const double x = z[static_cast<std::size_t>(v[i - 1].second)], y = z[static_cast<std::size_t>(v[i].second)];
+        sxy += x * y, sxx += x * x, syy += y * y, ++pairs;
+      }
+    }
+  return {sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0, pairs};
+}
+
+// Repeated runs (the same frequency, amplitude, direction and orientation): the pooled
+// scatter over the stated sigma, and its degrees of freedom.
+std::pair<double, int> repeat_scatter(const Campaign& c) {
+  std::map<std::string, std::vector<const RunRecord*>> groups;
+  for (const RunRecord& r : c.runs) {
+    char b[200];
+    std::snprintf(b, sizeof b, "%.9g|%.9g|%.4f,%.4f,%.4f|%.4f,%.4f,%.4f", r.frequency_Hz, r.amplitude_g, r.direction[0],
+                  r.direction[1], r.direction[2], r.orientation_g[0], r.orientation_g[1], r.orientation_g[2]);
+    groups[b].push_back(&r);
+  }
+  double chi2 = 0;
+  int dof = 0;
+  for (const auto& [k, g] : groups) {
+    if (g.size() < 2) continue;
+    double w = 0, m = 0;
+    for (const RunRecord* r : g) w += 1 / (r->sigma_g * r->sigma_g), m += r->measured_g / (r->sigma_g * r->sigma_g);
+    m /= w;
+    for (const RunRecord* r : g) chi2 += std::pow((r->measured_g - m) / r->sigma_g, 2);
+    dof += static_cast<int>(g.size()) - 1;
+  }
+  return {chi2, dof};
+}
+
+}  // namespace
+
+Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s) {
+  Campaign c = c0;
+  const Nuisance drift = remove_drift(c);
+  Diagnosis d = diagnose_once(c, s);
+  // The stated sigma: from repeated runs when there are enough (their scatter is the
+  // measurement's alone), else from the gaps no effect explains (the nominal's adjusted gaps
+  // when unexplained, the chosen effect's held-out ones when explained).
+  Nuisance scale;
+  scale.name = "sigma_scale", scale.unit = "1", scale.value = 1;
+  const int n = static_cast<int>(c.runs.size());
+  std::vector<double> z(static_cast<std::size_t>(n));
+  double z2 = 0;
+  for (int k = 0; k < n; ++k) {
+    const RunDiagnosis& rd = d.runs[static_cast<std::size_t>(k)];
+    const double sig = std::hypot(c.runs[static_cast<std::size_t>(k)].sigma_g, s.model_accuracy * rd.predicted_g);  // as rd.z's
+    z[static_cast<std::size_t>(k)] = d.explained ? rd.heldout_after_g / sig : rd.z;
+    z2 += z[static_cast<std::size_t>(k)] * z[static_cast<std::size_t>(k)];
+  }
+  const auto [rep_chi2, rep_dof] = repeat_scatter(c);
+  const auto [rho, pairs] = neighbour_correlation(c, z);
+  const double rho_sigma = rho * std::sqrt(std::max(pairs, 1));
+  // (The adjusted gaps have the coefficients' errors taken out under the static test's prior,
+  // not fitted freely: n degrees of freedom, a little fewer in truth, so k a little low.)
+  const int dof = n;
+  const bool from_repeats = rep_dof >= 5;
+  const double k2 = from_repeats ? rep_chi2 / rep_dof : z2 / dof;
+  const int kdof = from_repeats ? rep_dof : dof;
+  scale.estimated = true;
+  scale.value = std::sqrt(std::max(k2, 0.0));
+  scale.sigma = scale.value / std::sqrt(2.0 * kdof);
+  {
+    const std::string from = from_repeats ? std::string("from ").append(std::to_string(rep_dof)).append(" degrees of freedom of repeated runs")
+                             : d.explained ? std::string("from the gaps the chosen effect leaves (held out)")
+                                           : std::string("from the gaps no effect explains");
+    char buf[240];
+    std::snprintf(buf, sizeof buf, "%s; neighbouring runs' gaps correlate by %.2f (%.1f sigma over %d pairs)", from.c_str(), rho,
+                  rho_sigma, pairs);
+    scale.note = buf;
+  }
+  // Scaled when the excess is beyond chance (3 sigma of its own estimate) and it is scatter:
+  // measured by repeats, or a gap no effect explains whose neighbours are not alike.
+  const bool excess = scale.value > 1 + 3 * scale.sigma;
+  const bool scatter = from_repeats || (d.gap_significant && !d.explained && rho_sigma < s.structure_sigma);
+  if (excess && scatter && !(d.explained && !from_repeats)) {
+    Campaign scaled = c;
+    for (RunRecord& r : scaled.runs) r.sigma_g *= scale.value;
+    d = diagnose_once(scaled, s);
+    scale.applied = true;
+    char buf[80];
+    std::snprintf(buf, sizeof buf, " (sigma understated x%.2f; judged with the corrected sigma)", scale.value);
+    d.verdict += buf;
+  }
+  if (drift.applied && std::abs(drift.value) > 3 * drift.sigma) {
+    char buf[120];
+    std::snprintf(buf, sizeof buf, " (bias drift %.3g +- %.2g ug/h removed)", drift.value, drift.sigma);
+    d.verdict += buf;
+  }
+  d.nuisances = {drift, scale};
+  return d;
+}
+
+namespace {
+
+Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s) {
   if (c.statics.empty()) throw std::invalid_argument("diagnose: the campaign has no static readings");
   if (c.runs.empty()) throw std::invalid_argument("diagnose: the campaign has no usable shaker runs");
   Diagnosis d;
@@ -746,6 +911,80 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   } else {
     d.verdict = "not explained by any known effect";
   }
+  // Ambiguity: another single effect that also explains the gap with held-out evidence within
+  // ambiguity_evidence of the chosen one's (2 ln of their Bayes factor on the held-out runs).
+  if (d.explained && chosen.size() == 1) {
+    std::vector<std::string> tied = {best->fit.name};
+    for (const Scored& sc : scored)
+      if (&sc != best && best->fit.evidence - sc.fit.evidence < s.ambiguity_evidence && explains(sc, rms(sc.heldout)))
+        tied.push_back(sc.fit.name);
+    if (tied.size() > 1) {
+      d.ambiguous_with = tied;
+      d.verdict = "ambiguous between " + tied[0];
+      for (std::size_t i = 1; i < tied.size(); ++i) d.verdict += (i + 1 == tied.size() ? " and " : ", ") + tied[i];
+    }
+  }
+  // Advice on the next runs: for an ambiguous or unexplained gap, the runs (direction,
+  // frequency, amplitude, static orientation) where the candidates' predictions differ most,
+  // in a run's sigma (the campaign's median, with the model accuracy). The candidates: the
+  // ambiguous ones, else the three best by evidence, each at its fitted value; predicted from
+  // the identified coefficients (what the static test took up of an effect acting at rest is
+  // not given back here: a small part of such an effect's prediction).
+  if (s.advise_next_runs && d.gap_significant && (!d.ambiguous_with.empty() || !d.explained)) {
+    std::vector<std::pair<const Effect*, double>> cand;
+    if (!d.ambiguous_with.empty()) {
+      for (const auto& name : d.ambiguous_with)
+        for (const EffectFit& f : d.effects)
+          if (f.name == name) cand.emplace_back(find_effect(name), f.value);
+    } else {
+      for (std::size_t i = 0; i < std::min<std::size_t>(3, d.effects.size()); ++i)
+        cand.emplace_back(find_effect(d.effects[i].name), d.effects[i].value);
+    }
+    std::vector<double> sig;
+    for (const RunRecord& run : c.runs) sig.push_back(run.sigma_g);
+    std::nth_element(sig.begin(), sig.begin() + static_cast<std::ptrdiff_t>(sig.size() / 2), sig.end());
+    const double sigma_run = sig[sig.size() / 2];
+    const double amax = *std::max_element(amplitudes.begin(), amplitudes.end());
+    std::vector<NextRun> options;
+    const std::vector<Vec3> next_dirs = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 0).normalized(),
+                                    Vec3(1, 0, 1).normalized(), Vec3(0, 1, 1).normalized()};
+    const std::vector<Vec3> orients = {Vec3(1, 0, 1).normalized(), Vec3(-1, 0, 1).normalized(), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+    for (const Vec3& dir : next_dirs)
+      for (const Vec3& o : orients)
+        for (double a : {amax / 4, amax / 2, amax})
+          for (double f : {10.0, 30.0, 100.0, 300.0, 1000.0, 2000.0}) {
+            RunRecord run;
+            run.frequency_Hz = f, run.amplitude_g = a, run.direction = dir, run.orientation_g = o;
+            try {
+              const double p0 = predict_run_g(plant, run, nullptr, 0);
+              const double sg = std::hypot(sigma_run, s.model_accuracy * p0);
+              std::vector<double> pr;
+              for (const auto& [e, p] : cand) pr.push_back(predict_run_g(plant, run, e, p));
+              NextRun nr{f, a, dir, o, INFINITY, ""};
+              for (std::size_t i = 0; i < pr.size(); ++i)
+                for (std::size_t j = i + 1; j < pr.size(); ++j) {
+                  const double sep = std::abs(pr[i] - pr[j]) / sg;
+                  if (sep < nr.separation_sigma) nr.separation_sigma = sep, nr.between = cand[i].first->name + " vs " + cand[j].first->name;
+                }
+              if (std::isfinite(nr.separation_sigma)) options.push_back(nr);
+            } catch (const std::exception&) {  // a candidate's plant that cannot run there: not advised
+            }
+          }
+    std::sort(options.begin(), options.end(), [](const NextRun& x, const NextRun& y) { return x.separation_sigma > y.separation_sigma; });
+    // The best three, each a different direction or orientation where possible (else the next best).
+    for (const NextRun& nr : options) {
+      if (d.next_runs.size() == 3) break;
+      const bool alike = std::any_of(d.next_runs.begin(), d.next_runs.end(), [&](const NextRun& x) {
+        return (x.direction - nr.direction).norm() < 1e-9 && (x.orientation_g - nr.orientation_g).norm() < 1e-9;
+      });
+      if (!alike) d.next_runs.push_back(nr);
+    }
+    for (const NextRun& nr : options) {
+      if (d.next_runs.size() == 3) break;
+      if (std::none_of(d.next_runs.begin(), d.next_runs.end(), [&](const NextRun& x) { return &x == &nr || (x.frequency_Hz == nr.frequency_Hz && x.amplitude_g == nr.amplitude_g && (x.direction - nr.direction).norm() < 1e-9 && (x.orientation_g - nr.orientation_g).norm() < 1e-9); }))
+        d.next_runs.push_back(nr);
+    }
+  }
 
   // 5. Confirmation on the ODE plant: the runs with the largest gaps re-simulated with the
   // coefficients corrected by all runs (under the chosen effect) and the effect added, and
@@ -798,5 +1037,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s) {
   }
   return d;
 }
+
+}  // namespace
 
 }  // namespace vrelab::validation

@@ -50,6 +50,10 @@ struct RunRecord {
   Vec3 direction = Vec3::UnitX(), orientation_g = Vec3::UnitX();
   double measured_g = 0, sigma_g = 0;
   std::string where;
+  // The run's time in the campaign (h from its start; NaN: not given) and the output at rest
+  // just before it, over K1, against the reference the measured error is taken from (g; NaN:
+  // not given): a bias that drifts shows in both alike (docs/data-format.md, time_h, rest_ug).
+  double time_h = NAN, rest_g = NAN;
   vibration::SineVibration vibration() const;
 };
 
@@ -97,6 +101,15 @@ struct DiagnoseSettings {
   double explained_shrinkage = 0.9;
   int resimulate_runs = 12;             // runs (largest gaps first) re-simulated on the ODE; 0: none
   bool try_pairs = true;                // two effects at once when no one effect explains the gap
+  // Stated sigma too small: a significant gap that no effect explains and whose runs' gaps are
+  // not alike between neighbouring runs (the correlation of the gaps of runs one frequency or
+  // one amplitude step apart, as a normal deviate, below this) is scatter, not physics: the
+  // sigma is scaled by what the gaps say and the gap judged again.
+  double structure_sigma = 3.0;
+  // Two effects whose held-out evidence differs by less than this (2 ln of a Bayes factor;
+  // 6: "strong" on Kass and Raftery's scale) and that both explain the gap: "ambiguous".
+  double ambiguity_evidence = 6.0;
+  bool advise_next_runs = true;         // next_runs for an ambiguous or unexplained gap
   // False with `why` naming the setting (its field name), its value and the rule it breaks.
   bool IsValid(std::string* why) const;
 };
@@ -114,6 +127,27 @@ struct PairFit {
   std::string a, b;
   double pa = 0, pb = 0;         // their parameters, fitted on all runs
   double evidence = 0, heldout_chi2 = 0;
+};
+
+// A lab nuisance (not physics): estimated, removed or allowed for, and reported apart from
+// the effects. bias_drift: the rate of the rest readings' line over the campaign's time (ug/h),
+// removed from every run with a time; sigma_scale: the factor the stated sigma falls short by,
+// from repeated runs or from the gaps no effect explains.
+struct Nuisance {
+  std::string name, unit;
+  double value = 0, sigma = NAN;
+  bool estimated = false;  // the data allowed an estimate
+  bool applied = false;    // removed from the data (drift) or used to judge the gap (sigma)
+  std::string note;
+};
+
+// A run to add (what it would tell apart): the candidates' predictions differ there by
+// separation_sigma of a run's sigma (the campaign's median sigma and the model accuracy).
+struct NextRun {
+  double frequency_Hz = 0, amplitude_g = 0;
+  Vec3 direction = Vec3::UnitX(), orientation_g = Vec3::UnitX();
+  double separation_sigma = 0;
+  std::string between;  // "A vs B"
 };
 
 struct RunDiagnosis {
@@ -148,7 +182,12 @@ struct Diagnosis {
   std::string chosen;              // the best effect, or "A + B" when a pair explains the gap
   std::string folds;               // the cross-validation used
   bool explained = false;
-  std::string verdict;             // "no significant gap", "explained by <name>" (or "<A> + <B>"), "not explained by any known effect"
+  std::string verdict;             // "no significant gap", "explained by <name>" (or "<A> + <B>"), "not explained by any known effect",
+                                   // "ambiguous between <A> and <B>"; a nuisance applied is said after it
+  std::vector<Nuisance> nuisances;        // bias_drift, sigma_scale
+  std::vector<std::string> ambiguous_with;  // the effects that explain the gap equally well (empty: not ambiguous)
+  std::vector<NextRun> next_runs;         // best first; for an ambiguous or unexplained gap
+  const Nuisance* nuisance(const std::string& name) const;
   double rms_before_g = 0, rms_after_g = 0;          // held-out, over all runs
   double rms_before_sigma = 0, rms_after_sigma = 0;  // the same in units of each run's sigma
   // The confirmation on the ODE plant (the runs with the largest gaps; coefficients corrected

@@ -15,6 +15,31 @@ std::string heldout_line(const Diagnosis& d, double wall_s) {
                      wall_s >= 0 ? fmt::format(" ({:.1f} s wall)", wall_s) : "");
 }
 
+// The lab nuisances, one line each (not effects: estimated and removed or allowed for).
+std::string nuisance_lines(const Diagnosis& d) {
+  std::string t;
+  for (const auto& x : d.nuisances) {
+    if (!x.estimated) {
+      t += fmt::format("Nuisance {}: {}\n", x.name, x.note);
+      continue;
+    }
+    t += fmt::format("Nuisance {}: {:.4g} +- {:.2g} {}{}; {}\n", x.name, x.value, x.sigma, x.unit == "1" ? "" : x.unit,
+                     x.applied ? " (applied)" : "", x.note);
+  }
+  return t;
+}
+
+// The runs that would tell the candidates apart best.
+std::string next_run_lines(const Diagnosis& d) {
+  if (d.next_runs.empty()) return "";
+  std::string t = "Next runs (what tells the candidates apart best):\n";
+  for (const auto& r : d.next_runs)
+    t += fmt::format("  {:g} Hz, {:g} g along [{:.2g}, {:.2g}, {:.2g}], static a = [{:.2g}, {:.2g}, {:.2g}] g: {:.1f} sigma ({})\n",
+                     r.frequency_Hz, r.amplitude_g, r.direction[0], r.direction[1], r.direction[2], r.orientation_g[0],
+                     r.orientation_g[1], r.orientation_g[2], r.separation_sigma, r.between);
+  return t;
+}
+
 }  // namespace
 
 bool DiagnoseSettings::IsValid(std::string* why) const {
@@ -28,13 +53,21 @@ bool DiagnoseSettings::IsValid(std::string* why) const {
     w = fmt::format("explained_shrinkage = {}: a fraction of the held-out gap rms, in (0, 1]", s.explained_shrinkage);
   else if (s.resimulate_runs < 0)
     w = fmt::format("resimulate_runs = {}: must not be negative (0: none)", s.resimulate_runs);
+  else if (!(std::isfinite(s.structure_sigma) && s.structure_sigma > 0))
+    w = fmt::format("structure_sigma = {}: must be a positive number of sigma", s.structure_sigma);
+  else if (!(std::isfinite(s.ambiguity_evidence) && s.ambiguity_evidence >= 0))
+    w = fmt::format("ambiguity_evidence = {}: must be a non-negative evidence difference", s.ambiguity_evidence);
   if (why) *why = w;
   return w.empty();
 }
 
 std::string Diagnosis::BriefReport() const {
   const Diagnosis& d = *this;
-  return "Verdict: " + d.verdict + "\n" + heldout_line(d, -1);
+  std::string t = "Verdict: " + d.verdict + "\n" + heldout_line(d, -1);
+  for (const auto& x : d.nuisances)
+    if (x.applied && x.estimated && (x.name != "bias_drift" || std::abs(x.value) > 3 * x.sigma))
+      t += fmt::format("Nuisance {}: {:.4g} +- {:.2g} {}\n", x.name, x.value, x.sigma, x.unit == "1" ? "" : x.unit);
+  return t + next_run_lines(d);
 }
 
 std::string Diagnosis::FullReport(double wall_s) const {
@@ -55,6 +88,7 @@ std::string Diagnosis::FullReport(double wall_s) const {
                      "with it\n",
                      d.resimulated_runs, d.resimulated_rms_before_g * 1e6, d.chosen, d.resimulated_rms_after_g * 1e6);
   for (const auto& f : d.resimulation_failures) t += "  re-simulation failed: " + f + "\n";
+  t += nuisance_lines(d) + next_run_lines(d);
   return t;
 }
 
