@@ -10,6 +10,8 @@ namespace vrelab::io {
 
 using nlohmann::json;
 
+json nuisances_json(const validation::Diagnosis& d);
+
 namespace {
 
 json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
@@ -67,11 +69,16 @@ json campaign_row(const validation::BlindCampaign& k) {
   json row = {{"index", k.index}, {"seed", k.seed},           {"category", k.category}, {"hidden", h},
               {"called", k.called}, {"simulate_s", k.simulate_s}, {"wall_s", k.wall_s}};
   if (k.category == "single") row["effect_max_sigma"] = k.effect_max_sigma;
+  if (k.category == "sigma_understated") row["noise_scale"] = k.noise_scale;
+  if (k.category == "drift") row["drift_ug_per_h"] = k.drift_g_per_h * 1e6;
   if (k.error.empty()) {
     row["top"] = k.top;
     row["top_parameter"] = k.diagnosis.effects.front().value;
     row["rms_before_g"] = k.diagnosis.rms_before_g, row["rms_after_g"] = k.diagnosis.rms_after_g;
     row["where"] = k.diagnosis.where;
+    row["verdict"] = k.diagnosis.verdict;
+    row["nuisances"] = nuisances_json(k.diagnosis);
+    row["ambiguous_with"] = k.diagnosis.ambiguous_with;
   } else {
     row["error"] = k.error;
   }
