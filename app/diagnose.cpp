@@ -43,9 +43,10 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   bar.finish();
   io::write_atomic(o.out_dir + "/scores.json", io::json_text(io::to_json(r)));
   io::write_atomic(o.out_dir + "/confusion.csv", io::confusion_csv(r));
+  io::write_atomic(o.out_dir + "/report.html", io::blind_html(r));
   out << program() << r.FullReport();
   const std::string plot = io::run_plot_script("confusion.py", o.out_dir);
-  out << "Wrote " << o.out_dir << "/scores.json and confusion.csv"
+  out << "Wrote " << o.out_dir << "/scores.json, report.html and confusion.csv"
       << (plot.empty() ? ", confusion.png/svg" : "; figure skipped: " + plot) << "\n";
 }
 

@@ -1,5 +1,6 @@
 #include "io/diagnosis_json.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -256,6 +257,61 @@ std::string confusion_csv(const validation::BlindResult& r) {
     csv += "\n";
   }
   return csv;
+}
+
+namespace {
+std::string html_escape(const std::string& x) {
+  std::string o;
+  for (char ch : x) {
+    if (ch == '<') o += "&lt;";
+    else if (ch == '>') o += "&gt;";
+    else if (ch == '&') o += "&amp;";
+    else if (ch == '"') o += "&quot;";
+    else o += ch;
+  }
+  return o;
+}
+}  // namespace
+
+std::string blind_html(const validation::BlindResult& r) {
+  std::string h = "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>vrelab blind</title>\n"
+                  "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse;margin:1em 0}"
+                  "td,th{border:1px solid #999;padding:3px 8px;text-align:right}th{background:#eee}"
+                  "td.l,th.l{text-align:left}td.bad{background:#fcc}td.ok{background:#cfc}</style></head><body>\n";
+  h += fmt::format("<h1>blind --n {} --seed {}</h1>\n<p>{:.1f} s wall on {} threads. Each family scored apart: right; "
+                   "right physics, not the right effect; unexplained; no gap; confidently wrong (explained by an effect of "
+                   "another physics); ambiguous (the truth among them).</p>\n",
+                   r.settings.n, r.settings.seed, r.wall_s, r.threads);
+  h += "<h2>Per family</h2>\n<table><tr><th class=\"l\">family</th><th>n</th><th>right</th><th>right physics</th>"
+       "<th>unexplained</th><th>no gap</th><th>confidently wrong</th><th>ambiguous</th><th>(right among)</th><th>error</th></tr>\n";
+  for (const auto& [name, f] : r.scores.families)
+    h += fmt::format("<tr><td class=\"l\">{}</td><td>{}</td><td class=\"ok\">{}</td><td>{}</td><td>{}</td><td>{}</td>"
+                     "<td class=\"{}\">{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                     html_escape(name), f.n, f.right, f.family, f.unexplained, f.no_gap, f.wrong ? "bad" : "", f.wrong,
+                     f.ambiguous, f.right_among, f.error);
+  h += "</table>\n<h2>Confusion matrix</h2>\n<p>Rows: the hidden truth; columns: what diagnose called it (without the key).</p>\n";
+  std::vector<std::string> called;
+  for (const auto& [t, row] : r.confusion)
+    for (const auto& [c, k] : row)
+      if (std::find(called.begin(), called.end(), c) == called.end()) called.push_back(c);
+  std::sort(called.begin(), called.end());
+  h += "<table><tr><th class=\"l\">truth \\ called</th>";
+  for (const auto& c : called) h += "<th>" + html_escape(c) + "</th>";
+  h += "</tr>\n";
+  for (const auto& [t, row] : r.confusion) {
+    h += "<tr><td class=\"l\">" + html_escape(t) + "</td>";
+    for (const auto& c : called) {
+      const auto it = row.find(c);
+      const int k = it == row.end() ? 0 : it->second;
+      h += fmt::format("<td class=\"{}\">{}</td>", k && c == t ? "ok" : "", k ? std::to_string(k) : "");
+    }
+    h += "</tr>\n";
+  }
+  h += "</table>\n<h2>Every miss, with its why</h2>\n<ul>\n";
+  for (const auto& w : r.wrong) h += "<li>" + html_escape(w) + "</li>\n";
+  if (r.wrong.empty()) h += "<li>none</li>\n";
+  h += "</ul>\n</body></html>\n";
+  return h;
 }
 
 }  // namespace vrelab::io

@@ -24,5 +24,7 @@ nlohmann::json to_json(const validation::Diagnosis& d, const validation::Campaig
 nlohmann::json to_json(const FolderDiagnosis& f);
 nlohmann::json to_json(const validation::BlindResult& r);
 std::string confusion_csv(const validation::BlindResult& r);
+// `blind --out`'s report.html: the per-family table, the confusion matrix, every miss with why.
+std::string blind_html(const validation::BlindResult& r);
 
 }  // namespace vrelab::io

@@ -119,6 +119,25 @@ TEST(Blind, ConfusionCsvCountsPairVerdictsAsTwoEffects) {
   EXPECT_EQ(j["seed"], 11);
 }
 
+// blind --out's report.html: each family's row with its counts, the confusion matrix's cells,
+// every miss, the text escaped (a verdict or a note may hold < and &).
+TEST(Blind, HtmlReportHasTheFamiliesTheConfusionAndEveryMissEscaped) {
+  validation::BlindResult r;
+  r.settings.n = 5, r.settings.seed = 8;
+  validation::FamilyScore f;
+  f.n = 4, f.right = 2, f.family = 1, f.wrong = 1;
+  r.scores.families["single"] = f;
+  r.confusion["mechanical_mode"]["mechanical_mode"] = 2;
+  r.confusion["mechanical_mode"]["unexplained"] = 1;
+  r.wrong = {"[single] campaign 3: mode <1 kHz & more"};
+  const std::string h = io::blind_html(r);
+  EXPECT_NE(h.find("<td class=\"l\">single</td><td>4</td><td class=\"ok\">2</td><td>1</td><td>0</td><td>0</td><td class=\"bad\">1</td>"),
+            std::string::npos) << h;
+  EXPECT_NE(h.find("<td class=\"l\">mechanical_mode</td><td class=\"ok\">2</td><td class=\"\">1</td>"), std::string::npos) << h;
+  EXPECT_NE(h.find("<li>[single] campaign 3: mode &lt;1 kHz &amp; more</li>"), std::string::npos) << h;
+  EXPECT_EQ(h.find("<1 kHz"), std::string::npos);
+}
+
 // Numbers as a lab writes them: finite decimals only. strtod alone reads "0x1E" as 30, "inf"
 // and "nan" as themselves, and stops quietly at a decimal comma.
 TEST(CsvText, OnlyFiniteDecimalNumbersAreNumbers) {
