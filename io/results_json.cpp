@@ -215,7 +215,7 @@ json predict_json(const Case& c, const PredictStudy& s) {
     json ft = terms_json(fp.terms);
     ft["pickoff_nonlinearity"] = fp.pickoff_g;
     ft["pendulum_geometry"] = fp.pendulum_geometry_g;
-    j["frequency_dependent"] = {{"frequency_Hz", c.vibration->sine.frequency_Hz},
+    j["frequency_dependent"] = {{"frequency_Hz", c.vibration->type == "random" ? json(nullptr) : json(c.vibration->sine.frequency_Hz)},
                                 {"total_g", fp.total_g()},
                                 {"terms", ft},
                                 {"current_amplitude_g", std::abs(fp.current_amplitude_g)},

@@ -22,6 +22,7 @@
 #include "io/csv.hpp"
 #include "io/output.hpp"
 #include "io/results_json.hpp"
+#include "rectification/prediction/random.hpp"
 #include "rectification/simulation/sweep.hpp"
 #include "vrelab_version.hpp"
 
@@ -176,9 +177,12 @@ PredictStudy predict(const Case& c, bool frequency_dependent) {
   require(c, c.orientation_g.has_value(), "orientation", "predict");
   require(c, c.vibration.has_value(), "vibration", "predict");
   const VibrationSpec& vs = *c.vibration;
-  if (frequency_dependent && vs.type != "sine")
-    throw InputError(c.path + ": [vibration] type: --frequency-dependent takes a \"sine\" vibration");
-  if (frequency_dependent && !(vs.sine.frequency_Hz > 0))
+  const bool random_kind = vs.type == "random" || vs.type == "sine_on_random";
+  if (frequency_dependent && vs.type != "sine" && !random_kind)
+    throw InputError(c.path + ": [vibration] type: --frequency-dependent takes a \"sine\", \"random\" or \"sine_on_random\" vibration");
+  if (frequency_dependent && random_kind && !vs.psd)
+    throw InputError(c.path + ":" + std::to_string(vs.line) + ": [vibration] psd_IA: --frequency-dependent needs the random part as PSD tables (psd_IA, psd_PA, psd_OA), not rms_g");
+  if (frequency_dependent && vs.type != "random" && !(vs.sine.frequency_Hz > 0))
     throw InputError(c.path + ": [vibration] frequency_Hz: --frequency-dependent needs a positive frequency");
   PredictStudy s;
   s.terms = predict_terms(c);
@@ -192,7 +196,12 @@ PredictStudy predict(const Case& c, bool frequency_dependent) {
   if (vs.gaussian)
     s.description += fmt::format("{}Gaussian rms [{:g}, {:g}, {:g}] g", vs.type == "sine_on_random" ? " + " : ", ",
                                  vs.gaussian->rms_g[0], vs.gaussian->rms_g[1], vs.gaussian->rms_g[2]);
-  if (frequency_dependent)
+  if (frequency_dependent && vs.type == "random")
+    s.at_frequency = rectification::random_rectification_at_frequency(c.plant, *c.orientation_g, *vs.psd, c.range_limit_g);
+  else if (frequency_dependent && vs.type == "sine_on_random")
+    s.at_frequency = rectification::sine_on_random_rectification_at_frequency(c.plant, *c.orientation_g, vs.sine, *vs.psd,
+                                                                               c.range_limit_g);
+  else if (frequency_dependent)
     s.at_frequency = rectification::sine_rectification_at_frequency(c.plant, *c.orientation_g, vs.sine, c.range_limit_g);
   return s;
 }
@@ -202,11 +211,17 @@ namespace {
 std::string predict_at_frequency_report(const Case& c, const PredictStudy& s) {
   const VibrationSpec& vs = *c.vibration;
   const rectification::FrequencyPrediction& fp = *s.at_frequency;
-  std::string out = fmt::format(
-      "At {:g} Hz through the plant's dynamics ({}): current amplitude |I| = {:.6g} g per {:g} g on IA, "
-      "pendulum angle |Theta| = {:.4g} rad\n",
-      vs.sine.frequency_Hz, c.physical ? "physical parameters" : "from coefficients", std::abs(fp.current_amplitude_g),
-      vs.sine.amplitude_g[IA], std::abs(fp.angle_amplitude_rad));
+  std::string out;
+  if (vs.type == "sine")
+    out = fmt::format(
+        "At {:g} Hz through the plant's dynamics ({}): current amplitude |I| = {:.6g} g per {:g} g on IA, "
+        "pendulum angle |Theta| = {:.4g} rad\n",
+        vs.sine.frequency_Hz, c.physical ? "physical parameters" : "from coefficients", std::abs(fp.current_amplitude_g),
+        vs.sine.amplitude_g[IA], std::abs(fp.angle_amplitude_rad));
+  else
+    out = fmt::format("Through the plant's dynamics ({}): the {} motion's PSD filtered by the loop, each term's Gaussian "
+                      "expectation (docs/frequency.md, random motion)\n",
+                      c.physical ? "physical parameters" : "from coefficients", vs.type == "random" ? "random" : "sine-on-random");
   out += fmt::format("  {:<20}{:>14}{:>16}\n", "term", "quasi-static", "at frequency");
   for (int t = 0; t < rectification::kNumTerms; ++t) {
     if (t == rectification::t_clipping && !c.range_limit_g) continue;
