@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "io/output.hpp"
+#include "rectification/measurement/vrc.hpp"
 
 namespace vrelab::io {
 
@@ -42,6 +43,9 @@ json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
                     {"sigma_measured_g", r.sigma_g},
                     {"predicted_g", x.predicted_g},
                     {"sigma_predicted_g", x.sigma_predicted_g},
+                    {"input_rms_g", rectification::input_rms_g(r.vibration())},
+                    {"measured_vrc_ug_per_g2", rectification::vrc_ug_per_g2(r.measured_g, rectification::input_rms_g(r.vibration()))},
+                    {"predicted_vrc_ug_per_g2", rectification::vrc_ug_per_g2(x.predicted_g, rectification::input_rms_g(r.vibration()))},
                     {"gap_g", x.gap_g},
                     {"adjusted_gap_g", x.adjusted_gap_g},
                     {"z", x.z},

@@ -22,6 +22,7 @@
 #include "io/csv.hpp"
 #include "io/output.hpp"
 #include "io/results_json.hpp"
+#include "rectification/measurement/vrc.hpp"
 #include "rectification/prediction/random.hpp"
 #include "rectification/simulation/sweep.hpp"
 #include "vrelab_version.hpp"
@@ -258,6 +259,13 @@ std::string predict_report(const Case& c, const PredictStudy& s) {
     out += fmt::format("Eq. (3) as printed in the paper gives {:.6f} ug (differs by {:.6f} ug)\n", *s.printed_g * 1e6,
                        (*s.printed_g - total) * 1e6);
   if (s.at_frequency) out += predict_at_frequency_report(c, s);
+  const double rms = vibration_input_rms_g(*c.vibration);
+  if (rms > 0)
+    out += fmt::format("VRC = error / (input rms)^2, input rms {:.6g} g: {:.6g} ug/g^2 quasi-static{}\n", rms,
+                       rectification::vrc_ug_per_g2(total, rms),
+                       s.at_frequency ? fmt::format(", {:.6g} ug/g^2 through the dynamics",
+                                                    rectification::vrc_ug_per_g2(s.at_frequency->total_g(), rms))
+                                      : std::string());
   return out;
 }
 
@@ -399,6 +407,10 @@ std::string shake_report(const Case& c, const ShakeStudy& s) {
   out += fmt::format("  eq. (3) corrected, truth   {:>14.6f} ug\n", p * 1e6);
   out += fmt::format("  measured - eq. (3)         {:>14.6f} ug ({:+.4g} %)\n", (r.measured_g - p) * 1e6,
                      p != 0 ? 100 * (r.measured_g / p - 1) : 0.0);
+  if (const double rms = vibration_input_rms_g(*c.vibration); rms > 0)
+    out += fmt::format("  VRC (input rms {:.6g} g)      {:>14.6f} ug/g^2 +/- {:.3g} (eq. (3): {:.6f})\n", rms,
+                       rectification::vrc_ug_per_g2(r.measured_g, rms), rectification::vrc_ug_per_g2(r.sigma_g, rms),
+                       rectification::vrc_ug_per_g2(p, rms));
   out += fmt::format("  solver: {} steps, {} right-hand sides, {:.3g} s wall, {:.3g} s CPU; path: {}\n", r.steps,
                      r.rhs_evaluations, s.wall_s, s.cpu_s, r.path);
   return out;
@@ -433,6 +445,10 @@ std::string measure_report(const MeasureStudy& s) {
   out += fmt::format("  vibration error          {:>14.6f} ug  +/- {:.3g} ug (1 sigma, batch means of {} blocks)\n",
                      r.measured_g * 1e6, r.sigma_g * 1e6, w.blocks);
   out += fmt::format("  running-integral slope   {:>14.6f} ug\n", r.integral_slope_g * 1e6);
+  if (w.input_rms_g > 0)
+    out += fmt::format("  VRC (input rms {:g} g)   {:>14.6f} ug/g^2 +/- {:.3g}\n", w.input_rms_g,
+                       rectification::vrc_ug_per_g2(r.measured_g, w.input_rms_g),
+                       rectification::vrc_ug_per_g2(r.sigma_g, w.input_rms_g));
   return out;
 }
 

@@ -26,6 +26,7 @@ void SeriesWindows::validate() const {
     throw std::invalid_argument("vibration interval: shorter than one period of frequency_Hz");
   if (!(K1 > 0) || !finite(K1)) throw std::invalid_argument("K1 must be positive");
   if (blocks < 2) throw std::invalid_argument("blocks must be at least 2");
+  if (!(input_rms_g >= 0) || !finite(input_rms_g)) throw std::invalid_argument("input_rms_g must not be negative (0: not given)");
   if (on_from_s < baseline_to_s && baseline_from_s < on_to_s)
     throw std::invalid_argument("the vibration interval overlaps the baseline interval");
 }

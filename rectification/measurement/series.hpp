@@ -20,6 +20,7 @@ struct SeriesWindows {
   double frequency_Hz = 0;  // > 0: the vibration interval is cut to whole periods from on_from_s
   double K1 = 1.0;
   int blocks = 4;
+  double input_rms_g = 0;  // > 0: the input's rms (g), for the VRC in the report; 0: unknown
   // Throws std::invalid_argument naming the field.
   void validate() const;
   // False (with validate()'s reason in *why) for windows no measurement can use.
