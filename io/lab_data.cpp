@@ -400,7 +400,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
         int ln = 0;
         std::size_t tcol = 0, ucol = 1, columns = 0;
         bool header = false;
-        double last_t = -INFINITY;
+        double last_t = -INFINITY, first_dt = 0;
         while (std::getline(in, line)) {
           ++ln;
           check_text_line(line, ln, spath);
@@ -431,10 +431,12 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
           }
           const double t = *tx, u = *ux;
           if (!(t > last_t)) throw std::invalid_argument(fmt::format("{}:{}: time does not increase", spath, ln));
+          if (std::isfinite(last_t) && first_dt == 0) first_dt = t - last_t;  // as SeriesMeasurer detects it
           last_t = t;
           meas.add(t, u);
         }
-        if (last_t < *ot)
+        // Half-open windows, decided as `measure` does (rectification/measurement/series.hpp).
+        if (!rectification::record_covers_window_end(rectification::used_on_to_s(win), last_t, first_dt))
           throw std::invalid_argument(fmt::format("{}: the record ends at {:g} s, before on_to_s = {:g} s", spath, last_t, *ot));
         const rectification::SeriesResult res = meas.finish();
         r.measured_g = res.measured_g, r.sigma_g = res.sigma_g;
