@@ -84,9 +84,15 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
   RandomResponse out;
   out.from_Hz = knots.front();
   out.to_Hz = knots.back();
+  if (q.common_grid) {  // the global grid exp(k h), cut at the band's ends only
+    const double h = q.max_log_step, l0 = std::log(out.from_Hz), l1 = std::log(out.to_Hz);
+    knots = {out.from_Hz};
+    for (double k = std::floor(l0 / h) + 1; k * h < l1; ++k) knots.push_back(std::exp(k * h));
+    knots.push_back(out.to_Hz);
+  }
   for (std::size_t k = 0; k + 1 < knots.size(); ++k) {
     const double l0 = std::log(knots[k]), l1 = std::log(knots[k + 1]);
-    const int pieces = std::max(1, static_cast<int>(std::ceil((l1 - l0) / q.max_log_step)));
+    const int pieces = std::max(1, static_cast<int>(std::ceil((l1 - l0) / q.max_log_step - 1e-9)));
     const double h = (l1 - l0) / pieces;
     for (int m = 0; m < pieces; ++m) {
       const double mid = l0 + (m + 0.5) * h;

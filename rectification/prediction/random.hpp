@@ -51,8 +51,13 @@ struct RandomResponse {
 
 // Quadrature settings: each interval between table breakpoints is cut into pieces no wider
 // than max_log_step in ln f, each integrated by 8-point Gauss-Legendre.
+// With common_grid the pieces are instead [k h, (k + 1) h] in ln f (h = max_log_step) cut
+// only at the band's ends, so that tables with the same band share their frequencies (and a
+// cache of loop responses serves them all); a breakpoint inside a piece then costs O(h^2)
+// locally (~1e-4 relative at h = 0.1 on the standard tables).
 struct RandomQuadrature {
   double max_log_step = 0.02;
+  bool common_grid = false;
 };
 
 // The one-sided cross-spectral density S(f) of the profile, g^2/Hz (real: the synthesis

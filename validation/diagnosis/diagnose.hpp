@@ -30,6 +30,7 @@
 #include "validation/identification/uncertainty.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/profile.hpp"
+#include "vibration/random.hpp"
 
 namespace vrelab::validation {
 
@@ -50,6 +51,11 @@ struct RunRecord {
   Vec3 direction = Vec3::UnitX(), orientation_g = Vec3::UnitX();
   double measured_g = 0, sigma_g = 0;
   std::string where;
+  // Random and sine-on-random runs (docs/data-format.md): the random part, one PSD table per
+  // sensor axis. For a random run (sine_part false) frequency_Hz, amplitude_g and direction
+  // only describe it (the PSD's mean frequency, sqrt(2) x its rms, each axis's rms share).
+  std::optional<vibration::RandomProfile> random;
+  bool sine_part = true;
   vibration::SineVibration vibration() const;
 };
 
