@@ -301,10 +301,18 @@ json measure_json(const MeasureStudy& s) {
   j["sigma_g"] = r.sigma_g;
   j["integral_slope_g"] = r.integral_slope_g;
   j["baseline_g"] = r.baseline_g;
-  // Given with --input-rms-g (a record of the output alone does not know its input); else null.
-  j["input_rms_g"] = w.input_rms_g > 0 ? json(w.input_rms_g) : json(nullptr);
-  j["vrc_ug_per_g2"] = vrc_json(r.measured_g, w.input_rms_g);
-  j["sigma_vrc_ug_per_g2"] = vrc_json(r.sigma_g, w.input_rms_g);
+  // Given with --input-rms-g, else measured by the record's reference channels (ref_*_g or
+  // input_*_g columns); else null (a record of the output alone does not know its input).
+  const double rms = s.vrc_input_rms_g();
+  j["input_rms_g"] = rms > 0 ? json(rms) : json(nullptr);
+  j["input_rms_source"] = w.input_rms_g > 0 ? json("given") : rms > 0 ? json("reference_channels") : json(nullptr);
+  j["vrc_ug_per_g2"] = vrc_json(r.measured_g, rms);
+  j["sigma_vrc_ug_per_g2"] = vrc_json(r.sigma_g, rms);
+  if (s.reference) {
+    json axes = json::array();
+    for (int i = 0; i < 3; ++i) axes.push_back(s.reference_axes[static_cast<std::size_t>(i)]);
+    j["reference"] = {{"axes_present", axes}, {"rms_g", vec_json(s.reference_rms_g)}, {"input_rms_g", s.reference_input_rms_g}};
+  }
   j["samples"] = {{"on", r.samples_on}, {"baseline", r.samples_baseline}};
   j["sample_rate_Hz"] = r.sample_rate_Hz;
   return j;

@@ -424,7 +424,22 @@ MeasureStudy measure(const std::string& series_path, const std::string& column, 
   s.path = series_path;
   s.windows = w;
   rectification::SeriesMeasurer m(w);
-  s.column = read_series_csv(series_path, column, [&m](double t, double u) { m.add(t, u); });
+  // Reference channels: sums over the vibration window as the measurement reads it, [from, to).
+  const double on_from = w.on_from_s, on_to = rectification::used_on_to_s(w);
+  long n_ref = 0;
+  Vec3 sum = Vec3::Zero(), sum2 = Vec3::Zero();
+  const ReferenceSink ref = [&](double t, const std::array<double, 3>& g, const std::array<bool, 3>& present) {
+    s.reference = true, s.reference_axes = present;
+    if (t < on_from || t >= on_to) return;
+    ++n_ref;
+    for (int i = 0; i < 3; ++i) sum[i] += g[static_cast<std::size_t>(i)], sum2[i] += g[static_cast<std::size_t>(i)] * g[static_cast<std::size_t>(i)];
+  };
+  s.column = read_series_csv(series_path, column, [&m](double t, double u) { m.add(t, u); }, ref);
+  if (n_ref > 1) {
+    const double n = static_cast<double>(n_ref);
+    for (int i = 0; i < 3; ++i) s.reference_rms_g[i] = std::sqrt(std::max(0.0, sum2[i] / n - (sum[i] / n) * (sum[i] / n)));
+    s.reference_input_rms_g = s.reference_rms_g.norm();
+  }
   try {
     s.result = m.finish();
   } catch (const std::invalid_argument& e) {
@@ -445,10 +460,13 @@ std::string measure_report(const MeasureStudy& s) {
   out += fmt::format("  vibration error          {:>14.6f} ug  +/- {:.3g} ug (1 sigma, batch means of {} blocks)\n",
                      r.measured_g * 1e6, r.sigma_g * 1e6, w.blocks);
   out += fmt::format("  running-integral slope   {:>14.6f} ug\n", r.integral_slope_g * 1e6);
-  if (w.input_rms_g > 0)
-    out += fmt::format("  VRC (input rms {:g} g)   {:>14.6f} ug/g^2 +/- {:.3g}\n", w.input_rms_g,
-                       rectification::vrc_ug_per_g2(r.measured_g, w.input_rms_g),
-                       rectification::vrc_ug_per_g2(r.sigma_g, w.input_rms_g));
+  if (s.reference)
+    out += fmt::format("Reference channels over the vibration window: rms [{:.6g}, {:.6g}, {:.6g}] g, magnitude {:.6g} g\n",
+                       s.reference_rms_g[0], s.reference_rms_g[1], s.reference_rms_g[2], s.reference_input_rms_g);
+  if (const double rms = s.vrc_input_rms_g(); rms > 0)
+    out += fmt::format("  VRC (input rms {:g} g, {})   {:>14.6f} ug/g^2 +/- {:.3g}\n", rms,
+                       w.input_rms_g > 0 ? "given" : "reference channels", rectification::vrc_ug_per_g2(r.measured_g, rms),
+                       rectification::vrc_ug_per_g2(r.sigma_g, rms));
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -90,4 +91,37 @@ TEST(Vrc, ShakeAndMeasureReportTheSameCoefficientAsTheirErrors) {
   mo.input_rms_g = 0;  // not given: null
   run_measure(mo, text);
   EXPECT_TRUE(json::parse(read_file(mo.json_path))["vrc_ug_per_g2"].is_null());
+}
+
+// Reference channels: `vrelab shake --series` writes the table's motion (input_*_g); measure
+// reads it over the vibration window and takes its rms for the VRC. The shipped lab case is an
+// 80 Hz sine of peak amplitude_g: over whole periods sampled at 80 points a period the rms is
+// the exact amplitude / sqrt(2) (the discrete mean of sin^2 over whole periods is 1/2), so the
+// measured VRC equals shake's (same record, same error) to rounding.
+TEST(Vrc, MeasureTakesTheInputRmsFromTheRecordsReferenceChannels) {
+  TempDir d;
+  const std::string text0 = read_file(fs::path(VRELAB_CASES_DIR) / "shake-sine-lab.toml");
+  const fs::path c = d.path / "lab.toml";
+  std::ofstream(c) << std::regex_replace(text0, std::regex("min_measure_s = 2.0"), "min_measure_s = 0.5");
+  ShakeOptions so;
+  so.case_path = c.string();
+  so.json_path = (d.path / "shake.json").string();
+  so.series_path = (d.path / "ts.csv").string();
+  std::ostringstream text;
+  run_shake(so, text);
+  const json shake = json::parse(read_file(so.json_path));
+  const double settle = shake["measurement"]["settle_s"].get<double>();
+  const double span = shake["measurement"]["periods"].get<double>() / 80.0;
+  MeasureOptions mo;
+  mo.series_path = so.series_path;
+  mo.json_path = (d.path / "measure.json").string();
+  mo.on_s = {settle, settle + span};
+  mo.baseline_s = {-span, 0.0};
+  mo.frequency_Hz = 80;
+  mo.K1 = 1.25;
+  run_measure(mo, text);
+  const json m = json::parse(read_file(mo.json_path));
+  EXPECT_EQ(m["input_rms_source"], "reference_channels");
+  EXPECT_NEAR(m["input_rms_g"].get<double>(), shake["input_rms_g"].get<double>(), 1e-9 * shake["input_rms_g"].get<double>());
+  EXPECT_NEAR(m["vrc_ug_per_g2"].get<double>(), 1e6 * m["measured_g"].get<double>() / std::pow(m["input_rms_g"].get<double>(), 2), 1e-9);
 }
