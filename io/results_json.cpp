@@ -391,7 +391,11 @@ json reproduce_confirmation_json(const Case& c, const validation::ReproduceSetti
           {"integral_slope_straight_line_g", cf.shake.integral_slope_g},
           {"oscillation_amplitude_g_s", cf.oscillation_amplitude_g_s},
           {"predicted_g", cf.predicted.value_g},
-          {"sigma_predicted_g", cf.predicted.sigma_g}};
+          {"sigma_predicted_g", cf.predicted.sigma_g},
+          // A sine of peak amplitude_g along the direction: input rms amplitude_g / sqrt(2).
+          {"input_rms_g", s.confirmation_amplitude_g / std::numbers::sqrt2},
+          {"measured_vrc_ug_per_g2", vrc_json(cf.shake.measured_g, s.confirmation_amplitude_g / std::numbers::sqrt2)},
+          {"predicted_vrc_ug_per_g2", vrc_json(cf.predicted.value_g, s.confirmation_amplitude_g / std::numbers::sqrt2)}};
 }
 
 namespace {
