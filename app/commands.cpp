@@ -76,7 +76,7 @@ void run_measure(const MeasureOptions& o, std::ostream& out) {
   rectification::SeriesWindows w;
   w.on_from_s = o.on_s[0], w.on_to_s = o.on_s[1];
   w.baseline_from_s = o.baseline_s[0], w.baseline_to_s = o.baseline_s[1];
-  w.frequency_Hz = o.frequency_Hz, w.K1 = o.K1, w.blocks = o.blocks;
+  w.frequency_Hz = o.frequency_Hz, w.K1 = o.K1, w.blocks = o.blocks, w.input_rms_g = o.input_rms_g;
   const MeasureStudy s = measure(o.series_path, o.column, w);
   out << measure_report(s);
   write_json(o.json_path, measure_json(s));

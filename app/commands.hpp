@@ -47,6 +47,7 @@ struct MeasureOptions {
   double K1 = 1;
   std::string column;  // output column name; default the last column
   int blocks = 4;
+  double input_rms_g = 0;  // > 0: the VRC is reported too
 };
 void run_measure(const MeasureOptions& o, std::ostream& out);
 

@@ -93,6 +93,8 @@ Command add_measure(CLI::App& app) {
   cmd->add_option("--K1", o.K1, "Scale factor, output units per g (default 1: output in g)");
   cmd->add_option("--column", o.column, "Output column name (default: the last column)");
   cmd->add_option("--blocks", o.blocks, "Blocks for the batch-means uncertainty (default 4)");
+  cmd->add_option("--input-rms-g", o.input_rms_g,
+                  "The input's rms in g (magnitude over the axes): the VRC, error / rms^2 in ug/g^2, is reported too");
   cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
   return {cmd, [owned] {
             run_measure(*owned, std::cout);

@@ -189,17 +189,25 @@ int series_column(const std::vector<std::string>& header, const std::string& nam
 
 std::string read_series_csv(const std::string& path, const std::string& column_name,
                             const std::function<void(double, double)>& sample) {
+  return read_series_csv(path, column_name, sample, {});
+}
+
+std::string read_series_csv(const std::string& path, const std::string& column_name,
+                            const std::function<void(double, double)>& sample, const ReferenceSink& reference) {
   std::ifstream in(path);
   if (!in) throw InputError(path + ": cannot open the series (no such file?)");
-  return read_series_csv(in, path, column_name, sample);
+  return read_series_csv(in, path, column_name, sample, reference);
 }
 
 std::string read_series_csv(std::istream& in, const std::string& path, const std::string& column_name,
-                            const std::function<void(double, double)>& sample) {
+                            const std::function<void(double, double)>& sample, const ReferenceSink& reference) {
   std::string line, name;
   long line_no = 0;
   std::size_t column = 0;
   std::vector<std::string> header;
+  std::array<std::size_t, 3> ref_col{};
+  std::array<bool, 3> ref_present{};
+  bool any_ref = false;
   while (std::getline(in, line)) {
     ++line_no;
     check_text_line(line, line_no, path);
@@ -216,6 +224,13 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
       header = f;
       column = static_cast<std::size_t>(series_column(header, column_name, where));
       name = header[column];
+      static const std::array<const char*, 3> axes{"IA", "PA", "OA"};
+      for (std::size_t i = 0; i < 3 && reference; ++i)
+        for (const std::string prefix : {"ref_", "input_"}) {
+          const auto it = std::find(header.begin(), header.end(), prefix + axes[i] + "_g");
+          if (it != header.end() && !ref_present[i]) ref_col[i] = static_cast<std::size_t>(it - header.begin()), ref_present[i] = true;
+        }
+      any_ref = ref_present[0] || ref_present[1] || ref_present[2];
       continue;
     }
     if (f.size() != header.size())
@@ -236,6 +251,18 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
       sample(value[0], value[1]);
     } catch (const std::invalid_argument& e) {
       throw InputError(fmt::format("{}: {} (t = {}, {} = {})", where, e.what(), f[0], name, f[column]));
+    }
+    if (any_ref) {
+      std::array<double, 3> ref{};
+      for (std::size_t i = 0; i < 3; ++i) {
+        if (!ref_present[i]) continue;
+        const auto x = parse_decimal(f[ref_col[i]]);
+        if (!x)
+          throw InputError(fmt::format("{}: reference column {} ('{}'): {}", where, header[ref_col[i]], f[ref_col[i]],
+                                       why_not_decimal(f[ref_col[i]])));
+        ref[i] = *x;
+      }
+      reference(value[0], ref, ref_present);
     }
   }
   if (header.empty()) throw InputError(path + ": no header line and no samples");

@@ -7,6 +7,7 @@
 // mark, as Excel's "CSV UTF-8" writes it, is dropped); numbers are finite decimals
 // (parse_decimal); the separator is ',' (a header split by ';' is refused with a hint).
 #include <cstddef>
+#include <array>
 #include <functional>
 #include <iosfwd>
 #include <optional>
@@ -52,8 +53,16 @@ std::string closest_name(const std::string& name, const std::vector<std::string>
 // file and the line.
 std::string read_series_csv(const std::string& path, const std::string& column,
                             const std::function<void(double t_s, double value)>& sample);
+// Reference-accelerometer channels (the table's measured motion, g, sensor axes): columns
+// ref_IA_g, ref_PA_g, ref_OA_g, or input_IA_g, input_PA_g, input_OA_g as `vrelab shake
+// --series` writes the virtual table's motion (ref_ preferred), any of the three; `present`
+// says which the header has. Called per row after `sample` when the header has any.
+using ReferenceSink = std::function<void(double t_s, const std::array<double, 3>& ref_g, const std::array<bool, 3>& present)>;
 // The same from a stream (`path` only names it in messages): the in-memory entry point.
 std::string read_series_csv(std::istream& in, const std::string& path, const std::string& column,
-                            const std::function<void(double t_s, double value)>& sample);
+                            const std::function<void(double t_s, double value)>& sample,
+                            const ReferenceSink& reference = {});
+std::string read_series_csv(const std::string& path, const std::string& column,
+                            const std::function<void(double t_s, double value)>& sample, const ReferenceSink& reference);
 
 }  // namespace vrelab::io

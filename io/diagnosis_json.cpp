@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "io/output.hpp"
+#include "rectification/measurement/vrc.hpp"
 
 namespace vrelab::io {
 
@@ -31,6 +32,16 @@ json effects_json(const validation::Diagnosis& d) {
   return effects;
 }
 
+// The run's input rms for the VRC (rectification/measurement/vrc.hpp): the sine's, the random
+// part's, or both added.
+double run_input_rms_g(const validation::RunRecord& r) {
+  double s2 = r.sine_part ? std::pow(rectification::input_rms_g(r.vibration()), 2) : 0.0;
+  if (r.random)
+    for (const auto& t : r.random->psd)
+      if (t) s2 += std::pow(vibration::rms_g(*t), 2);
+  return std::sqrt(s2);
+}
+
 json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
   json runs = json::array();
   for (std::size_t k = 0; k < c.runs.size(); ++k) {
@@ -45,6 +56,9 @@ json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
                     {"sigma_measured_g", r.sigma_g},
                     {"predicted_g", x.predicted_g},
                     {"sigma_predicted_g", x.sigma_predicted_g},
+                    {"input_rms_g", run_input_rms_g(r)},
+                    {"measured_vrc_ug_per_g2", rectification::vrc_ug_per_g2(r.measured_g, run_input_rms_g(r))},
+                    {"predicted_vrc_ug_per_g2", rectification::vrc_ug_per_g2(x.predicted_g, run_input_rms_g(r))},
                     {"gap_g", x.gap_g},
                     {"adjusted_gap_g", x.adjusted_gap_g},
                     {"z", x.z},

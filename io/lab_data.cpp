@@ -1,6 +1,7 @@
 #include "io/lab_data.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -124,6 +125,44 @@ void require_columns(const Csv& csv, const std::vector<std::string>& cols, const
     if (!csv.has(c))
       throw InputError(fmt::format("{}: the header lacks column '{}'{}{}", csv.path, c, hint, columns_found(csv, c)));
 }
+
+// A random run's PSD file (docs/data-format.md): frequency_Hz and psd_<axis>_g2_per_Hz for
+// the axes that move (a missing column: that axis at rest); breakpoints, straight lines on
+// log-log axes between them. Bad content throws InputError naming the file, line and column.
+vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling) {
+  const Csv csv = read_csv(path);
+  require_columns(csv, {"frequency_Hz"});
+  static const std::array<std::string, 3> cols{"psd_IA_g2_per_Hz", "psd_PA_g2_per_Hz", "psd_OA_g2_per_Hz"};
+  vibration::RandomProfile p;
+  p.coupling = coupling == "independent" ? vibration::AxisCoupling::independent : vibration::AxisCoupling::common;
+  bool any = false;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!csv.has(cols[i])) continue;
+    any = true;
+    vibration::PsdTable t;
+    for (const auto& row : csv.rows) {
+      std::string why;
+      const auto f = number(csv, row, "frequency_Hz", &why), g = number(csv, row, cols[i], &why);
+      if (!f || !g) throw InputError(why);
+      if (!(*f > 0) || (!t.rows.empty() && !(*f > t.rows.back().frequency_Hz)))
+        throw InputError(fmt::format("{}:{}: column frequency_Hz: {:g} must be positive and above the previous row's", path,
+                                     row.first, *f));
+      if (!(*g > 0))
+        throw InputError(fmt::format("{}:{}: column {}: {:g} must be positive (an axis at rest: leave its column out)", path,
+                                     row.first, cols[i], *g));
+      t.rows.push_back(vibration::PsdRow::level(*f, *g));
+    }
+    try {
+      vibration::validate(t);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: column {}: {}", path, cols[i], e.what()));
+    }
+    p.psd[i] = t;
+  }
+  if (!any) throw InputError(path + ": the header needs at least one of psd_IA_g2_per_Hz, psd_PA_g2_per_Hz, psd_OA_g2_per_Hz");
+  return p;
+}
+
 
 // The output column of a file must carry the manifest's unit: output_<unit>, sigma_<unit>.
 void require_unit(const Csv& csv, const std::string& prefix, const std::string& unit) {
@@ -349,18 +388,66 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     validation::RunRecord r;
     r.id = idc;
     r.where = fmt::format("{}:{}", rn.path, row.first);
-    const auto f = get("frequency_Hz"), a = get("amplitude_g"), d0 = get("d_IA"), d1 = get("d_PA"), d2 = get("d_OA"),
-               o0 = get("a_IA_g"), o1 = get("a_PA_g"), o2 = get("a_OA_g");
-    if (!f || !a || !d0 || !d1 || !d2 || !o0 || !o1 || !o2) {
+    // The run's kind (optional column, default sine) and, for random ones, the PSD file.
+    auto cell = [&](const std::string& col) {
+      return rn.has(col) && rn.column.at(col) < row.second.size() ? row.second[rn.column.at(col)] : std::string();
+    };
+    std::string kind = cell("kind");
+    if (kind.empty()) kind = "sine";
+    if (kind != "sine" && kind != "random" && kind != "sine_on_random") {
+      c.skipped.push_back(fmt::format("{}:{}: column kind: must be sine, random or sine_on_random, got '{}'", rn.path,
+                                      row.first, kind));
+      continue;
+    }
+    if (kind != "sine") {
+      const std::string coupling = cell("coupling").empty() ? "common" : cell("coupling");
+      if (coupling != "common" && coupling != "independent") {
+        c.skipped.push_back(fmt::format("{}:{}: column coupling: must be common or independent, got '{}'", rn.path,
+                                        row.first, coupling));
+        continue;
+      }
+      if (cell("psd").empty()) {
+        c.skipped.push_back(fmt::format("{}:{}: column psd: a {} run needs its PSD file", rn.path, row.first, kind));
+        continue;
+      }
+      try {
+        r.random = read_psd_file((fs::path(dir) / cell("psd")).string(), coupling);
+      } catch (const InputError& e) {
+        c.skipped.push_back(label + ": " + e.what());
+        continue;
+      }
+      r.sine_part = kind == "sine_on_random";
+    }
+    const auto o0 = get("a_IA_g"), o1 = get("a_PA_g"), o2 = get("a_OA_g");
+    if (!o0 || !o1 || !o2) {
       c.skipped.push_back(named + ": " + why);
       continue;
     }
-    const Vec3 d(*d0, *d1, *d2);
-    if (!(*f > 0) || !(*a > 0) || !(d.norm() > 0)) {
-      c.skipped.push_back(label + ": frequency, amplitude and direction must be positive / non-zero");
-      continue;
+    if (kind == "random") {
+      // No sine: frequency, amplitude and direction describe the PSD (its mean frequency,
+      // sqrt(2) x its rms, each axis's rms share); the row's cells are not read.
+      Vec3 rms = Vec3::Zero();
+      double moment1 = 0;
+      for (int i = 0; i < 3; ++i)
+        if (const auto& t = r.random->psd[static_cast<std::size_t>(i)]) {
+          rms[i] = vibration::rms_g(*t);
+          moment1 += vibration::psd_moment(vibration::resolve(*t), 1);
+        }
+      r.frequency_Hz = moment1 / rms.squaredNorm(), r.amplitude_g = std::sqrt(2.0) * rms.norm(), r.direction = rms.normalized();
+      r.orientation_g = Vec3(*o0, *o1, *o2);
+    } else {
+      const auto f = get("frequency_Hz"), a = get("amplitude_g"), d0 = get("d_IA"), d1 = get("d_PA"), d2 = get("d_OA");
+      if (!f || !a || !d0 || !d1 || !d2) {
+        c.skipped.push_back(named + ": " + why);
+        continue;
+      }
+      const Vec3 d(*d0, *d1, *d2);
+      if (!(*f > 0) || !(*a > 0) || !(d.norm() > 0)) {
+        c.skipped.push_back(label + ": frequency, amplitude and direction must be positive / non-zero");
+        continue;
+      }
+      r.frequency_Hz = *f, r.amplitude_g = *a, r.direction = d.normalized(), r.orientation_g = Vec3(*o0, *o1, *o2);
     }
-    r.frequency_Hz = *f, r.amplitude_g = *a, r.direction = d.normalized(), r.orientation_g = Vec3(*o0, *o1, *o2);
     if (std::abs(r.orientation_g.norm() - 1) > 0.01) {
       c.skipped.push_back(fmt::format("{}: the static orientation has |a| = {:.4g} g; gravity is 1 g (a_*_g in g)", label,
                                       r.orientation_g.norm()));
@@ -381,15 +468,19 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       win.baseline_from_s = *rf, win.baseline_to_s = *rt, win.on_from_s = *of, win.on_to_s = *ot;
       win.frequency_Hz = r.frequency_Hz, win.K1 = K1;
       // Batch means over whole periods: up to 8 blocks of equal whole numbers of periods (the
-      // vibration window shortened to a multiple of the blocks).
-      const long periods = static_cast<long>(std::floor((*ot - *of) * r.frequency_Hz + 1e-9));
+      // vibration window shortened to a multiple of the blocks). A random run (random or sine
+      // on random, not periodic): 8 blocks over the window as given.
+      if (r.random) win.frequency_Hz = 0, win.blocks = 8;
+      const long periods = r.random ? 8 : static_cast<long>(std::floor((*ot - *of) * r.frequency_Hz + 1e-9));
       if (periods < 2) {
         c.skipped.push_back(fmt::format("{}: the vibration window holds {} whole period(s) of {:g} Hz; at least 2 are needed",
                                         label, periods, r.frequency_Hz));
         continue;
       }
-      win.blocks = static_cast<int>(std::min<long>(8, periods));
-      win.on_to_s = *of + static_cast<double>(periods / win.blocks * win.blocks) / r.frequency_Hz;
+      if (!r.random) {
+        win.blocks = static_cast<int>(std::min<long>(8, periods));
+        win.on_to_s = *of + static_cast<double>(periods / win.blocks * win.blocks) / r.frequency_Hz;
+      }
       const std::string spath = (fs::path(dir) / file).string();
       try {
         win.validate();
@@ -400,7 +491,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
         int ln = 0;
         std::size_t tcol = 0, ucol = 1, columns = 0;
         bool header = false;
-        double last_t = -INFINITY;
+        double last_t = -INFINITY, first_dt = 0;
         while (std::getline(in, line)) {
           ++ln;
           check_text_line(line, ln, spath);
@@ -431,10 +522,12 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
           }
           const double t = *tx, u = *ux;
           if (!(t > last_t)) throw std::invalid_argument(fmt::format("{}:{}: time does not increase", spath, ln));
+          if (std::isfinite(last_t) && first_dt == 0) first_dt = t - last_t;  // as SeriesMeasurer detects it
           last_t = t;
           meas.add(t, u);
         }
-        if (last_t < *ot)
+        // Half-open windows, decided as `measure` does (rectification/measurement/series.hpp).
+        if (!rectification::record_covers_window_end(rectification::used_on_to_s(win), last_t, first_dt))
           throw std::invalid_argument(fmt::format("{}: the record ends at {:g} s, before on_to_s = {:g} s", spath, last_t, *ot));
         const rectification::SeriesResult res = meas.finish();
         r.measured_g = res.measured_g, r.sigma_g = res.sigma_g;

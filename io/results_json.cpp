@@ -1,8 +1,10 @@
 #include "io/results_json.hpp"
 
+#include <cmath>
 #include <numbers>
 
 #include "io/output.hpp"
+#include "rectification/measurement/vrc.hpp"
 
 namespace vrelab::io {
 
@@ -79,6 +81,19 @@ json reproduce_settings_json(const validation::ReproduceSettings& s) {
           {"departure_frequencies_Hz", s.departure_frequencies_Hz},
           {"invisible_shift_per_g", s.invisible_shift_per_g},
           {"threads", s.threads}};
+}
+
+double vibration_input_rms_g(const VibrationSpec& v) {
+  vibration::SineVibration sine = v.sine;
+  if (v.swept) sine.amplitude_g = v.swept->amplitude_g;
+  const double s2 = v.type == "random" ? 0.0 : std::pow(rectification::input_rms_g(sine), 2);
+  const double r2 = v.gaussian ? std::pow(rectification::input_rms_g(*v.gaussian), 2) : 0.0;
+  return std::sqrt(s2 + r2);
+}
+
+json vrc_json(double error_g, double input_rms_g) {
+  const double x = rectification::vrc_ug_per_g2(error_g, input_rms_g);
+  return std::isfinite(x) ? json(x) : json(nullptr);
 }
 
 json vibration_json(const VibrationSpec& v) {
@@ -210,19 +225,23 @@ json predict_json(const Case& c, const PredictStudy& s) {
   j["terms"] = terms_json(s.terms);
   j["omitted_by_paper_g"] = s.terms.omitted_by_paper_g();
   j["paper_printed_total_g"] = s.printed_g ? json(*s.printed_g) : json(nullptr);
+  const double rms = vibration_input_rms_g(*c.vibration);
+  j["input_rms_g"] = rms;
+  j["vrc_ug_per_g2"] = vrc_json(s.terms.total_g(), rms);
   if (s.at_frequency) {
     const rectification::FrequencyPrediction& fp = *s.at_frequency;
     json ft = terms_json(fp.terms);
     ft["pickoff_nonlinearity"] = fp.pickoff_g;
     ft["pendulum_geometry"] = fp.pendulum_geometry_g;
-    j["frequency_dependent"] = {{"frequency_Hz", c.vibration->sine.frequency_Hz},
+    j["frequency_dependent"] = {{"frequency_Hz", c.vibration->type == "random" ? json(nullptr) : json(c.vibration->sine.frequency_Hz)},
                                 {"total_g", fp.total_g()},
+                                {"vrc_ug_per_g2", vrc_json(fp.total_g(), rms)},
                                 {"terms", ft},
                                 {"current_amplitude_g", std::abs(fp.current_amplitude_g)},
                                 {"angle_amplitude_rad", std::abs(fp.angle_amplitude_rad)},
                                 {"plant", plant_json(c.plant, c.physical.has_value())}};
   }
-  j["units"] = {{"total_g", "g"}, {"terms", "g"}};
+  j["units"] = {{"total_g", "g"}, {"terms", "g"}, {"input_rms_g", "g"}, {"vrc_ug_per_g2", "ug/g^2"}};
   return j;
 }
 
@@ -235,6 +254,11 @@ json shake_json(const Case& c, const ShakeStudy& s) {
   j["predicted_eq3_g"] = s.predicted_g;
   j["integral_slope_g"] = r.integral_slope_g;
   j["baseline_g"] = r.baseline_g;
+  const double rms = vibration_input_rms_g(*c.vibration);  // the commanded motion's
+  j["input_rms_g"] = rms;
+  j["vrc_ug_per_g2"] = vrc_json(r.measured_g, rms);
+  j["sigma_vrc_ug_per_g2"] = vrc_json(r.sigma_g, rms);
+  j["predicted_eq3_vrc_ug_per_g2"] = vrc_json(s.predicted_g, rms);
   j["plant"] = plant_json(c.plant, c.physical.has_value());
   j["vibration"] = vibration_json(*c.vibration);
   j["vibration"]["description"] = s.table.motion->describe();
@@ -257,7 +281,7 @@ json shake_json(const Case& c, const ShakeStudy& s) {
                        {"path", r.path},
                        {"shooting_iterations", r.shooting_iterations},
                        {"simulated_s", r.simulated_s}};
-  j["units"] = {{"measured_g", "g"}, {"sigma_g", "g"}, {"predicted_eq3_g", "g"}};
+  j["units"] = {{"measured_g", "g"}, {"sigma_g", "g"}, {"predicted_eq3_g", "g"}, {"input_rms_g", "g"}, {"vrc_ug_per_g2", "ug/g^2"}};
   return j;
 }
 
@@ -277,6 +301,18 @@ json measure_json(const MeasureStudy& s) {
   j["sigma_g"] = r.sigma_g;
   j["integral_slope_g"] = r.integral_slope_g;
   j["baseline_g"] = r.baseline_g;
+  // Given with --input-rms-g, else measured by the record's reference channels (ref_*_g or
+  // input_*_g columns); else null (a record of the output alone does not know its input).
+  const double rms = s.vrc_input_rms_g();
+  j["input_rms_g"] = rms > 0 ? json(rms) : json(nullptr);
+  j["input_rms_source"] = w.input_rms_g > 0 ? json("given") : rms > 0 ? json("reference_channels") : json(nullptr);
+  j["vrc_ug_per_g2"] = vrc_json(r.measured_g, rms);
+  j["sigma_vrc_ug_per_g2"] = vrc_json(r.sigma_g, rms);
+  if (s.reference) {
+    json axes = json::array();
+    for (int i = 0; i < 3; ++i) axes.push_back(s.reference_axes[static_cast<std::size_t>(i)]);
+    j["reference"] = {{"axes_present", axes}, {"rms_g", vec_json(s.reference_rms_g)}, {"input_rms_g", s.reference_input_rms_g}};
+  }
   j["samples"] = {{"on", r.samples_on}, {"baseline", r.samples_baseline}};
   j["sample_rate_Hz"] = r.sample_rate_Hz;
   return j;
@@ -307,6 +343,11 @@ json run_json(const RunResult& r) {
           {"amplitude_g", r.amplitude_g},
           {"measured_g", r.measured_g},
           {"sigma_measured_g", r.sigma_measured_g},
+          // The run is a sine of peak amplitude_g along direction_unit: input rms amplitude_g / sqrt(2).
+          {"input_rms_g", r.amplitude_g * r.direction_unit.norm() / std::numbers::sqrt2},
+          {"measured_vrc_ug_per_g2", vrc_json(r.measured_g, r.amplitude_g * r.direction_unit.norm() / std::numbers::sqrt2)},
+          {"predicted_vrc_ug_per_g2", vrc_json(r.predicted.value_g, r.amplitude_g * r.direction_unit.norm() / std::numbers::sqrt2)},
+          {"at_frequency_vrc_ug_per_g2", vrc_json(r.at_frequency.value_g, r.amplitude_g * r.direction_unit.norm() / std::numbers::sqrt2)},
           {"predicted_g", r.predicted.value_g},
           {"sigma_predicted_g", r.predicted.sigma_g},
           {"printed_g", r.printed_g},
@@ -350,7 +391,11 @@ json reproduce_confirmation_json(const Case& c, const validation::ReproduceSetti
           {"integral_slope_straight_line_g", cf.shake.integral_slope_g},
           {"oscillation_amplitude_g_s", cf.oscillation_amplitude_g_s},
           {"predicted_g", cf.predicted.value_g},
-          {"sigma_predicted_g", cf.predicted.sigma_g}};
+          {"sigma_predicted_g", cf.predicted.sigma_g},
+          // A sine of peak amplitude_g along the direction: input rms amplitude_g / sqrt(2).
+          {"input_rms_g", s.confirmation_amplitude_g / std::numbers::sqrt2},
+          {"measured_vrc_ug_per_g2", vrc_json(cf.shake.measured_g, s.confirmation_amplitude_g / std::numbers::sqrt2)},
+          {"predicted_vrc_ug_per_g2", vrc_json(cf.predicted.value_g, s.confirmation_amplitude_g / std::numbers::sqrt2)}};
 }
 
 namespace {

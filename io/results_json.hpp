@@ -26,6 +26,12 @@ nlohmann::json reproduce_settings_json(const validation::ReproduceSettings& s);
 
 // ---- the commands' results (each with its "settings")
 nlohmann::json identify_json(const Case& c, const IdentifyStudy& s);
+// The rms of the commanded dynamic input's magnitude, g (rectification/measurement/vrc.hpp):
+// sqrt(sum_i w_i^2 / 2) for a (swept) sine, sqrt(sum_i rms_i^2) for random, both added for
+// sine on random.
+double vibration_input_rms_g(const VibrationSpec& v);
+// VRC = error / rms^2 in ug/g^2, null where the rms is 0.
+nlohmann::json vrc_json(double error_g, double input_rms_g);
 nlohmann::json predict_json(const Case& c, const PredictStudy& s);
 nlohmann::json shake_json(const Case& c, const ShakeStudy& s);
 nlohmann::json measure_json(const MeasureStudy& s);

@@ -22,6 +22,8 @@
 #include "io/csv.hpp"
 #include "io/output.hpp"
 #include "io/results_json.hpp"
+#include "rectification/measurement/vrc.hpp"
+#include "rectification/prediction/random.hpp"
 #include "rectification/simulation/sweep.hpp"
 #include "vrelab_version.hpp"
 
@@ -176,9 +178,12 @@ PredictStudy predict(const Case& c, bool frequency_dependent) {
   require(c, c.orientation_g.has_value(), "orientation", "predict");
   require(c, c.vibration.has_value(), "vibration", "predict");
   const VibrationSpec& vs = *c.vibration;
-  if (frequency_dependent && vs.type != "sine")
-    throw InputError(c.path + ": [vibration] type: --frequency-dependent takes a \"sine\" vibration");
-  if (frequency_dependent && !(vs.sine.frequency_Hz > 0))
+  const bool random_kind = vs.type == "random" || vs.type == "sine_on_random";
+  if (frequency_dependent && vs.type != "sine" && !random_kind)
+    throw InputError(c.path + ": [vibration] type: --frequency-dependent takes a \"sine\", \"random\" or \"sine_on_random\" vibration");
+  if (frequency_dependent && random_kind && !vs.psd)
+    throw InputError(c.path + ":" + std::to_string(vs.line) + ": [vibration] psd_IA: --frequency-dependent needs the random part as PSD tables (psd_IA, psd_PA, psd_OA), not rms_g");
+  if (frequency_dependent && vs.type != "random" && !(vs.sine.frequency_Hz > 0))
     throw InputError(c.path + ": [vibration] frequency_Hz: --frequency-dependent needs a positive frequency");
   PredictStudy s;
   s.terms = predict_terms(c);
@@ -192,7 +197,12 @@ PredictStudy predict(const Case& c, bool frequency_dependent) {
   if (vs.gaussian)
     s.description += fmt::format("{}Gaussian rms [{:g}, {:g}, {:g}] g", vs.type == "sine_on_random" ? " + " : ", ",
                                  vs.gaussian->rms_g[0], vs.gaussian->rms_g[1], vs.gaussian->rms_g[2]);
-  if (frequency_dependent)
+  if (frequency_dependent && vs.type == "random")
+    s.at_frequency = rectification::random_rectification_at_frequency(c.plant, *c.orientation_g, *vs.psd, c.range_limit_g);
+  else if (frequency_dependent && vs.type == "sine_on_random")
+    s.at_frequency = rectification::sine_on_random_rectification_at_frequency(c.plant, *c.orientation_g, vs.sine, *vs.psd,
+                                                                               c.range_limit_g);
+  else if (frequency_dependent)
     s.at_frequency = rectification::sine_rectification_at_frequency(c.plant, *c.orientation_g, vs.sine, c.range_limit_g);
   return s;
 }
@@ -202,11 +212,17 @@ namespace {
 std::string predict_at_frequency_report(const Case& c, const PredictStudy& s) {
   const VibrationSpec& vs = *c.vibration;
   const rectification::FrequencyPrediction& fp = *s.at_frequency;
-  std::string out = fmt::format(
-      "At {:g} Hz through the plant's dynamics ({}): current amplitude |I| = {:.6g} g per {:g} g on IA, "
-      "pendulum angle |Theta| = {:.4g} rad\n",
-      vs.sine.frequency_Hz, c.physical ? "physical parameters" : "from coefficients", std::abs(fp.current_amplitude_g),
-      vs.sine.amplitude_g[IA], std::abs(fp.angle_amplitude_rad));
+  std::string out;
+  if (vs.type == "sine")
+    out = fmt::format(
+        "At {:g} Hz through the plant's dynamics ({}): current amplitude |I| = {:.6g} g per {:g} g on IA, "
+        "pendulum angle |Theta| = {:.4g} rad\n",
+        vs.sine.frequency_Hz, c.physical ? "physical parameters" : "from coefficients", std::abs(fp.current_amplitude_g),
+        vs.sine.amplitude_g[IA], std::abs(fp.angle_amplitude_rad));
+  else
+    out = fmt::format("Through the plant's dynamics ({}): the {} motion's PSD filtered by the loop, each term's Gaussian "
+                      "expectation (docs/frequency.md, random motion)\n",
+                      c.physical ? "physical parameters" : "from coefficients", vs.type == "random" ? "random" : "sine-on-random");
   out += fmt::format("  {:<20}{:>14}{:>16}\n", "term", "quasi-static", "at frequency");
   for (int t = 0; t < rectification::kNumTerms; ++t) {
     if (t == rectification::t_clipping && !c.range_limit_g) continue;
@@ -243,6 +259,13 @@ std::string predict_report(const Case& c, const PredictStudy& s) {
     out += fmt::format("Eq. (3) as printed in the paper gives {:.6f} ug (differs by {:.6f} ug)\n", *s.printed_g * 1e6,
                        (*s.printed_g - total) * 1e6);
   if (s.at_frequency) out += predict_at_frequency_report(c, s);
+  const double rms = vibration_input_rms_g(*c.vibration);
+  if (rms > 0)
+    out += fmt::format("VRC = error / (input rms)^2, input rms {:.6g} g: {:.6g} ug/g^2 quasi-static{}\n", rms,
+                       rectification::vrc_ug_per_g2(total, rms),
+                       s.at_frequency ? fmt::format(", {:.6g} ug/g^2 through the dynamics",
+                                                    rectification::vrc_ug_per_g2(s.at_frequency->total_g(), rms))
+                                      : std::string());
   return out;
 }
 
@@ -384,6 +407,10 @@ std::string shake_report(const Case& c, const ShakeStudy& s) {
   out += fmt::format("  eq. (3) corrected, truth   {:>14.6f} ug\n", p * 1e6);
   out += fmt::format("  measured - eq. (3)         {:>14.6f} ug ({:+.4g} %)\n", (r.measured_g - p) * 1e6,
                      p != 0 ? 100 * (r.measured_g / p - 1) : 0.0);
+  if (const double rms = vibration_input_rms_g(*c.vibration); rms > 0)
+    out += fmt::format("  VRC (input rms {:.6g} g)      {:>14.6f} ug/g^2 +/- {:.3g} (eq. (3): {:.6f})\n", rms,
+                       rectification::vrc_ug_per_g2(r.measured_g, rms), rectification::vrc_ug_per_g2(r.sigma_g, rms),
+                       rectification::vrc_ug_per_g2(p, rms));
   out += fmt::format("  solver: {} steps, {} right-hand sides, {:.3g} s wall, {:.3g} s CPU; path: {}\n", r.steps,
                      r.rhs_evaluations, s.wall_s, s.cpu_s, r.path);
   return out;
@@ -397,7 +424,22 @@ MeasureStudy measure(const std::string& series_path, const std::string& column, 
   s.path = series_path;
   s.windows = w;
   rectification::SeriesMeasurer m(w);
-  s.column = read_series_csv(series_path, column, [&m](double t, double u) { m.add(t, u); });
+  // Reference channels: sums over the vibration window as the measurement reads it, [from, to).
+  const double on_from = w.on_from_s, on_to = rectification::used_on_to_s(w);
+  long n_ref = 0;
+  Vec3 sum = Vec3::Zero(), sum2 = Vec3::Zero();
+  const ReferenceSink ref = [&](double t, const std::array<double, 3>& g, const std::array<bool, 3>& present) {
+    s.reference = true, s.reference_axes = present;
+    if (t < on_from || t >= on_to) return;
+    ++n_ref;
+    for (int i = 0; i < 3; ++i) sum[i] += g[static_cast<std::size_t>(i)], sum2[i] += g[static_cast<std::size_t>(i)] * g[static_cast<std::size_t>(i)];
+  };
+  s.column = read_series_csv(series_path, column, [&m](double t, double u) { m.add(t, u); }, ref);
+  if (n_ref > 1) {
+    const double n = static_cast<double>(n_ref);
+    for (int i = 0; i < 3; ++i) s.reference_rms_g[i] = std::sqrt(std::max(0.0, sum2[i] / n - (sum[i] / n) * (sum[i] / n)));
+    s.reference_input_rms_g = s.reference_rms_g.norm();
+  }
   try {
     s.result = m.finish();
   } catch (const std::invalid_argument& e) {
@@ -418,6 +460,13 @@ std::string measure_report(const MeasureStudy& s) {
   out += fmt::format("  vibration error          {:>14.6f} ug  +/- {:.3g} ug (1 sigma, batch means of {} blocks)\n",
                      r.measured_g * 1e6, r.sigma_g * 1e6, w.blocks);
   out += fmt::format("  running-integral slope   {:>14.6f} ug\n", r.integral_slope_g * 1e6);
+  if (s.reference)
+    out += fmt::format("Reference channels over the vibration window: rms [{:.6g}, {:.6g}, {:.6g}] g, magnitude {:.6g} g\n",
+                       s.reference_rms_g[0], s.reference_rms_g[1], s.reference_rms_g[2], s.reference_input_rms_g);
+  if (const double rms = s.vrc_input_rms_g(); rms > 0)
+    out += fmt::format("  VRC (input rms {:g} g, {})   {:>14.6f} ug/g^2 +/- {:.3g}\n", rms,
+                       w.input_rms_g > 0 ? "given" : "reference channels", rectification::vrc_ug_per_g2(r.measured_g, rms),
+                       rectification::vrc_ug_per_g2(r.sigma_g, rms));
   return out;
 }
 

@@ -69,6 +69,14 @@ struct MeasureStudy {
   std::string path, column;
   rectification::SeriesWindows windows;
   rectification::SeriesResult result;
+  // With reference channels (io/csv.hpp ReferenceSink): the measured motion over the vibration
+  // window, per axis (mean removed, g; 0 for an axis without a column) and its magnitude's rms.
+  bool reference = false;
+  std::array<bool, 3> reference_axes{};
+  Vec3 reference_rms_g = Vec3::Zero();
+  double reference_input_rms_g = 0;
+  // The input rms the VRC used: --input-rms-g, else the reference channels', else 0 (none).
+  double vrc_input_rms_g() const { return windows.input_rms_g > 0 ? windows.input_rms_g : reference_input_rms_g; }
 };
 MeasureStudy measure(const std::string& series_path, const std::string& column, const rectification::SeriesWindows& w);
 std::string measure_report(const MeasureStudy& s);

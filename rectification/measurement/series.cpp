@@ -1,6 +1,7 @@
 #include "rectification/measurement/series.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace vrelab::rectification {
@@ -26,8 +27,18 @@ void SeriesWindows::validate() const {
     throw std::invalid_argument("vibration interval: shorter than one period of frequency_Hz");
   if (!(K1 > 0) || !finite(K1)) throw std::invalid_argument("K1 must be positive");
   if (blocks < 2) throw std::invalid_argument("blocks must be at least 2");
+  if (!(input_rms_g >= 0) || !finite(input_rms_g)) throw std::invalid_argument("input_rms_g must not be negative (0: not given)");
   if (on_from_s < baseline_to_s && baseline_from_s < on_to_s)
     throw std::invalid_argument("the vibration interval overlaps the baseline interval");
+}
+
+bool record_covers_window_end(double to_s, double last_t_s, double dt_s) {
+  return last_t_s + dt_s * (1 + 1e-6) >= to_s;
+}
+
+double used_on_to_s(const SeriesWindows& w) {
+  return w.frequency_Hz > 0 ? w.on_from_s + std::floor((w.on_to_s - w.on_from_s) * w.frequency_Hz + 1e-9) / w.frequency_Hz
+                            : w.on_to_s;
 }
 
 SeriesMeasurer::SeriesMeasurer(const SeriesWindows& w) : w_(w) {
@@ -35,8 +46,7 @@ SeriesMeasurer::SeriesMeasurer(const SeriesWindows& w) : w_(w) {
   base_.from = w.baseline_from_s;
   base_.to = w.baseline_to_s;
   on_.from = w.on_from_s;
-  on_.to = w.frequency_Hz > 0 ? w.on_from_s + std::floor((w.on_to_s - w.on_from_s) * w.frequency_Hz + 1e-9) / w.frequency_Hz
-                              : w.on_to_s;
+  on_.to = used_on_to_s(w);
   for (Window* x : {&base_, &on_}) {
     x->sum.assign(static_cast<std::size_t>(w.blocks), 0.0);
     x->count.assign(static_cast<std::size_t>(w.blocks), 0);
@@ -95,6 +105,13 @@ SeriesResult SeriesMeasurer::finish() const {
   };
   const auto [base_mean, base_sigma] = stats(base_, "baseline", r.samples_baseline);
   const auto [on_mean, on_sigma] = stats(on_, "vibration", r.samples_on);
+  for (const auto& [w, what] : {std::pair<const Window*, const char*>{&base_, "baseline"}, {&on_, "vibration"}})
+    if (!record_covers_window_end(w->to, last_t_, first_dt_)) {
+      char msg[200];
+      std::snprintf(msg, sizeof msg, "the record ends at %g s, before the %s interval [%g, %g) s does (its last sample is due at %g s)",
+                    last_t_, what, w->from, w->to, w->to - first_dt_);
+      throw std::invalid_argument(msg);
+    }
   r.baseline_g = base_mean;
   r.measured_g = on_mean - base_mean;
   r.sigma_g = std::sqrt(base_sigma * base_sigma + on_sigma * on_sigma);

@@ -20,6 +20,7 @@ struct SeriesWindows {
   double frequency_Hz = 0;  // > 0: the vibration interval is cut to whole periods from on_from_s
   double K1 = 1.0;
   int blocks = 4;
+  double input_rms_g = 0;  // > 0: the input's rms (g), for the VRC in the report; 0: unknown
   // Throws std::invalid_argument naming the field.
   void validate() const;
   // False (with validate()'s reason in *why) for windows no measurement can use.
@@ -33,12 +34,22 @@ struct SeriesResult {
   double on_to_used_s = 0;  // end of the vibration interval used (whole periods)
 };
 
+// Windows are half-open, [from, to): a record sampled every dt_s covers a window's end when
+// its last sample is at or after to - dt (the next sample would fall at or beyond `to`), to
+// 1e-6 dt for the rounding of written times. `measure` (SeriesMeasurer::finish) and the lab
+// data's raw records (diagnose) both decide with this.
+bool record_covers_window_end(double to_s, double last_t_s, double dt_s);
+// The vibration window's end as the measurement uses it: on_to_s, or with frequency_Hz > 0
+// on_from_s plus the whole periods it holds (to 1e-9 of a period).
+double used_on_to_s(const SeriesWindows& w);
+
 class SeriesMeasurer {
  public:
   explicit SeriesMeasurer(const SeriesWindows& w);
   // Samples must come in increasing time; throws std::invalid_argument otherwise.
   void add(double t_s, double output);
-  // Throws std::invalid_argument if a window holds fewer than two samples per block.
+  // Throws std::invalid_argument if a window holds fewer than two samples per block, or the
+  // record ends before a window does (record_covers_window_end).
   SeriesResult finish() const;
 
  private:

@@ -16,6 +16,7 @@
 #include <Eigen/Dense>
 
 #include "rectification/prediction/frequency.hpp"
+#include "rectification/prediction/random.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "vibration/excitation.hpp"
 #include "validation/reproduce/reproduce.hpp"
@@ -25,6 +26,11 @@ namespace {
 
 using plant::Coefficients;
 using plant::PlantConfig;
+
+// Random runs: the PSD integral on a grid of 0.1 in ln f shared by every table of the same
+// band (rectification/prediction/random.hpp, common_grid; 8 Gauss-Legendre points a piece):
+// the loop responses are then cached across runs. Within 1e-5 of the fine default on GEVS.
+const rectification::RandomQuadrature kRandomRunQuadrature{0.1, true};
 
 // The table's motion as the prediction takes it: a pure sine exactly, else one period of
 // the excitation resolved into harmonics.
@@ -76,8 +82,8 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
     const RunRecord& r = runs[static_cast<std::size_t>(k)];
     PlantConfig cfg = nominal;
     TableMotion m = table_motion(r);
-    if (e) e->apply(p, cfg, m);
-    cfg = rectification::amplitude_linearised(cfg, m.sine);
+    if (e) e->apply(p, cfg, m);  // a random run: what the effect does to the table's motion is not applied
+    if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
     // The loop responses depend on the effect's value and, for an amplitude-dependent one,
     // on the run: the key says both.
     std::string key;
@@ -86,8 +92,16 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
       std::snprintf(buf, sizeof buf, "=%.17g|%.17g", p, cfg.dynamics.pendulum_damping_ratio);
       key = e->name + buf;
     }
-    const rectification::PeriodicInput input = periodic_input(m, r.frequency_Hz);
     const rectification::ResponseAt h = [&](double f) { return cache.get(cfg, key, f); };
+    const rectification::PeriodicInput input = r.random ? rectification::PeriodicInput{} : periodic_input(m, r.frequency_Hz);
+    // A random or sine-on-random run: the random part's covariances through the loop, once.
+    std::optional<rectification::RandomResponse> rr;
+    std::optional<vibration::SineVibration> sine;
+    std::optional<rectification::LoopResponse> sine_h;
+    if (r.random) {
+      rr = rectification::random_response(*r.random, h, kRandomRunQuadrature);
+      if (r.sine_part) sine = r.vibration(), sine_h = h(r.frequency_Hz);
+    }
     // Coefficients as identified, then the effect's own change of them (if any) on top.
     const Coefficients shift = [&] {
       Coefficients z = nominal.coefficients;
@@ -100,6 +114,7 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
     const auto f = [&](const Coefficients& co) {
       PlantConfig q = cfg;
       for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
+      if (rr) return rectification::random_rectification_at_frequency(q, r.orientation_g, *rr, sine, sine_h).total_g();
       return rectification::periodic_rectification(q, r.orientation_g, input, h).total_g();
     };
     const CoefArray g = prediction_gradient(f, nominal.coefficients);
@@ -349,14 +364,21 @@ Coefficients taken_up_by_static_test(const Effect& e, const PlantConfig& plant, 
 double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effect* e, double p) {
   PlantConfig cfg = nominal;
   TableMotion m = table_motion(r);
-  if (e) e->apply(p, cfg, m);
-  cfg = rectification::amplitude_linearised(cfg, m.sine);
+  if (e) e->apply(p, cfg, m);  // a random run: what the effect does to the table's motion is not applied
+  if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
   std::map<double, rectification::LoopResponse> responses;
   const rectification::ResponseAt h = [&](double f) {
     auto it = responses.find(f);
     if (it == responses.end()) it = responses.emplace(f, rectification::loop_response(cfg, f)).first;
     return it->second;
   };
+  if (r.random) {
+    const rectification::RandomResponse rr = rectification::random_response(*r.random, h, kRandomRunQuadrature);
+    std::optional<vibration::SineVibration> sine;
+    std::optional<rectification::LoopResponse> sine_h;
+    if (r.sine_part) sine = r.vibration(), sine_h = h(r.frequency_Hz);
+    return rectification::random_rectification_at_frequency(cfg, r.orientation_g, rr, sine, sine_h).total_g();
+  }
   return rectification::periodic_rectification(cfg, r.orientation_g, periodic_input(m, r.frequency_Hz), h).total_g();
 }
 
@@ -1010,6 +1032,8 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s) {
     PlantConfig corrected = plant;
     for (int i = 0; i < plant::kNumCoefficients; ++i) corrected.coefficients[i] += dc(i);
     std::vector<int> order = all;
+    // Random runs are not re-simulated here (the ODE measures them statistically, seconds each).
+    std::erase_if(order, [&](int k) { return c.runs[static_cast<std::size_t>(k)].random.has_value(); });
     std::sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(r(a)) > std::abs(r(b)); });
     order.resize(std::min<std::size_t>(order.size(), static_cast<std::size_t>(s.resimulate_runs)));
     double sb = 0, sa = 0;

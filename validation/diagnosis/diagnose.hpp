@@ -30,6 +30,7 @@
 #include "validation/identification/uncertainty.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/profile.hpp"
+#include "vibration/random.hpp"
 
 namespace vrelab::validation {
 
@@ -54,6 +55,11 @@ struct RunRecord {
   // just before it, over K1, against the reference the measured error is taken from (g; NaN:
   // not given): a bias that drifts shows in both alike (docs/data-format.md, time_h, rest_ug).
   double time_h = NAN, rest_g = NAN;
+  // Random and sine-on-random runs (docs/data-format.md): the random part, one PSD table per
+  // sensor axis. For a random run (sine_part false) frequency_Hz, amplitude_g and direction
+  // only describe it (the PSD's mean frequency, sqrt(2) x its rms, each axis's rms share).
+  std::optional<vibration::RandomProfile> random;
+  bool sine_part = true;
   vibration::SineVibration vibration() const;
 };
 

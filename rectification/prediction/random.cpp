@@ -1,0 +1,245 @@
+#include "rectification/prediction/random.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <stdexcept>
+#include <vector>
+
+namespace vrelab::rectification {
+
+using namespace plant;
+
+namespace {
+
+// 8-point Gauss-Legendre on [-1, 1].
+constexpr std::array<double, 8> kGlX{-0.9602898564975363, -0.7966664774136267, -0.5255324099163290, -0.1834346424956498,
+                                     0.1834346424956498,  0.5255324099163290,  0.7966664774136267,  0.9602898564975363};
+constexpr std::array<double, 8> kGlW{0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
+                                     0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
+
+// Probabilists' Gauss-Hermite rule (weight exp(-x^2/2)/sqrt(2 pi)) by Golub-Welsch: the
+// Jacobi matrix has off-diagonal sqrt(k); nodes its eigenvalues, weights the squared first
+// components of the eigenvectors.
+struct HermiteRule {
+  std::vector<double> x, w;
+};
+const HermiteRule& hermite_rule() {
+  static const HermiteRule rule = [] {
+    constexpr int n = 24;
+    Eigen::MatrixXd j = Eigen::MatrixXd::Zero(n, n);
+    for (int k = 1; k < n; ++k) j(k, k - 1) = j(k - 1, k) = std::sqrt(static_cast<double>(k));
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(j);
+    HermiteRule r;
+    for (int k = 0; k < n; ++k) {
+      r.x.push_back(es.eigenvalues()[k]);
+      r.w.push_back(es.eigenvectors()(0, k) * es.eigenvectors()(0, k));
+    }
+    return r;
+  }();
+  return rule;
+}
+
+}  // namespace
+
+vibration::RandomVibration gaussian_of(const Eigen::Matrix3d& c) {
+  vibration::RandomVibration v;
+  v.correlation = Eigen::Matrix3d::Identity();
+  for (int i = 0; i < 3; ++i) v.rms_g[i] = std::sqrt(std::max(0.0, c(i, i)));
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (i != j && v.rms_g[i] > 0 && v.rms_g[j] > 0)
+        v.correlation(i, j) = std::clamp(c(i, j) / (v.rms_g[i] * v.rms_g[j]), -1.0, 1.0);
+  return v;
+}
+
+Eigen::Matrix3d cross_spectrum_g2_per_Hz(const vibration::RandomProfile& p, double f) {
+  Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
+  std::array<double, 3> g{};
+  for (int i = 0; i < 3; ++i)
+    if (const auto& t = p.psd[static_cast<std::size_t>(i)]) g[static_cast<std::size_t>(i)] = vibration::psd_g2_per_Hz(*t, f);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (i == j) s(i, i) = g[static_cast<std::size_t>(i)];
+      else if (p.coupling == vibration::AxisCoupling::common)
+        s(i, j) = std::sqrt(g[static_cast<std::size_t>(i)] * g[static_cast<std::size_t>(j)]);
+  return s;
+}
+
+RandomResponse random_response(const vibration::RandomProfile& p, const ResponseAt& response, const RandomQuadrature& q) {
+  vibration::validate(p);
+  if (!(q.max_log_step > 0)) throw std::invalid_argument("random_response: max_log_step must be positive");
+  // Every table's breakpoints: the PSD is a power law between them (smooth in ln f), and
+  // it jumps to 0 outside a table's band.
+  std::vector<double> knots;
+  for (const auto& t : p.psd)
+    if (t) {
+      const vibration::ResolvedPsd r = vibration::resolve(*t);
+      knots.insert(knots.end(), r.frequency_Hz.begin(), r.frequency_Hz.end());
+    }
+  std::sort(knots.begin(), knots.end());
+  knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
+  RandomResponse out;
+  out.from_Hz = knots.front();
+  out.to_Hz = knots.back();
+  if (q.common_grid) {  // the global grid exp(k h), cut at the band's ends only
+    const double h = q.max_log_step, l0 = std::log(out.from_Hz), l1 = std::log(out.to_Hz);
+    knots = {out.from_Hz};
+    for (double k = std::floor(l0 / h) + 1; k * h < l1; ++k) knots.push_back(std::exp(k * h));
+    knots.push_back(out.to_Hz);
+  }
+  for (std::size_t k = 0; k + 1 < knots.size(); ++k) {
+    const double l0 = std::log(knots[k]), l1 = std::log(knots[k + 1]);
+    const int pieces = std::max(1, static_cast<int>(std::ceil((l1 - l0) / q.max_log_step - 1e-9)));
+    const double h = (l1 - l0) / pieces;
+    for (int m = 0; m < pieces; ++m) {
+      const double mid = l0 + (m + 0.5) * h;
+      for (std::size_t n = 0; n < kGlX.size(); ++n) {
+        const double f = std::exp(mid + 0.5 * h * kGlX[n]);
+        const double weight = 0.5 * h * kGlW[n] * f;  // df = f d(ln f)
+        const Eigen::Matrix3d s = cross_spectrum_g2_per_Hz(p, f);
+        if (s.isZero(0.0)) continue;
+        const LoopResponse r = response(f);
+        ++out.frequencies;
+        out.dc_gain = r.dc_gain;
+        // Rows: the responses' transfer to each input axis.
+        Eigen::Matrix<std::complex<double>, 5, 3> hm = Eigen::Matrix<std::complex<double>, 5, 3>::Zero();
+        for (int j = 0; j < 3; ++j) {
+          const auto sj = static_cast<std::size_t>(j);
+          hm(j, j) = r.mechanical[sj];
+          hm(RandomResponse::kCurrent, j) = r.current[sj];
+          hm(RandomResponse::kAngle, j) = r.angle_rad[sj];
+        }
+        out.covariance += weight * (hm * s.cast<std::complex<double>>() * hm.adjoint()).real();
+        out.input_covariance_g2 += weight * s;
+      }
+    }
+  }
+  return out;
+}
+
+RandomResponse random_response(const PlantConfig& plant, const vibration::RandomProfile& p, const RandomQuadrature& q) {
+  return random_response(p, [&plant](double f) { return loop_response(plant, f); }, q);
+}
+
+FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const RandomResponse& rr,
+                                                      const std::optional<vibration::SineVibration>& sine,
+                                                      const std::optional<LoopResponse>& sine_response,
+                                                      std::optional<double> range_g) {
+  if (sine && !sine_response) throw std::invalid_argument("random_rectification_at_frequency: a sine needs its loop response");
+  if (sine && std::abs(sine_response->frequency_Hz - sine->frequency_Hz) > 1e-9 * sine->frequency_Hz)
+    throw std::invalid_argument("random_rectification_at_frequency: the loop response is for another frequency");
+  double p2 = 0.0;
+  bool geometry = false;
+  for (const auto& e : config.effects) {
+    p2 += e->pickoff_p2_per_rad();
+    geometry = geometry || e->vibropendulous();
+  }
+  const auto& c5 = rr.covariance;
+  using R = RandomResponse;
+  // What the terms see: the felt motion's covariance, and the same with IA the current.
+  const Eigen::Matrix3d felt_cov = c5.topLeftCorner<3, 3>();
+  Eigen::Matrix3d loop_cov = felt_cov;
+  loop_cov(IA, IA) = c5(R::kCurrent, R::kCurrent);
+  for (int j : {PA, OA}) loop_cov(IA, j) = loop_cov(j, IA) = c5(R::kCurrent, j);
+  const vibration::RandomVibration felt = gaussian_of(felt_cov), through_loop = gaussian_of(loop_cov);
+
+  // The sine, as in sine_rectification_at_frequency.
+  vibration::SineVibration sine_felt, sine_loop;
+  Eigen::Vector3cd Fs = Eigen::Vector3cd::Zero();
+  std::complex<double> Is = 0.0, Ths = 0.0;
+  if (sine) {
+    const LoopResponse& h = *sine_response;
+    sine_felt = *sine;
+    for (int i = 0; i < 3; ++i) {
+      const auto si = static_cast<std::size_t>(i);
+      const std::complex<double> W = std::polar(sine->amplitude_g[i], sine->phase_rad[i]);
+      Fs[i] = h.mechanical[si] * W;
+      Is += h.current[si] * W;
+      Ths += h.angle_rad[si] * W;
+      sine_felt.amplitude_g[i] = std::abs(Fs[i]);
+      sine_felt.phase_rad[i] = std::arg(Fs[i]);
+    }
+    sine_loop = sine_felt;
+    sine_loop.amplitude_g[IA] = std::abs(Is);
+    sine_loop.phase_rad[IA] = std::arg(Is);
+  }
+  const double dc_gain = sine ? sine_response->dc_gain : rr.dc_gain;
+  FrequencyPrediction out;
+  out.loop_dc_gain = dc_gain;
+  out.current_amplitude_g = Is;
+  out.angle_amplitude_rad = Ths;
+  for (int c = k0; c < kNumCoefficients; ++c) {
+    if (c == k0 || c == delta_OA || c == delta_PA || config.coefficients[c] == 0) continue;
+    Coefficients only;
+    only[K1] = 1;
+    only[c] = config.coefficients[c];
+    const bool filtered = c <= k4 && config.location[c] != Location::input;
+    const Eq3Terms t = sine ? sine_on_random_rectification(only, a, filtered ? sine_loop : sine_felt,
+                                                           filtered ? through_loop : felt)
+                            : random_rectification(only, a, filtered ? through_loop : felt);
+    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
+    for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
+  }
+  if (range_g) {
+    Coefficients unit;
+    unit[K1] = 1;
+    const Eq3Terms t = sine ? sine_on_random_rectification(unit, a, sine_loop, through_loop, range_g)
+                            : random_rectification(unit, a, through_loop, range_g);
+    out.terms.g[t_clipping] = t.g[t_clipping];
+  }
+  // Effects beyond (1): second moments of the angle (the sine's and the random's add).
+  const Dynamics& d = config.dynamics;
+  const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+  const double theta2 = c5(R::kAngle, R::kAngle) + std::norm(Ths) / 2;
+  const double pa_theta = c5(R::kF_PA, R::kAngle) + std::real(Fs[PA] * std::conj(Ths)) / 2;
+  out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * theta2;
+  if (geometry) out.pendulum_geometry_g = dc_gain * (-pa_theta - a[IA] * theta2 / 2);
+  // A readout polynomial: E over the output's Gaussian part (Gauss-Hermite), averaged over the
+  // sine's phase (32 points: exact for a trigonometric polynomial of degree < 32).
+  bool readout = false;
+  for (const auto& e : config.effects) readout = readout || e->readout_averaged_in_prediction();
+  if (readout) {
+    Coefficients cross_out;
+    cross_out[K1] = 1;
+    for (int c = delta_OA; c < kNumCoefficients; ++c)
+      if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
+    const Vec3 slope = plant::output_gradient(cross_out, a) - Vec3::UnitX();
+    Eigen::Matrix<double, 5, 1> u_row = Eigen::Matrix<double, 5, 1>::Zero();  // U = I + slope . F
+    u_row[R::kCurrent] = 1;
+    for (int i = 0; i < 3; ++i) u_row[i] = slope[i];
+    const double sigma_u = std::sqrt(std::max(0.0, u_row.dot(c5 * u_row)));
+    const std::complex<double> Us = Is + slope[IA] * Fs[IA] + slope[PA] * Fs[PA] + slope[OA] * Fs[OA];
+    const double u0 = plant::output_g(config.coefficients, a);
+    const HermiteRule& gh = hermite_rule();
+    const int phases = sine ? 32 : 1;
+    for (const auto& e : config.effects) {
+      if (!e->readout_averaged_in_prediction()) continue;
+      double mean = 0;
+      for (int k = 0; k < phases; ++k) {
+        const double us = std::real(Us * std::polar(1.0, 2 * std::numbers::pi * k / phases));
+        for (std::size_t n = 0; n < gh.x.size(); ++n) mean += gh.w[n] * e->readout(u0 + us + sigma_u * gh.x[n]) / phases;
+      }
+      out.readout_g += mean - e->readout(u0);
+    }
+  }
+  return out;
+}
+
+FrequencyPrediction random_rectification_at_frequency(const PlantConfig& plant, const Vec3& a, const vibration::RandomProfile& p,
+                                                      std::optional<double> range_g) {
+  return random_rectification_at_frequency(plant, a, random_response(plant, p), std::nullopt, std::nullopt, range_g);
+}
+
+FrequencyPrediction sine_on_random_rectification_at_frequency(const PlantConfig& plant, const Vec3& a,
+                                                              const vibration::SineVibration& sine,
+                                                              const vibration::RandomProfile& p, std::optional<double> range_g) {
+  vibration::validate(sine);
+  if (!(sine.frequency_Hz > 0)) throw std::invalid_argument("sine_on_random: the sine's frequency_Hz must be positive");
+  return random_rectification_at_frequency(plant, a, random_response(plant, p), sine, loop_response(plant, sine.frequency_Hz),
+                                           range_g);
+}
+
+}  // namespace vrelab::rectification

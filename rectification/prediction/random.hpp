@@ -1,0 +1,92 @@
+#pragma once
+// rectification/prediction/random.hpp -- the frequency-dependent vibration error of Gaussian random
+// and sine-on-random motion: eq. (3)'s random form through the plant's dynamics.
+//
+// Takes: a plant (plant/accelerometer.hpp), the static orientation (g), a random profile
+//        (vibration/random.hpp: one-sided PSD per sensor axis in g^2/Hz and the axes'
+//        coupling) and, for sine-on-random, the sine (g peak, phase, Hz).
+// Gives: the vibration error per term of model (1) and per effect (g), to first order in the
+//        nonlinearities, in the FrequencyPrediction of frequency.hpp (the same fields).
+//
+// The random motion x(t) is zero-mean Gaussian with the one-sided cross-spectral density
+// S_ij(f) (g^2/Hz): S_ii = G_i, and between axes S_ij = sqrt(G_i G_j) for `common` phases,
+// 0 for `independent` ones. Every linear response y = sum_j H_yj(f) x_j of the plant (the
+// felt motion F_i = T_i x_i behind a mechanical mode, the rebalance current I, the pendulum
+// angle Theta; rectification::loop_response) is then Gaussian too, with the covariances
+//     C_yz = integral Re( sum_ij H_yi(f) S_ij(f) conj(H_zj(f)) ) df
+// over the table band (piecewise Gauss-Legendre in ln f, RandomResponse). Each term of (1)
+// at its place then takes the Gaussian expectation of eq. (3)'s random form
+// (eq3.hpp random_rectification), with the covariance of what it sees: IA terms in the loop
+// or at the output the current's variance C_II; input terms and the cross terms the felt
+// motion's covariance; so k2 C, k3 3 a C, k4 (6 a^2 C + 3 C^2) (Isserlis), k1' the mean of
+// |a + X| of a Gaussian, the cross terms k_ij C_ij (the static orientation enters through
+// a_IA in k3, k4, k1'). The effects: pickoff (w_p^2/b) p2 E[theta^2]; pendulum geometry
+// dc_gain (-E[F_PA theta] - a_IA E[theta^2]/2); a readout polynomial E[R(u0 + U)] - R(u0) by
+// 24-point Gauss-Hermite (exact for degree < 48), U = I + the output cross terms' slope . F.
+// Sine on random (independent): each term's joint expectation, the random one averaged over
+// the sine's phase (eq3.hpp sine_on_random_rectification) with the sine through the loop at
+// its frequency; the angle's second moments add.
+// Not modelled for random motion: a squeeze film's amplitude-dependent damping (the nominal
+// damping is used), clipping beyond the current's Gaussian (range limit of I).
+#include <optional>
+
+#include <Eigen/Dense>
+
+#include "plant/accelerometer.hpp"
+#include "rectification/prediction/frequency.hpp"
+#include "vibration/random.hpp"
+
+namespace vrelab::rectification {
+
+// The joint covariance of the plant's linear responses to a random input, and the input's.
+// Index order of `covariance`: F_IA, F_PA, F_OA (felt, g), I (current, g), Theta (rad).
+struct RandomResponse {
+  enum Index : int { kF_IA = 0, kF_PA = 1, kF_OA = 2, kCurrent = 3, kAngle = 4 };
+  Eigen::Matrix<double, 5, 5> covariance = Eigen::Matrix<double, 5, 5>::Zero();
+  Eigen::Matrix3d input_covariance_g2 = Eigen::Matrix3d::Zero();  // of the case's motion x
+  double dc_gain = 1;
+  double from_Hz = 0, to_Hz = 0;
+  int frequencies = 0;  // loop responses evaluated
+};
+
+// Quadrature settings: each interval between table breakpoints is cut into pieces no wider
+// than max_log_step in ln f, each integrated by 8-point Gauss-Legendre.
+// With common_grid the pieces are instead [k h, (k + 1) h] in ln f (h = max_log_step) cut
+// only at the band's ends, so that tables with the same band share their frequencies (and a
+// cache of loop responses serves them all); a breakpoint inside a piece then costs O(h^2)
+// locally (~1e-4 relative at h = 0.1 on the standard tables).
+struct RandomQuadrature {
+  double max_log_step = 0.02;
+  bool common_grid = false;
+};
+
+// The one-sided cross-spectral density S(f) of the profile, g^2/Hz (real: the synthesis
+// uses zero relative phase for common coupling).
+Eigen::Matrix3d cross_spectrum_g2_per_Hz(const vibration::RandomProfile& p, double frequency_Hz);
+
+RandomResponse random_response(const vibration::RandomProfile& p, const ResponseAt& response,
+                               const RandomQuadrature& q = {});
+RandomResponse random_response(const plant::PlantConfig& plant, const vibration::RandomProfile& p,
+                               const RandomQuadrature& q = {});
+
+// Random only (sine == nullopt), or sine on random (the sine's loop response at its frequency).
+FrequencyPrediction random_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
+                                                      const RandomResponse& random,
+                                                      const std::optional<vibration::SineVibration>& sine = std::nullopt,
+                                                      const std::optional<LoopResponse>& sine_response = std::nullopt,
+                                                      std::optional<double> range_limit_g = std::nullopt);
+
+// Convenience: the loop responses computed here.
+FrequencyPrediction random_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
+                                                      const vibration::RandomProfile& p,
+                                                      std::optional<double> range_limit_g = std::nullopt);
+FrequencyPrediction sine_on_random_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
+                                                              const vibration::SineVibration& sine,
+                                                              const vibration::RandomProfile& p,
+                                                              std::optional<double> range_limit_g = std::nullopt);
+
+// A Gaussian description (rms and correlation) of a 3x3 covariance (axes at rest: rms 0,
+// correlation 0 off the diagonal).
+vibration::RandomVibration gaussian_of(const Eigen::Matrix3d& covariance_g2);
+
+}  // namespace vrelab::rectification
