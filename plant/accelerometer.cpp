@@ -178,8 +178,23 @@ double Accelerometer::solve_z(double i) const {
   // m_il(z) = z + F_input(z) + F_loop(z) = i: monotone, a small perturbation of z = i.
   double z = i - f_ia(Location::input, i) - f_ia(Location::loop, i);
   for (int it = 0; it < 30; ++it) {
-    const double g = z + f_ia(Location::input, z) + f_ia(Location::loop, z) - i;
-    const double dz = g / (1 + f_ia_slope(Location::input, z) + f_ia_slope(Location::loop, z));
+    // f_ia and f_ia_slope at the input and in the loop in one pass over the terms (the same
+    // sums in the same order: bit-identical to four calls).
+    double f_in = 0, f_loop = 0, s_in = 0, s_loop = 0;
+    for (int c : kIaTerms) {
+      const Location l = config_.location[c];
+      if (l == Location::output) continue;
+      const double k = config_.coefficients[c], f = k * ia_basis(c, z), sl = k * ia_basis_slope(c, z);
+      if (l == Location::input) {
+        f_in += f;
+        s_in += sl;
+      } else {
+        f_loop += f;
+        s_loop += sl;
+      }
+    }
+    const double g = z + f_in + f_loop - i;
+    const double dz = g / (1 + s_in + s_loop);
     z -= dz;
     if (std::abs(dz) <= 1e-16 * (1 + std::abs(z))) break;
   }
@@ -194,7 +209,14 @@ double Accelerometer::readout(double i, const Vec3& a) const {
 }
 
 void Accelerometer::rhs(double t, const double* x, double* dx) const {
-  const Vec3 a_case = input_ ? Vec3(a_static_ + input_(t)) : a_static_;
+  evaluate(input_ ? Vec3(a_static_ + input_(t)) : a_static_, x, dx);
+}
+
+double Accelerometer::rhs_output(const Vec3& dynamic_input_g, const double* x, double* dx) const {
+  return evaluate(Vec3(a_static_ + dynamic_input_g), x, dx);
+}
+
+double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx) const {
   Vec3 a = a_case;
   for (std::size_t e = 0; e < config_.effects.size(); ++e)
     a = config_.effects[e]->input(a, x + effect_offset_[e], dx + effect_offset_[e]);
@@ -234,13 +256,14 @@ void Accelerometer::rhs(double t, const double* x, double* dx) const {
     dx[kAA1] = dx[kAA2] = 0.0;
   }
   dx[kQuadrature] = out - q_ref_;
+  return out;
 }
 
 double Accelerometer::output_g(double t, const double* x) const {
   if (config_.dynamics.antialias_Hz > 0) return x[kAA1];
   const Vec3 a_case = input_ ? Vec3(a_static_ + input_(t)) : a_static_;
   Vec3 a = a_case;
-  std::vector<double> scratch(static_cast<std::size_t>(n_));
+  std::vector<double> scratch(config_.effects.empty() ? 0 : static_cast<std::size_t>(n_));  // no allocation without effects
   for (std::size_t e = 0; e < config_.effects.size(); ++e)
     a = config_.effects[e]->input(a, x + effect_offset_[e], scratch.data() + effect_offset_[e]);
   double p = x[kTheta];
