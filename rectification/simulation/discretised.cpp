@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -58,47 +57,47 @@ std::pair<std::int64_t, std::int64_t> rational_ratio(double ratio) {
   return {0, 0};
 }
 
-// The per-step arithmetic, with fixed sizes for the common plants (7 core states; 1-3 excited
-// axes) so that Eigen unrolls and vectorises the small products, Dynamic otherwise.
+// The per-step arithmetic on the states that move (`act`), with fixed sizes for the common
+// plants (5 such states: the pendulum's two, the lead, the PI integral and the quadrature;
+// 1-3 excited axes) so that Eigen unrolls the small products, Dynamic otherwise.
 template <int N, int W>
 struct Kernel {
   using MapM = Eigen::Map<const Eigen::Matrix<double, N, N>>;
   using MapV = Eigen::Map<Eigen::Matrix<double, N, 1>>;
   using MapCV = Eigen::Map<const Eigen::Matrix<double, N, 1>>;
-  // z <- E z + K w;  y_pred <- E y + P1 N.
+  // kw = K w;  z <- E z + kw;  sigma <- sigma + kw + P1 g + E P2 dN.
   static void propagate(const StepData& d) {
     const int n = d.n, w = d.w;
-    const MapM e(d.e, n, n), p1(d.p1, n, n);
+    const MapM e(d.e, n, n), p1(d.p1, n, n), ep2(d.ep2, n, n);
     const Eigen::Map<const Eigen::Matrix<double, N, W>> k(d.k, n, w);
     const Eigen::Map<const Eigen::Matrix<double, W, 1>> window(d.window, w);
-    MapV z(d.z, n), ypred(d.y_pred, n);
-    const MapCV y(d.y, n), nnow(d.n_now, n);
-    Eigen::Matrix<double, N, 1> t(n);
+    MapV z(d.z, n), sigma(d.sigma, n);
+    const MapCV g(d.g, n), dn(d.dn, n);
+    Eigen::Matrix<double, N, 1> kw(n), t(n);
+    kw.noalias() = k * window;
     t.noalias() = e * z;
-    t.noalias() += k * window;
-    z = t;
-    ypred.noalias() = e * y;
-    ypred.noalias() += p1 * nnow;
+    z = t + kw;
+    t.noalias() = p1 * g;
+    t.noalias() += ep2 * dn;
+    sigma += kw + t;
   }
-  // N = f - A (z + y_pred) - B a (f in n_now on entry); y = y_pred + P2 (N - N_prev);
-  // returns C (y - y_pred).
+  // g <- f - B a (f in g on entry); N = g - A sigma; dN = N - N_prev (0 at the start);
+  // returns C P2 dN (the output's correction from sigma to the corrected state).
   static double correct(const StepData& d, bool first) {
     const int n = d.n;
-    const MapM a(d.a, n, n), p2(d.p2, n, n);
-    MapV nnow(d.n_now, n), nprev(d.n_prev, n), y(d.y, n);
-    const MapCV z(d.z, n), ypred(d.y_pred, n), c(d.c, n);
-    Eigen::Matrix<double, N, 1> x(n);
-    x = z + ypred;
-    nnow.noalias() -= a * x;
-    for (int i = 0; i < d.k_axes; ++i) nnow -= Eigen::Map<const Eigen::Matrix<double, N, 1>>(d.b + i * n, n) * d.a_k[i];
-    if (first) {
-      y.setZero();
-      return 0.0;
-    }
-    x = nnow - nprev;
-    y = ypred;
-    y.noalias() += p2 * x;
-    return c.dot(y - ypred);
+    const MapM a(d.a, n, n);
+    MapV g(d.g, n), nprev(d.n_prev, n), dn(d.dn, n);
+    const MapCV sigma(d.sigma, n), cp2(d.c_p2, n);
+    for (int i = 0; i < d.k_axes; ++i) g -= Eigen::Map<const Eigen::Matrix<double, N, 1>>(d.b + i * n, n) * d.a_k[i];
+    Eigen::Matrix<double, N, 1> nnow(n);
+    nnow = g;
+    nnow.noalias() -= a * sigma;
+    if (first)
+      dn.setZero();
+    else
+      dn = nnow - nprev;
+    nprev = nnow;
+    return cp2.dot(dn);
   }
 };
 
@@ -149,7 +148,7 @@ std::string DiscretisedRandomPlant::unsupported(const plant::PlantConfig& config
 DiscretisedRandomPlant::DiscretisedRandomPlant(const Accelerometer& plant, const Accelerometer::Linear& lin,
                                                const std::vector<double>& x_eq, const vibration::RandomExcitation& ex,
                                                double rate)
-    : plant_(plant), lin_(lin), x_eq_(x_eq), rate_(rate), n_(plant.size()) {
+    : plant_(plant), x_eq_(x_eq), rate_(rate), n_(plant.size()) {
   const std::string why = unsupported(plant.config(), ex, rate);
   if (!why.empty()) throw std::invalid_argument("discretised random path: " + why);
   const double fs = ex.sample_rate_Hz();
@@ -173,8 +172,8 @@ DiscretisedRandomPlant::DiscretisedRandomPlant(const Accelerometer& plant, const
 
   // The plant augmented by the input polynomial's derivative chain (time in knot intervals):
   // [z; a; a'; ...; a^(5)]' = [[A/fs, B/fs, 0..], [0, 0, I, ..], ..., [0 ..]] [...].
-  const Eigen::Index na = n + 6 * k;
-  Eigen::MatrixXd aug = Eigen::MatrixXd::Zero(na, na);
+  const Eigen::Index n_aug = n + 6 * k;
+  Eigen::MatrixXd aug = Eigen::MatrixXd::Zero(n_aug, n_aug);
   aug.topLeftCorner(n, n) = a_mat_ / fs;
   aug.block(0, n, n, k) = b_mat_ / fs;
   for (Eigen::Index d = 0; d < 5; ++d)
@@ -219,51 +218,84 @@ DiscretisedRandomPlant::DiscretisedRandomPlant(const Accelerometer& plant, const
   etd.block(0, n, n, n).setIdentity();
   etd.block(n, 2 * n, n, n).setIdentity();
   const Eigen::MatrixXd phi = etd.exp();
-  e_ = whole.topLeftCorner(n, n);
-  p1_ = h * phi.block(0, n, n, n);
-  p2_ = h * phi.block(0, 2 * n, n, n);
-  if (std::getenv("VRELAB_ETD1")) p2_.setZero();
-
-  z_ = y_ = y_pred_ = n_now_ = n_prev_ = x_ = Eigen::VectorXd::Zero(n);
-  window_ = Eigen::VectorXd::Zero(7 * k);
-  a_k_ = Eigen::VectorXd::Zero(k);
-  c_ = lin.C.transpose();
-  q_row_ = lin.A.row(Accelerometer::kQuadrature).transpose();
+  // Restricted to the states that move: the inert ones (zero row and column of A, zero row
+  // of B: the anti-alias filter when off) stay at rest, their blocks of every matrix being 0.
+  std::vector<int> inert;
+  for (int i = 0; i < n_; ++i) {
+    const bool still = lin.A.row(i).cwiseAbs().maxCoeff() == 0 && lin.A.col(i).cwiseAbs().maxCoeff() == 0 &&
+                       lin.B.row(i).cwiseAbs().maxCoeff() == 0;
+    (still ? inert : act_).push_back(i);
+  }
+  inert_ = inert;
+  na_ = static_cast<int>(act_.size());
+  const Eigen::Index na = na_;
+  // Rows on the moving states; columns too when they are states (square), else all.
+  auto restrict = [&](const Eigen::MatrixXd& full, bool square) {
+    Eigen::MatrixXd r(na, square ? na : full.cols());
+    for (Eigen::Index i = 0; i < na; ++i)
+      for (Eigen::Index c = 0; c < r.cols(); ++c)
+        r(i, c) = full(act_[static_cast<std::size_t>(i)], square ? act_[static_cast<std::size_t>(c)] : c);
+    return r;
+  };
+  const Eigen::MatrixXd p2 = restrict(h * phi.block(0, 2 * n, n, n), true);
+  e_ = restrict(whole.topLeftCorner(n, n), true);
+  p1_ = restrict(h * phi.block(0, n, n, n), true);
+  ep2_ = e_ * p2;
+  a_mat_ = restrict(a_mat_, true);
+  b_mat_ = restrict(b_mat_, false);
+  for (auto& kj : k_step_) kj = restrict(kj, false);
+  Eigen::RowVectorXd c_act(na), q_row(na);
+  for (Eigen::Index i = 0; i < na; ++i) {
+    c_act[i] = lin.C[act_[static_cast<std::size_t>(i)]];
+    q_row[i] = lin.A(Accelerometer::kQuadrature, act_[static_cast<std::size_t>(i)]);
+    if (act_[static_cast<std::size_t>(i)] == Accelerometer::kQuadrature) q_index_ = static_cast<int>(i);
+  }
+  c_p2_ = (c_act * p2).transpose();
+  p2_q_ = p2.row(q_index_).transpose();
+  q_row_ = q_row.transpose();
   q_input_.resize(k);
   for (Eigen::Index a = 0; a < k; ++a) q_input_[a] = lin.B(Accelerometer::kQuadrature, axes_[static_cast<std::size_t>(a)]);
-  // The fixed-size kernels for the plants without stateful effects.
+
+  z_ = sigma_ = g_ = n_prev_ = dn_ = Eigen::VectorXd::Zero(na);
+  window_ = Eigen::VectorXd::Zero(7 * k);
+  a_k_ = Eigen::VectorXd::Zero(k);
+  x_.assign(static_cast<std::size_t>(n), 0.0);
+  f_.assign(static_cast<std::size_t>(n), 0.0);
   propagate_ = &Kernel<Eigen::Dynamic, Eigen::Dynamic>::propagate;
   correct_ = &Kernel<Eigen::Dynamic, Eigen::Dynamic>::correct;
-  if (n == Accelerometer::kCoreStates) {
-    if (k == 1) propagate_ = &Kernel<7, 7>::propagate, correct_ = &Kernel<7, 7>::correct;
-    if (k == 2) propagate_ = &Kernel<7, 14>::propagate, correct_ = &Kernel<7, 14>::correct;
-    if (k == 3) propagate_ = &Kernel<7, 21>::propagate, correct_ = &Kernel<7, 21>::correct;
+  if (na == 5) {
+    if (k == 1) propagate_ = &Kernel<5, 7>::propagate, correct_ = &Kernel<5, 7>::correct;
+    if (k == 2) propagate_ = &Kernel<5, 14>::propagate, correct_ = &Kernel<5, 14>::correct;
+    if (k == 3) propagate_ = &Kernel<5, 21>::propagate, correct_ = &Kernel<5, 21>::correct;
   }
+  data_ = step_data();
   evaluate_at_grid_point();
 }
 
 DiscretisedRandomPlant::~DiscretisedRandomPlant() = default;
 
-double DiscretisedRandomPlant::residual_quadrature() const { return y_[Accelerometer::kQuadrature]; }
+double DiscretisedRandomPlant::residual_quadrature() const {
+  // y_Q = Q - z_Q at the corrected state sigma + P2 dN.
+  return sigma_[q_index_] - z_[q_index_] + p2_q_.dot(dn_);
+}
 
-StepData DiscretisedRandomPlant::step_data(std::int64_t j) {
+StepData DiscretisedRandomPlant::step_data() {
   StepData d;
-  d.n = n_;
+  d.n = na_;
   d.w = 7 * k_;
   d.k_axes = k_;
   d.e = e_.data();
   d.p1 = p1_.data();
-  d.p2 = p2_.data();
+  d.ep2 = ep2_.data();
   d.a = a_mat_.data();
   d.b = b_mat_.data();
-  d.k = k_step_[static_cast<std::size_t>(j)].data();
-  d.c = c_.data();
+  d.c_p2 = c_p2_.data();
   d.window = window_.data();
   d.z = z_.data();
-  d.y = y_.data();
-  d.y_pred = y_pred_.data();
-  d.n_now = n_now_.data();
+  d.sigma = sigma_.data();
+  d.g = g_.data();
   d.n_prev = n_prev_.data();
+  d.dn = dn_.data();
   d.a_k = a_k_.data();
   return d;
 }
@@ -273,7 +305,8 @@ void DiscretisedRandomPlant::advance() {
   coef_->ensure(n0 - 2, n0 + 4);
   for (int w = 0; w < 7; ++w)
     for (int a = 0; a < k_; ++a) window_[w * k_ + a] = coef_->at(static_cast<std::size_t>(a), n0 - 2 + w);
-  propagate_(step_data(j));
+  data_.k = k_step_[static_cast<std::size_t>(j)].data();
+  propagate_(data_);
   ++m_;
   evaluate_at_grid_point();
 }
@@ -287,13 +320,17 @@ void DiscretisedRandomPlant::evaluate_at_grid_point() {
     double s = 0;
     for (int i = 0; i < 6; ++i) s += w[static_cast<std::size_t>(i)] * coef_->at(static_cast<std::size_t>(a), n0 - 2 + i);
     a_[axes_[static_cast<std::size_t>(a)]] = s;
+    a_k_[a] = s;
   }
-  for (int a = 0; a < k_; ++a) a_k_[a] = a_[axes_[static_cast<std::size_t>(a)]];
-  for (int i = 0; i < n_; ++i) x_[i] = x_eq_[static_cast<std::size_t>(i)] + z_[i] + y_pred_[i];
-  std::swap(n_prev_, n_now_);
-  out_ = plant_.rhs_output(a_, x_.data(), n_now_.data());
+  for (int i = 0; i < n_; ++i) x_[static_cast<std::size_t>(i)] = x_eq_[static_cast<std::size_t>(i)];
+  for (int i = 0; i < na_; ++i) x_[static_cast<std::size_t>(act_[static_cast<std::size_t>(i)])] += sigma_[i];
+  out_ = plant_.rhs_output(a_, x_.data(), f_.data());
   ++evaluations_;
-  out_ += correct_(step_data(j), m_ == 0);  // y at rest at m = 0
+  for (int i = 0; i < na_; ++i) g_[i] = f_[static_cast<std::size_t>(act_[static_cast<std::size_t>(i)])];
+  for (int i : inert_)
+    if (f_[static_cast<std::size_t>(i)] != 0.0)
+      throw std::logic_error("DiscretisedRandomPlant: a state the linearisation holds still moved");
+  out_ += correct_(data_, m_ == 0);
   linear_ = q_row_.dot(z_) + q_input_.dot(a_k_);
 }
 

@@ -44,9 +44,9 @@ namespace vrelab::rectification {
 // Pointers into a DiscretisedRandomPlant's matrices and vectors for one step (internal).
 struct StepData {
   int n = 0, w = 0, k_axes = 0;
-  const double *e = nullptr, *p1 = nullptr, *p2 = nullptr, *a = nullptr, *b = nullptr, *k = nullptr, *c = nullptr,
-               *window = nullptr, *a_k = nullptr;
-  double *z = nullptr, *y = nullptr, *y_pred = nullptr, *n_now = nullptr, *n_prev = nullptr;
+  const double *e = nullptr, *p1 = nullptr, *ep2 = nullptr, *a = nullptr, *b = nullptr, *k = nullptr,
+               *c_p2 = nullptr, *window = nullptr, *a_k = nullptr;
+  double *z = nullptr, *sigma = nullptr, *g = nullptr, *n_prev = nullptr, *dn = nullptr;
 };
 
 class DiscretisedRandomPlant {
@@ -72,23 +72,29 @@ class DiscretisedRandomPlant {
  private:
   struct Coefficients;
   void evaluate_at_grid_point();  // a, N, output, linear output at m (y holds the prediction)
-  StepData step_data(std::int64_t phase);
+  StepData step_data();
 
   const plant::Accelerometer& plant_;
-  const plant::Accelerometer::Linear& lin_;
   const std::vector<double>& x_eq_;
   double rate_;
-  int n_;
-  std::vector<int> axes_;  // excited axes
-  int k_ = 0;              // their number
+  int n_;                       // plant states
+  std::vector<int> act_, inert_;  // states that move / that the linearisation holds still
+  int na_ = 0, q_index_ = 0;    // act_'s size, the quadrature's place in it
+  std::vector<int> axes_;       // excited axes
+  int k_ = 0;                   // their number
   std::int64_t p_ = 1, q_ = 1;  // grid step = p/q knot intervals
   std::int64_t m_ = 0;
   // Per phase j (grid point m at knot position floor + j/q): input weights (6) and the input
-  // contribution over the step (n x 7k, row-major).
+  // contribution over the step (na x 7k).
   std::vector<std::vector<double>> weights_;
   std::vector<Eigen::MatrixXd> k_step_;
-  Eigen::MatrixXd e_, p1_, p2_, a_mat_, b_mat_;  // e^{Ah}, h phi1, h phi2, A, B (excited axes)
-  Eigen::VectorXd z_, y_, y_pred_, n_now_, n_prev_, x_, window_, a_k_, c_, q_row_, q_input_;
+  // On the moving states: e^{Ah}, h phi1(Ah), e^{Ah} h phi2(Ah), A, B (excited axes).
+  Eigen::MatrixXd e_, p1_, ep2_, a_mat_, b_mat_;
+  // z: the companion; sigma: the deviation x - x_eq where the plant is evaluated (the ETD2
+  // prediction; the corrected state is sigma + P2 dN); g = f - B a; N_prev; dN.
+  Eigen::VectorXd z_, sigma_, g_, n_prev_, dn_, window_, a_k_, c_p2_, p2_q_, q_row_, q_input_;
+  std::vector<double> x_, f_;  // full plant state and derivative
+  StepData data_;
   void (*propagate_)(const StepData&) = nullptr;
   double (*correct_)(const StepData&, bool first) = nullptr;
   Vec3 a_ = Vec3::Zero();
