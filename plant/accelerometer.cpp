@@ -144,6 +144,8 @@ Accelerometer::Accelerometer(PlantConfig config, const Vec3& a_static_g, Input i
     has_loop_ |= config_.location[c] == Location::loop;
     has_out_ia_ |= config_.location[c] == Location::output;
   }
+  for (int c : kCrossTerms)
+    if (config_.coefficients[c] != 0) has_cross_[static_cast<std::size_t>(config_.location[c])] = true;
   n_ = kCoreStates;
   for (const auto& e : config_.effects) {
     effect_offset_.push_back(n_);
@@ -166,6 +168,7 @@ double Accelerometer::f_ia_slope(Location l, double z) const {
 }
 
 double Accelerometer::cross(Location l, const Vec3& a) const {
+  if (!has_cross_[static_cast<std::size_t>(l)]) return 0.0;  // the sum below of zero terms
   const Basis f = basis(a);
   double s = 0;
   for (int c : kCrossTerms)
@@ -183,8 +186,9 @@ double Accelerometer::solve_z(double i) const {
     double f_in = 0, f_loop = 0, s_in = 0, s_loop = 0;
     for (int c : kIaTerms) {
       const Location l = config_.location[c];
-      if (l == Location::output) continue;
-      const double k = config_.coefficients[c], f = k * ia_basis(c, z), sl = k * ia_basis_slope(c, z);
+      const double k = config_.coefficients[c];
+      if (l == Location::output || k == 0) continue;  // adds +-0 to sums that start at +0
+      const double f = k * ia_basis(c, z), sl = k * ia_basis_slope(c, z);
       if (l == Location::input) {
         f_in += f;
         s_in += sl;
@@ -220,7 +224,7 @@ double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx) 
   Vec3 a = a_case;
   for (std::size_t e = 0; e < config_.effects.size(); ++e)
     a = config_.effects[e]->input(a, x + effect_offset_[e], dx + effect_offset_[e]);
-  const double s1 = a[IA] + f_ia(Location::input, a[IA]) + cross(Location::input, a);
+  const double s1 = a[IA] + (has_in_ia_ ? f_ia(Location::input, a[IA]) : 0.0) + cross(Location::input, a);
 
   const double theta = x[kTheta], omega = x[kOmega];
   double p = theta;

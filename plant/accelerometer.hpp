@@ -132,6 +132,7 @@ class Accelerometer final : public OdeSystem {
   std::vector<int> effect_offset_;
   double q_ref_ = 0.0;
   bool has_in_ia_ = false, has_loop_ = false, has_out_ia_ = false;
+  std::array<bool, 3> has_cross_{};  // a cross term with a non-zero coefficient at each Location
 };
 
 // The plant run statically: from rest with every state zero (the instrument switched on in
