@@ -502,21 +502,38 @@ ShakeResult shake_excitation(const plant::PlantConfig& config, const Vec3& a_sta
       const long settle_n = static_cast<long>(std::ceil(r.settle_s * rate));
       const long block_n = std::max<long>(2, static_cast<long>(std::llround(measure_s * rate / s.blocks)));
       const long total_n = settle_n + s.blocks * block_n;
+      long steps_done = total_n;
       if (!sampled) {
+        // The blocks of the CVODE path (edges at settle_s + b measure_s / blocks): the residual
+        // integral y_Q between grid points by the cubic Hermite through its values and slopes
+        // (the slope: output - baseline - linear output), an error ~(w h)^4 / 384 of a step's
+        // increment, ~1e-11 g at 4 kHz content on a 16 kHz grid.
         r.method = "continuous integral";
-        while (plant.index() < settle_n) plant.advance();
-        double q_prev = plant.residual_quadrature();
+        auto slope = [&] { return plant.output_g() - r.baseline_g - plant.linear_output_g(); };
+        double t0 = 0, q0 = plant.residual_quadrature(), d0 = slope();
+        auto residual_at = [&](double t) {
+          while (plant.time_s() < t) {
+            t0 = plant.time_s(), q0 = plant.residual_quadrature(), d0 = slope();
+            plant.advance();
+          }
+          const double t1 = plant.time_s(), q1 = plant.residual_quadrature(), d1 = slope();
+          if (!(t1 > t0) || t >= t1) return q1;
+          const double h = t1 - t0, u = (t - t0) / h, u2 = u * u, u3 = u2 * u;
+          return (2 * u3 - 3 * u2 + 1) * q0 + (u3 - 2 * u2 + u) * h * d0 + (3 * u2 - 2 * u3) * q1 + (u3 - u2) * h * d1;
+        };
+        const double block_s = measure_s / s.blocks;
+        double q_prev = residual_at(r.settle_s);
         std::vector<double> block_mean;
         r.measured_g = 0;
         for (int b = 1; b <= s.blocks; ++b) {
-          while (plant.index() < settle_n + b * block_n) plant.advance();
-          const double q = plant.residual_quadrature();
-          block_mean.push_back((q - q_prev) / (static_cast<double>(block_n) * dt));
+          const double q = residual_at(r.settle_s + b * block_s);
+          block_mean.push_back((q - q_prev) / block_s);
           r.measured_g += block_mean.back() / s.blocks;
           q_prev = q;
         }
         r.integral_slope_g = r.measured_g;
         r.sigma_g = batch_sigma(block_mean, r.measured_g);
+        steps_done = plant.index();
       } else {
         r.method = "sampled record";
         r.sample_rate_Hz = rate;
@@ -528,7 +545,7 @@ ShakeResult shake_excitation(const plant::PlantConfig& config, const Vec3& a_sta
         rec.finish(r);
       }
       r.periods = 0;
-      r.simulated_s = static_cast<double>(total_n) * dt;
+      r.simulated_s = static_cast<double>(steps_done) * dt;
       r.steps = plant.index();
       r.rhs_evaluations = plant.plant_evaluations();
       return r;
