@@ -8,6 +8,8 @@
 #include <Eigen/Dense>
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "core/cancel.hpp"
+
 namespace vrelab::rectification {
 namespace {
 
@@ -115,6 +117,7 @@ struct DiscretisedRandomPlant::Coefficients {
   // Coefficients [lo, hi] available.
   void ensure(std::int64_t lo, std::int64_t hi) {
     if (first != std::numeric_limits<std::int64_t>::min() && lo >= first && hi < first + kLength) return;
+    core::throw_if_cancelled();  // a caller's cancel flag (core/cancel.hpp), every 8192 knots
     first = lo;
     const vibration::SampledSignal s = ex.samples(first - kMargin, static_cast<std::size_t>(kLength + 2 * kMargin));
     c.resize(axes.size());
