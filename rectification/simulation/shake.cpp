@@ -1,5 +1,6 @@
 #include "rectification/simulation/shake.hpp"
 
+#include "core/cancel.hpp"
 #include "rectification/simulation/discretised.hpp"
 #include "vibration/sampled.hpp"
 
@@ -69,6 +70,7 @@ class SampledRecorder {
         rest_(static_cast<std::size_t>(blocks), 0.0), vib_(rest_) {
     const long rest_n = blocks * block_n;
     for (long m = 0; m < rest_n; ++m) {
+      if (m % 65536 == 0) core::throw_if_cancelled();  // a long record at rest (Ctrl-C from Python)
       const double u = acquire(baseline_g);
       rest_[static_cast<std::size_t>(m / block_n)] += u / k1;
       if (sink_) sink_(static_cast<double>(m - rest_n) * dt, Vec3::Zero(), u);
