@@ -5,6 +5,8 @@
 #include <limits>
 #include <complex>
 #include <numbers>
+#include <optional>
+#include <utility>
 #include <stdexcept>
 
 #include <Eigen/Dense>
@@ -81,7 +83,29 @@ bool Dynamics::IsValid(std::string* error) const {
   return true;
 }
 
+namespace {
+Servo design_servo_uncached(const Dynamics& d);
+bool same_dynamics(const Dynamics& a, const Dynamics& b) {
+  return a.pendulum_frequency_Hz == b.pendulum_frequency_Hz && a.pendulum_damping_ratio == b.pendulum_damping_ratio &&
+         a.angle_gain_rad_per_s2_per_g == b.angle_gain_rad_per_s2_per_g && a.loop_bandwidth_Hz == b.loop_bandwidth_Hz &&
+         a.phase_margin_deg == b.phase_margin_deg && a.integrator == b.integrator &&
+         a.integrator_zero_ratio == b.integrator_zero_ratio && a.antialias_Hz == b.antialias_Hz;
+}
+}  // namespace
+
+// The design (its check for a single crossing scans 3000 frequencies: ~0.1 ms, a quarter of a
+// sine condition's time when every plant constructed redesigned it) is kept for the last
+// dynamics seen on this thread.
 Servo design_servo(const Dynamics& d) {
+  thread_local std::optional<std::pair<Dynamics, Servo>> last;
+  if (last && same_dynamics(last->first, d)) return last->second;
+  const Servo s = design_servo_uncached(d);  // throws for invalid dynamics: nothing cached
+  last.emplace(d, s);
+  return s;
+}
+
+namespace {
+Servo design_servo_uncached(const Dynamics& d) {
   std::string why;
   if (!d.IsValid(&why)) throw std::invalid_argument(why);
   using C = std::complex<double>;
@@ -124,6 +148,7 @@ Servo design_servo(const Dynamics& d) {
                                 "the pendulum frequency (" + std::to_string(d.pendulum_frequency_Hz) + " Hz)");
   return s;
 }
+}  // namespace
 
 Accelerometer::Accelerometer(PlantConfig config, const Vec3& a_static_g, Input input)
     : config_(std::move(config)),
@@ -144,6 +169,8 @@ Accelerometer::Accelerometer(PlantConfig config, const Vec3& a_static_g, Input i
     has_loop_ |= config_.location[c] == Location::loop;
     has_out_ia_ |= config_.location[c] == Location::output;
   }
+  for (int c : kCrossTerms)
+    if (config_.coefficients[c] != 0) has_cross_[static_cast<std::size_t>(config_.location[c])] = true;
   n_ = kCoreStates;
   for (const auto& e : config_.effects) {
     effect_offset_.push_back(n_);
@@ -166,6 +193,7 @@ double Accelerometer::f_ia_slope(Location l, double z) const {
 }
 
 double Accelerometer::cross(Location l, const Vec3& a) const {
+  if (!has_cross_[static_cast<std::size_t>(l)]) return 0.0;  // the sum below of zero terms
   const Basis f = basis(a);
   double s = 0;
   for (int c : kCrossTerms)
@@ -178,8 +206,24 @@ double Accelerometer::solve_z(double i) const {
   // m_il(z) = z + F_input(z) + F_loop(z) = i: monotone, a small perturbation of z = i.
   double z = i - f_ia(Location::input, i) - f_ia(Location::loop, i);
   for (int it = 0; it < 30; ++it) {
-    const double g = z + f_ia(Location::input, z) + f_ia(Location::loop, z) - i;
-    const double dz = g / (1 + f_ia_slope(Location::input, z) + f_ia_slope(Location::loop, z));
+    // f_ia and f_ia_slope at the input and in the loop in one pass over the terms (the same
+    // sums in the same order: bit-identical to four calls).
+    double f_in = 0, f_loop = 0, s_in = 0, s_loop = 0;
+    for (int c : kIaTerms) {
+      const Location l = config_.location[c];
+      const double k = config_.coefficients[c];
+      if (l == Location::output || k == 0) continue;  // adds +-0 to sums that start at +0
+      const double f = k * ia_basis(c, z), sl = k * ia_basis_slope(c, z);
+      if (l == Location::input) {
+        f_in += f;
+        s_in += sl;
+      } else {
+        f_loop += f;
+        s_loop += sl;
+      }
+    }
+    const double g = z + f_in + f_loop - i;
+    const double dz = g / (1 + s_in + s_loop);
     z -= dz;
     if (std::abs(dz) <= 1e-16 * (1 + std::abs(z))) break;
   }
@@ -194,11 +238,18 @@ double Accelerometer::readout(double i, const Vec3& a) const {
 }
 
 void Accelerometer::rhs(double t, const double* x, double* dx) const {
-  const Vec3 a_case = input_ ? Vec3(a_static_ + input_(t)) : a_static_;
+  evaluate(input_ ? Vec3(a_static_ + input_(t)) : a_static_, x, dx);
+}
+
+double Accelerometer::rhs_output(const Vec3& dynamic_input_g, const double* x, double* dx) const {
+  return evaluate(Vec3(a_static_ + dynamic_input_g), x, dx);
+}
+
+double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx) const {
   Vec3 a = a_case;
   for (std::size_t e = 0; e < config_.effects.size(); ++e)
     a = config_.effects[e]->input(a, x + effect_offset_[e], dx + effect_offset_[e]);
-  const double s1 = a[IA] + f_ia(Location::input, a[IA]) + cross(Location::input, a);
+  const double s1 = a[IA] + (has_in_ia_ ? f_ia(Location::input, a[IA]) : 0.0) + cross(Location::input, a);
 
   const double theta = x[kTheta], omega = x[kOmega];
   double p = theta;
@@ -234,13 +285,14 @@ void Accelerometer::rhs(double t, const double* x, double* dx) const {
     dx[kAA1] = dx[kAA2] = 0.0;
   }
   dx[kQuadrature] = out - q_ref_;
+  return out;
 }
 
 double Accelerometer::output_g(double t, const double* x) const {
   if (config_.dynamics.antialias_Hz > 0) return x[kAA1];
   const Vec3 a_case = input_ ? Vec3(a_static_ + input_(t)) : a_static_;
   Vec3 a = a_case;
-  std::vector<double> scratch(static_cast<std::size_t>(n_));
+  std::vector<double> scratch(config_.effects.empty() ? 0 : static_cast<std::size_t>(n_));  // no allocation without effects
   for (std::size_t e = 0; e < config_.effects.size(); ++e)
     a = config_.effects[e]->input(a, x + effect_offset_[e], scratch.data() + effect_offset_[e]);
   double p = x[kTheta];

@@ -90,6 +90,10 @@ class Accelerometer final : public OdeSystem {
 
   // Normalised output U/K1 (g) at state x and time t (after the anti-alias filter if on).
   double output_g(double t, const double* x) const;
+  // rhs and output_g in one evaluation, at the dynamic input given (g, sensor axes) instead
+  // of the Input function: dx = rhs, returns the output (the discretised random path of
+  // rectification/simulation/discretised.hpp evaluates the plant once per sample this way).
+  double rhs_output(const Vec3& dynamic_input_g, const double* x, double* dx) const;
   // dQ/dt = output_g - quadrature_reference_g: Q integrates the output minus a reference.
   void set_quadrature_reference(double g) { q_ref_ = g; }
 
@@ -113,6 +117,7 @@ class Accelerometer final : public OdeSystem {
   const Vec3& static_g() const { return a_static_; }
 
  private:
+  double evaluate(const Vec3& a_case, const double* x, double* dx) const;  // rhs; returns the output
   double solve_z(double i) const;  // m_il^-1
   double f_ia(Location l, double z) const;
   double f_ia_slope(Location l, double z) const;
@@ -127,6 +132,7 @@ class Accelerometer final : public OdeSystem {
   std::vector<int> effect_offset_;
   double q_ref_ = 0.0;
   bool has_in_ia_ = false, has_loop_ = false, has_out_ia_ = false;
+  std::array<bool, 3> has_cross_{};  // a cross term with a non-zero coefficient at each Location
 };
 
 // The plant run statically: from rest with every state zero (the instrument switched on in

@@ -56,6 +56,10 @@ struct ShakeSettings {
   // shake_sine: reach the periodic steady state directly (docs/performance.md) instead of
   // integrating the settling; false forces the transient path (settle, then measure).
   bool periodic_steady_state = true;
+  // shake_excitation with a RandomExcitation: step once per sample with the exact
+  // discretisation of the linear loop and an exponential-integrator correction for the
+  // nonlinear terms (rectification/simulation/discretised.hpp); false forces CVODE.
+  bool exponential_integrator = true;
   bool IsValid(std::string* error) const;
 };
 
@@ -76,7 +80,9 @@ struct ShakeResult {
   long steps = 0, rhs_evaluations = 0;
   // How the run reached the state it measured (docs/performance.md): "transient" (settled
   // for settle_s, measured `periods` periods), "settle + one period" or "shooting" (the
-  // periodic steady state; one period stands for all, the record is replayed).
+  // periodic steady state; one period stands for all, the record is replayed); aperiodic
+  // runs: "exponential integrator" (one step per sample) or "CVODE" followed by the reason
+  // the exponential integrator did not apply.
   std::string path = "transient";
   int shooting_iterations = 0;  // one-period maps evaluated by the shooting
   double simulated_s = 0;       // time the ODE actually integrated
