@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 
 #include "app/commands.hpp"
+#include "core/dispatch.hpp"
 #include "core/progress.hpp"
+#include "io/batch.hpp"
 #include "io/diagnosis.hpp"
 #include "io/diagnosis_json.hpp"
 #include "io/diagnosis_report.hpp"
@@ -33,6 +35,15 @@ void run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
   out << program() << f.FullReport();
   if (!o.json_path.empty()) io::write_atomic(o.json_path, io::json_text(io::to_json(f)));
   if (!o.report_dir.empty()) io::write_diagnosis_report(f, o.report_dir);
+}
+
+int run_diagnose_many(const DiagnoseOptions& o, std::ostream& out) {
+  if (!o.json_path.empty() || !o.report_dir.empty())
+    throw io::InputError("diagnose --summary: --json and --report are for one campaign folder");
+  if (o.threads < 0) throw io::InputError("diagnose --threads: must not be negative (0: all cores)");
+  const io::BatchSummary s = io::diagnose_many({o.dirs, o.summary_path, o.settings, o.threads, o.progress, false}, out);
+  out << s.BriefReport(o.summary_path);
+  return static_cast<int>(s.failures.size());
 }
 
 void run_blind(const BlindOptions& o, std::ostream& out) {

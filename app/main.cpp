@@ -2,14 +2,21 @@
 // results out. Exit codes: 0 success, 2 bad input (case file, options,
 // parameters the physics rejects, solver failures), 1 anything else.
 #include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
 #include <functional>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/commands.hpp"
+#include "core/dispatch.hpp"
+#ifdef VRELAB_HAVE_MPI
+#include "core/mpi.hpp"
+#endif
 #include "io/case_file.hpp"
 #include "plant/ode_solver.hpp"
 #include "vrelab_version.hpp"
@@ -20,10 +27,12 @@ using namespace vrelab::app;
 using namespace vrelab::io;
 
 // A subcommand and what running it does (its exit code); each add_* registers
-// one command's options on the CLI.
+// one command's options on the CLI. `distributed`: the command hands its items to every rank
+// under mpirun (core/dispatch.hpp); the other commands run on rank 0 alone.
 struct Command {
   CLI::App* sub;
   std::function<int()> run;
+  std::function<bool()> distributed = [] { return false; };
 };
 
 Command add_identify(CLI::App& app) {
@@ -40,10 +49,12 @@ Command add_identify(CLI::App& app) {
   cmd->add_flag_callback(
       "--no-work-limit", [&o] { o.work_limit = false; },
       "Run even if the estimated work exceeds the limits (docs/case-files.md, Limits)");
-  return {cmd, [owned] {
+  return {cmd,
+          [owned] {
             run_identify(*owned, std::cout);
             return 0;
-          }};
+          },
+          [owned] { return owned->monte_carlo > 0; }};
 }
 
 Command add_predict(CLI::App& app) {
@@ -113,7 +124,7 @@ Command add_sweep(CLI::App& app) {
   cmd->add_flag_callback(
       "--no-work-limit", [&o] { o.work_limit = false; },
       "Run even if the estimated work exceeds the limits (docs/case-files.md, Limits)");
-  return {cmd, [owned] { return run_sweep(*owned, std::cout) > 0 ? 2 : 0; }};
+  return {cmd, [owned] { return run_sweep(*owned, std::cout) > 0 ? 2 : 0; }, [] { return true; }};
 }
 
 Command add_frequency(CLI::App& app) {
@@ -183,7 +194,14 @@ Command add_diagnose(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("diagnose",
                                      "The sim-to-real gap of a campaign: "
                                      "where, which effect, how far it shrinks");
-  cmd->add_option("dir", o.dir, "Campaign folder (docs/data-format.md)")->required();
+  cmd->add_option("dir", o.dirs,
+                  "Campaign folder (docs/data-format.md); with --summary: several, or folders of campaign folders")
+      ->required();
+  cmd->add_option("--summary", o.summary_path,
+                  "Diagnose every campaign given and write one row per campaign to this CSV (resumed if it exists; "
+                  "docs/mpi.md)");
+  cmd->add_option("--threads", o.threads, "With --summary: threads (0: all cores; under mpirun 1 per rank)");
+  cmd->add_flag_callback("--no-progress", [&o] { o.progress = false; }, "With --summary: no progress bar");
   cmd->add_option("--json", o.json_path, "Write the diagnosis as JSON");
   cmd->add_option("--report", o.report_dir, "Write report.md, report.html and diagnosis.json to this folder");
   // DiagnoseSettings over the manifest's [diagnose] (docs/data-format.md).
@@ -195,10 +213,17 @@ Command add_diagnose(CLI::App& app) {
   cmd->add_option("--resimulate-runs", o.settings.resimulate_runs, "Runs re-simulated on the ODE plant (12; 0: none)");
   cmd->add_flag_callback(
       "--no-pairs", [&o] { o.settings.try_pairs = false; }, "Do not try two effects at once");
-  return {cmd, [owned] {
-            run_diagnose(*owned, std::cout);
+  return {cmd,
+          [owned] {
+            DiagnoseOptions& d = *owned;
+            if (!d.summary_path.empty()) return run_diagnose_many(d, std::cout) > 0 ? 2 : 0;
+            if (d.dirs.size() > 1)
+              throw InputError("diagnose: several campaign folders need --summary FILE (one row per campaign)");
+            d.dir = d.dirs.front();
+            run_diagnose(d, std::cout);
             return 0;
-          }};
+          },
+          [owned] { return !owned->summary_path.empty(); }};
 }
 
 Command add_blind(CLI::App& app) {
@@ -213,15 +238,88 @@ Command add_blind(CLI::App& app) {
   cmd->add_option("--threads", o.settings.threads, "Threads (0: all cores)");
   cmd->add_flag_callback(
       "--no-progress", [&o] { o.progress = false; }, "No progress bar");
-  return {cmd, [owned] {
+  return {cmd,
+          [owned] {
             run_blind(*owned, std::cout);
             return 0;
-          }};
+          },
+          [] { return true; }};
+}
+
+#ifdef VRELAB_HAVE_MPI
+vrelab::core::MpiJob*& mpi_job() {
+  static vrelab::core::MpiJob* job = nullptr;
+  return job;
+}
+#endif
+
+// Under mpirun (core/mpi.hpp) rank 0 prints and writes; the other ranks say nothing, and a
+// failing rank ends the job: the others may wait in a dispatch it will not reach. A rank
+// other than 0 first gives rank 0 a second to report the same error (a bad case file is
+// every rank's) and end the job itself.
+int exit_code(int code, bool root) {
+#ifdef VRELAB_HAVE_MPI
+  if (code != 0 && vrelab::core::process_count() > 1 && mpi_job()) {
+    if (!root) std::this_thread::sleep_for(std::chrono::seconds(1));
+    std::fflush(nullptr);
+    mpi_job()->abort(code);
+  }
+#else
+  (void)root;
+#endif
+  return code;
+}
+
+// The chosen command's exit code; errors printed (rank 0), or by another rank with its number.
+int run_command(const std::vector<Command>& commands, bool root) {
+  const int rank = vrelab::core::process_rank();
+  auto report = [&](const char* kind, const char* what) {
+    if (root) std::cerr << "vrelab: " << kind << what << "\n";
+    else std::fprintf(stderr, "vrelab: rank %d: %s%s\n", rank, kind, what);
+  };
+  try {
+    for (const Command& c : commands)
+      if (*c.sub) {
+        if (!root && !c.distributed()) return 0;  // rank 0 runs it alone
+        return c.run();
+      }
+  } catch (const InputError& e) {
+    report("error: ", e.what());
+    return 2;
+  } catch (const vrelab::plant::SolverError& e) {
+    report("error: ", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    // The library rejects parameters it cannot work with (e.g. an unstable loop
+    // design): input that passed the case reader's checks but not the physics.
+    report("error: ", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    report("internal error: ", e.what());
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+#ifdef VRELAB_HAVE_MPI
+  // Only under mpirun; without it the program runs on threads, as it does without MPI.
+  std::unique_ptr<vrelab::core::MpiJob> mpi;
+  try {
+    mpi = vrelab::core::start_mpi(&argc, &argv);
+  } catch (const std::exception& e) {
+    std::cerr << "vrelab: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  mpi_job() = mpi.get();
+#endif
+  const bool root = vrelab::core::is_root_process();
+  if (!root) {  // no output, no progress from the other ranks
+    std::cout.setstate(std::ios::badbit);
+    std::cerr.setstate(std::ios::badbit);
+  }
   CLI::App app{
       "vrelab: a virtual shaker laboratory for the vibration "
       "rectification error of accelerometers"};
@@ -237,23 +335,5 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
-  try {
-    for (const Command& c : commands)
-      if (*c.sub) return c.run();
-  } catch (const InputError& e) {
-    std::cerr << "vrelab: error: " << e.what() << "\n";
-    return 2;
-  } catch (const vrelab::plant::SolverError& e) {
-    std::cerr << "vrelab: error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    // The library rejects parameters it cannot work with (e.g. an unstable loop
-    // design): input that passed the case reader's checks but not the physics.
-    std::cerr << "vrelab: error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "vrelab: internal error: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  return exit_code(run_command(commands, root), root);
 }
