@@ -253,29 +253,40 @@ vrelab::core::MpiJob*& mpi_job() {
 }
 #endif
 
+// A rank other than 0's error message, printed only if rank 0 has not ended the job first.
+std::string& worker_error() {
+  static std::string message;
+  return message;
+}
+
 // Under mpirun (core/mpi.hpp) rank 0 prints and writes; the other ranks say nothing, and a
-// failing rank ends the job: the others may wait in a dispatch it will not reach. A rank
-// other than 0 first gives rank 0 a second to report the same error (a bad case file is
-// every rank's) and end the job itself.
-int exit_code(int code, bool root) {
+// rank that met an error (`raised`) ends the job: the others may wait in a dispatch it will
+// not reach. A rank other than 0 first gives rank 0 3 s to report the same error (a bad
+// case file is every rank's) and end the job itself. A command that ran to its end with
+// failed items (exit 2) just returns: every rank has left the dispatch.
+int exit_code(int code, bool raised, bool root) {
 #ifdef VRELAB_HAVE_MPI
-  if (code != 0 && vrelab::core::process_count() > 1 && mpi_job()) {
-    if (!root) std::this_thread::sleep_for(std::chrono::seconds(1));
+  if (raised && vrelab::core::process_count() > 1 && mpi_job()) {
+    if (!root) {
+      std::this_thread::sleep_for(std::chrono::seconds(3));
+      std::fprintf(stderr, "%s\n", worker_error().c_str());
+    }
     std::fflush(nullptr);
     mpi_job()->abort(code);
   }
 #else
-  (void)root;
+  (void)raised, (void)root;
 #endif
   return code;
 }
 
 // The chosen command's exit code; errors printed (rank 0), or by another rank with its number.
-int run_command(const std::vector<Command>& commands, bool root) {
+int run_command(const std::vector<Command>& commands, bool root, bool* raised) {
   const int rank = vrelab::core::process_rank();
   auto report = [&](const char* kind, const char* what) {
+    *raised = true;
     if (root) std::cerr << "vrelab: " << kind << what << "\n";
-    else std::fprintf(stderr, "vrelab: rank %d: %s%s\n", rank, kind, what);
+    else worker_error() = std::string("vrelab: rank ").append(std::to_string(rank)).append(": ").append(kind).append(what);
   };
   try {
     for (const Command& c : commands)
@@ -335,5 +346,7 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
-  return exit_code(run_command(commands, root), root);
+  bool raised = false;
+  const int code = run_command(commands, root, &raised);
+  return exit_code(code, raised, root);
 }
