@@ -66,6 +66,9 @@ class MpiDistributor final : public Distributor, public MpiJob {
     // Worker ranks without MPI_THREAD_SERIALIZED use one thread (only it calls MPI).
     int t = threads_per_process(threads);
     if (!serialized_ && rank_ != 0) t = 1;
+    // Rank 0 computes beside coordinating, unless VRELAB_MPI_ROOT_THREADS says how many of its
+    // threads compute (0: it only coordinates; docs/mpi.md, beyond a few hundred ranks).
+    if (const char* v = std::getenv("VRELAB_MPI_ROOT_THREADS"); v && rank_ == 0) t = std::max(0, std::atoi(v));
     std::vector<int> counts(static_cast<std::size_t>(ranks_), 0);
     check(MPI_Gather(&t, 1, MPI_INT, counts.data(), 1, MPI_INT, 0, MPI_COMM_WORLD), "MPI_Gather");
     if (rank_ == 0) {
