@@ -3,9 +3,9 @@
 // Protocol, one dispatch: every rank sends rank 0 its threads (MPI_Gather). Each thread of a
 // worker rank then loops: under the rank's lock, send rank 0 a request (carrying its last
 // result, or its failure) and receive the reply, an item index or "stop"; compute the item
-// outside the lock. One request per rank is outstanding at a time, so a reply always belongs
+// outside the lock (waiting with MPI_Test and short sleeps). One request per rank is outstanding at a time, so a reply always belongs
 // to the thread that waits for it (MPI_THREAD_SERIALIZED is enough). Rank 0's main thread
-// coordinates: it polls for requests (MPI_Iprobe with a short sleep: a blocking receive
+// coordinates: it polls for requests (MPI_Iprobe, sleeping 20-250 us when idle: a blocking receive
 // spins a core in Open MPI, a core rank 0's own compute threads need), calls on_result
 // under the lock, and replies with the next item; rank 0's threads take items from the same
 // queue. The dispatch ends when every remote thread has been told to stop; after a failure
@@ -94,7 +94,16 @@ class MpiDistributor final : public Distributor, public MpiJob {
           std::lock_guard<std::mutex> g(mpi);
           const std::string m = message(item, status, payload);
           check(MPI_Send(m.data(), static_cast<int>(m.size()), MPI_BYTE, 0, kTagRequest, MPI_COMM_WORLD), "MPI_Send");
-          check(MPI_Recv(&next, 8, MPI_BYTE, 0, kTagReply, MPI_COMM_WORLD, MPI_STATUS_IGNORE), "MPI_Recv");
+          // Waits without spinning (a blocking receive would take a core from the threads
+          // computing on an oversubscribed node).
+          MPI_Request reply;
+          check(MPI_Irecv(&next, 8, MPI_BYTE, 0, kTagReply, MPI_COMM_WORLD, &reply), "MPI_Irecv");
+          for (int done = 0, wait_us = 0;;) {
+            check(MPI_Test(&reply, &done, MPI_STATUS_IGNORE), "MPI_Test");
+            if (done) break;
+            wait_us = wait_us == 0 ? 10 : std::min(wait_us * 2, 250);
+            std::this_thread::sleep_for(std::chrono::microseconds(wait_us));
+          }
         }
         if (next == kStop) return;
         item = next;
@@ -166,7 +175,7 @@ class MpiDistributor final : public Distributor, public MpiJob {
         MPI_Status st;
         check(MPI_Iprobe(MPI_ANY_SOURCE, kTagRequest, MPI_COMM_WORLD, &flag, &st), "MPI_Iprobe");
         if (!flag) {
-          idle_us = idle_us == 0 ? 20 : std::min(idle_us * 2, 1000);
+          idle_us = idle_us == 0 ? 20 : std::min(idle_us * 2, 250);
           std::this_thread::sleep_for(std::chrono::microseconds(idle_us));
           continue;
         }
