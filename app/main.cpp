@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <iostream>
 #include <memory>
@@ -118,7 +119,7 @@ Command add_sweep(CLI::App& app) {
   cmd->add_option("case", o.case_path, "Case file (TOML) with a [sweep] table")->required();
   cmd->add_option("--out", o.out_path, "Results CSV (resumed if it exists)")->required();
   cmd->add_flag("--restart", o.restart, "Discard an existing results file");
-  cmd->add_option("--threads", o.threads, "Threads (default: the case's, 0 = all cores)");
+  cmd->add_option("--threads", o.threads, "Threads (default: the case's, 0 = all cores; under mpirun per rank, 0 = 1)");
   cmd->add_flag_callback(
       "--no-progress", [&o] { o.progress = false; }, "No progress bar");
   cmd->add_flag_callback(
@@ -234,8 +235,9 @@ Command add_blind(CLI::App& app) {
                                      "diagnosed without their keys, then scored");
   cmd->add_option("--n", o.settings.n, "Number of campaigns")->capture_default_str();
   cmd->add_option("--seed", o.settings.seed, "Seed of the draw")->capture_default_str();
-  cmd->add_option("--out", o.out_dir, "Output folder (scores.json, confusion.csv)")->capture_default_str();
-  cmd->add_option("--threads", o.settings.threads, "Threads (0: all cores)");
+  cmd->add_option("--out", o.out_dir, "Output folder (scores.json, confusion.csv; campaigns.txt: a rerun resumes)")
+      ->capture_default_str();
+  cmd->add_option("--threads", o.settings.threads, "Threads (0: all cores; under mpirun per rank, 0 = 1)");
   cmd->add_flag_callback(
       "--no-progress", [&o] { o.progress = false; }, "No progress bar");
   return {cmd,
@@ -325,8 +327,16 @@ int main(int argc, char** argv) {
     return 1;
   }
   mpi_job() = mpi.get();
-#endif
   const bool root = vrelab::core::is_root_process();
+#else
+  // Built without MPI but started by mpirun: rank 0 runs the command on its threads, the
+  // others leave at once (N copies would each write the same files).
+  const char* rank_env = std::getenv("OMPI_COMM_WORLD_RANK") ? std::getenv("OMPI_COMM_WORLD_RANK") : std::getenv("PMI_RANK");
+  if (rank_env && std::string(rank_env) != "0") return 0;
+  if (rank_env)
+    std::cerr << "vrelab: note: built without MPI (-DVRELAB_MPI=ON, docs/mpi.md): running on rank 0's threads alone\n";
+  const bool root = true;
+#endif
   if (!root) {  // no output, no progress from the other ranks
     std::cout.setstate(std::ios::badbit);
     std::cerr.setstate(std::ios::badbit);
