@@ -11,7 +11,8 @@ cd "$(dirname "$0")"
 packages=(build-essential cmake git pkg-config
           libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libfftw3-dev libsundials-dev
           libgtest-dev libbenchmark-dev python3-matplotlib
-          python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest)
+          python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest
+          libopenmpi-dev openmpi-bin)
 
 run_main=1
 [ "${1:-}" = "--no-run" ] && run_main=0
@@ -25,8 +26,14 @@ if ! dpkg -s "${packages[@]}" >/dev/null 2>&1; then
 fi
 
 echo "== Building into build/"
+# The MPI build (sweep, blind, identify --monte-carlo, diagnose --summary across the ranks of
+# mpirun; docs/mpi.md) when Open MPI is installed, unless VRELAB_CMAKE_ARGS says otherwise.
+mpi_arg=""
+if command -v mpicxx >/dev/null 2>&1 && command -v mpirun >/dev/null 2>&1 && [[ "${VRELAB_CMAKE_ARGS:-}" != *VRELAB_MPI* ]]; then
+  mpi_arg="-DVRELAB_MPI=ON"
+fi
 # shellcheck disable=SC2086
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release ${VRELAB_CMAKE_ARGS:-}
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release $mpi_arg ${VRELAB_CMAKE_ARGS:-}
 cmake --build build -j"$(nproc)"
 
 # `import vrelab` for Debian's /usr/bin/python3: a .pth file in its site directory for local

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/dispatch.hpp"
 #include "io/case_file.hpp"
 #include "io/output.hpp"
 #include "io/results_json.hpp"
@@ -45,7 +46,12 @@ void run_identify(const IdentifyOptions& o, std::ostream& out) {
   if (o.seed) c.seed = *o.seed;
   if (o.work_limit) check_identify_work(c, o.monte_carlo);
   const IdentifyStudy s = identify(c, o.monte_carlo);
-  const nlohmann::json j = identify_json(c, s);
+  if (!core::is_root_process()) return;  // under mpirun the Monte Carlo's results are rank 0's
+  nlohmann::json j = identify_json(c, s);
+  if (o.monte_carlo > 0) {  // where the trials ran (they do not depend on it: blocks seeded by their index)
+    j["settings"]["monte_carlo_ranks"] = core::process_count();
+    j["settings"]["monte_carlo_threads_per_rank"] = core::threads_per_process(0);
+  }
   check_finite(c, j);
   out << identify_report(c, s);
   write_json(o.json_path, j);

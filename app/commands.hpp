@@ -91,8 +91,15 @@ void run_campaign(const CampaignOptions& o, std::ostream& out);
 struct DiagnoseOptions {
   std::string dir, json_path, report_dir;
   io::DiagnoseOverrides settings;  // over the manifest's [diagnose]
+  // Many campaigns (io/batch.hpp): the folders given, the summary CSV, threads, progress.
+  std::vector<std::string> dirs;
+  std::string summary_path;
+  int threads = 0;
+  bool progress = true;
 };
 void run_diagnose(const DiagnoseOptions& o, std::ostream& out);
+// diagnose DIR... --summary FILE; returns the number of campaigns that failed.
+int run_diagnose_many(const DiagnoseOptions& o, std::ostream& out);
 
 struct BlindOptions {
   validation::BlindSettings settings;

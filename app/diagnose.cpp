@@ -1,12 +1,17 @@
 // app/diagnose.cpp -- `vrelab campaign`, `vrelab diagnose`, `vrelab blind`: each calls one
 // library function, prints its report and writes its results (io/diagnosis.hpp,
 // validation/diagnosis/blind.hpp, io/diagnosis_json.hpp).
+#include <cstdint>
+#include <fstream>
 #include <iostream>
+#include <map>
 
 #include <fmt/format.h>
 
 #include "app/commands.hpp"
+#include "core/dispatch.hpp"
 #include "core/progress.hpp"
+#include "io/batch.hpp"
 #include "io/diagnosis.hpp"
 #include "io/diagnosis_json.hpp"
 #include "io/diagnosis_report.hpp"
@@ -35,16 +40,89 @@ void run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
   if (!o.report_dir.empty()) io::write_diagnosis_report(f, o.report_dir);
 }
 
+int run_diagnose_many(const DiagnoseOptions& o, std::ostream& out) {
+  if (!o.json_path.empty() || !o.report_dir.empty())
+    throw io::InputError("diagnose --summary: --json and --report are for one campaign folder");
+  if (o.threads < 0) throw io::InputError("diagnose --threads: must not be negative (0: all cores)");
+  const io::BatchSummary s = io::diagnose_many({o.dirs, o.summary_path, o.settings, o.threads, o.progress, false}, out);
+  out << s.BriefReport(o.summary_path);
+  return static_cast<int>(s.failures.size());
+}
+
+namespace {
+
+// blind --out DIR keeps DIR/campaigns.txt: a line per campaign diagnosed ("index<TAB>result
+// <TAB>checksum", validation::campaign_result_text), appended as each finishes, under a header
+// naming the seed, the diagnosis' settings and the program. A rerun with the same header
+// reads them back instead of running them again (a killed run resumes; --n may grow); a
+// line whose checksum fails (cut short, edited) is run again.
+std::string blind_header(const validation::BlindSettings& s) {
+  const auto& d = s.diagnose;
+  return fmt::format("# vrelab {} ({}) blind: campaigns diagnosed (index, result, checksum); seed {} model_accuracy {:.17g} "
+                     "significance_sigma {:.17g} explained_shrinkage {:.17g} resimulate_runs {} try_pairs {}\n",
+                     kProgramVersion, kGitDescribe, s.seed, d.model_accuracy, d.significance_sigma, d.explained_shrinkage,
+                     d.resimulate_runs, d.try_pairs);
+}
+
+std::string line_checksum(const std::string& text) {
+  std::uint32_t h = 2166136261u;
+  for (unsigned char ch : text) h = (h ^ ch) * 16777619u;
+  return fmt::format("{:08x}", h);
+}
+
+std::map<int, std::string> blind_done(const std::string& path, const std::string& header) {
+  std::map<int, std::string> done;
+  std::ifstream in(path);
+  std::string line;
+  if (!std::getline(in, line) || line + "\n" != header) return done;  // another seed, settings or program
+  while (std::getline(in, line)) {
+    const std::size_t a = line.find('\t'), b = line.rfind('\t');
+    if (a == std::string::npos || b == a) continue;
+    const std::string body = line.substr(0, b);
+    if (line_checksum(body) != line.substr(b + 1)) continue;
+    try {
+      done[std::stoi(line.substr(0, a))] = line.substr(a + 1, b - a - 1);
+    } catch (const std::exception&) {
+    }
+  }
+  return done;
+}
+
+}  // namespace
+
 void run_blind(const BlindOptions& o, std::ostream& out) {
   std::string why;
   if (!o.settings.IsValid(&why)) throw io::InputError("blind: " + why);
-  core::Progress bar(std::cerr, "blind", static_cast<std::size_t>(o.settings.n), o.progress);
-  const validation::BlindResult r = validation::run_blind(o.settings, [&bar](std::size_t, std::size_t) { bar.tick(); });
+  const bool writer = core::is_root_process();
+  const std::string done_path = o.out_dir + "/campaigns.txt", header = blind_header(o.settings);
+  std::map<int, std::string> done;
+  if (writer) {
+    done = blind_done(done_path, header);
+    std::string kept = header;
+    for (const auto& [i, t] : done) {
+      const std::string body = fmt::format("{}\t{}", i, t);
+      kept += body + "\t" + line_checksum(body) + "\n";
+    }
+    io::write_atomic(done_path, kept);
+  }
+  std::ofstream append;
+  if (writer) append.open(done_path, std::ios::app);
+  std::size_t resumed = 0;
+  for (const auto& [i, t] : done) resumed += i < o.settings.n;
+  core::Progress bar(std::cerr, "blind", static_cast<std::size_t>(o.settings.n) - resumed, o.progress && writer);
+  const validation::BlindResult r = validation::run_blind(
+      o.settings, [&bar](std::size_t, std::size_t) { bar.tick(); }, done,
+      [&](int i, const std::string& text) {
+        const std::string body = fmt::format("{}\t{}", i, text);
+        append << body << "\t" << line_checksum(body) << "\n" << std::flush;  // an interruption loses at most this line
+      });
   bar.finish();
+  if (!writer) return;
   io::write_atomic(o.out_dir + "/scores.json", io::json_text(io::to_json(r)));
   io::write_atomic(o.out_dir + "/confusion.csv", io::confusion_csv(r));
   io::write_atomic(o.out_dir + "/report.html", io::blind_html(r));
   out << program() << r.FullReport();
+  if (resumed > 0) out << fmt::format("  {} campaign(s) read back from {} (an earlier run)\n", resumed, done_path);
   const std::string plot = io::run_plot_script("confusion.py", o.out_dir);
   out << "Wrote " << o.out_dir << "/scores.json, report.html and confusion.csv"
       << (plot.empty() ? ", confusion.png/svg" : "; figure skipped: " + plot) << "\n";

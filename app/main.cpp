@@ -2,14 +2,22 @@
 // results out. Exit codes: 0 success, 2 bad input (case file, options,
 // parameters the physics rejects, solver failures), 1 anything else.
 #include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <iostream>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/commands.hpp"
+#include "core/dispatch.hpp"
+#ifdef VRELAB_HAVE_MPI
+#include "core/mpi.hpp"
+#endif
 #include "io/case_file.hpp"
 #include "plant/ode_solver.hpp"
 #include "vrelab_version.hpp"
@@ -20,10 +28,12 @@ using namespace vrelab::app;
 using namespace vrelab::io;
 
 // A subcommand and what running it does (its exit code); each add_* registers
-// one command's options on the CLI.
+// one command's options on the CLI. `distributed`: the command hands its items to every rank
+// under mpirun (core/dispatch.hpp); the other commands run on rank 0 alone.
 struct Command {
   CLI::App* sub;
   std::function<int()> run;
+  std::function<bool()> distributed = [] { return false; };
 };
 
 Command add_identify(CLI::App& app) {
@@ -40,10 +50,12 @@ Command add_identify(CLI::App& app) {
   cmd->add_flag_callback(
       "--no-work-limit", [&o] { o.work_limit = false; },
       "Run even if the estimated work exceeds the limits (docs/case-files.md, Limits)");
-  return {cmd, [owned] {
+  return {cmd,
+          [owned] {
             run_identify(*owned, std::cout);
             return 0;
-          }};
+          },
+          [owned] { return owned->monte_carlo > 0; }};
 }
 
 Command add_predict(CLI::App& app) {
@@ -109,13 +121,13 @@ Command add_sweep(CLI::App& app) {
   cmd->add_option("case", o.case_path, "Case file (TOML) with a [sweep] table")->required();
   cmd->add_option("--out", o.out_path, "Results CSV (resumed if it exists)")->required();
   cmd->add_flag("--restart", o.restart, "Discard an existing results file");
-  cmd->add_option("--threads", o.threads, "Threads (default: the case's, 0 = all cores)");
+  cmd->add_option("--threads", o.threads, "Threads (default: the case's, 0 = all cores; under mpirun per rank, 0 = 1)");
   cmd->add_flag_callback(
       "--no-progress", [&o] { o.progress = false; }, "No progress bar");
   cmd->add_flag_callback(
       "--no-work-limit", [&o] { o.work_limit = false; },
       "Run even if the estimated work exceeds the limits (docs/case-files.md, Limits)");
-  return {cmd, [owned] { return run_sweep(*owned, std::cout) > 0 ? 2 : 0; }};
+  return {cmd, [owned] { return run_sweep(*owned, std::cout) > 0 ? 2 : 0; }, [] { return true; }};
 }
 
 Command add_frequency(CLI::App& app) {
@@ -185,7 +197,14 @@ Command add_diagnose(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("diagnose",
                                      "The sim-to-real gap of a campaign: "
                                      "where, which effect, how far it shrinks");
-  cmd->add_option("dir", o.dir, "Campaign folder (docs/data-format.md)")->required();
+  cmd->add_option("dir", o.dirs,
+                  "Campaign folder (docs/data-format.md); with --summary: several, or folders of campaign folders")
+      ->required();
+  cmd->add_option("--summary", o.summary_path,
+                  "Diagnose every campaign given and write one row per campaign to this CSV (resumed if it exists; "
+                  "docs/mpi.md)");
+  cmd->add_option("--threads", o.threads, "With --summary: threads (0: all cores; under mpirun 1 per rank)");
+  cmd->add_flag_callback("--no-progress", [&o] { o.progress = false; }, "With --summary: no progress bar");
   cmd->add_option("--json", o.json_path, "Write the diagnosis as JSON");
   cmd->add_option("--report", o.report_dir, "Write report.md, report.html and diagnosis.json to this folder");
   // DiagnoseSettings over the manifest's [diagnose] (docs/data-format.md).
@@ -197,10 +216,17 @@ Command add_diagnose(CLI::App& app) {
   cmd->add_option("--resimulate-runs", o.settings.resimulate_runs, "Runs re-simulated on the ODE plant (12; 0: none)");
   cmd->add_flag_callback(
       "--no-pairs", [&o] { o.settings.try_pairs = false; }, "Do not try two effects at once");
-  return {cmd, [owned] {
-            run_diagnose(*owned, std::cout);
+  return {cmd,
+          [owned] {
+            DiagnoseOptions& d = *owned;
+            if (!d.summary_path.empty()) return run_diagnose_many(d, std::cout) > 0 ? 2 : 0;
+            if (d.dirs.size() > 1)
+              throw InputError("diagnose: several campaign folders need --summary FILE (one row per campaign)");
+            d.dir = d.dirs.front();
+            run_diagnose(d, std::cout);
             return 0;
-          }};
+          },
+          [owned] { return !owned->summary_path.empty(); }};
 }
 
 Command add_blind(CLI::App& app) {
@@ -211,19 +237,112 @@ Command add_blind(CLI::App& app) {
                                      "diagnosed without their keys, then scored");
   cmd->add_option("--n", o.settings.n, "Number of campaigns")->capture_default_str();
   cmd->add_option("--seed", o.settings.seed, "Seed of the draw")->capture_default_str();
-  cmd->add_option("--out", o.out_dir, "Output folder (scores.json, confusion.csv)")->capture_default_str();
-  cmd->add_option("--threads", o.settings.threads, "Threads (0: all cores)");
+  cmd->add_option("--out", o.out_dir, "Output folder (scores.json, confusion.csv; campaigns.txt: a rerun resumes)")
+      ->capture_default_str();
+  cmd->add_option("--threads", o.settings.threads, "Threads (0: all cores; under mpirun per rank, 0 = 1)");
   cmd->add_flag_callback(
       "--no-progress", [&o] { o.progress = false; }, "No progress bar");
-  return {cmd, [owned] {
+  return {cmd,
+          [owned] {
             run_blind(*owned, std::cout);
             return 0;
-          }};
+          },
+          [] { return true; }};
+}
+
+#ifdef VRELAB_HAVE_MPI
+vrelab::core::MpiJob*& mpi_job() {
+  static vrelab::core::MpiJob* job = nullptr;
+  return job;
+}
+#endif
+
+// A rank other than 0's error message, printed only if rank 0 has not ended the job first.
+std::string& worker_error() {
+  static std::string message;
+  return message;
+}
+
+// Under mpirun (core/mpi.hpp) rank 0 prints and writes; the other ranks say nothing, and a
+// rank that met an error (`raised`) ends the job: the others may wait in a dispatch it will
+// not reach. A rank other than 0 first gives rank 0 3 s to report the same error (a bad
+// case file is every rank's) and end the job itself. A command that ran to its end with
+// failed items (exit 2) just returns: every rank has left the dispatch.
+int exit_code(int code, bool raised, bool root) {
+#ifdef VRELAB_HAVE_MPI
+  if (raised && vrelab::core::process_count() > 1 && mpi_job()) {
+    if (!root) {
+      std::this_thread::sleep_for(std::chrono::seconds(3));
+      std::fprintf(stderr, "%s\n", worker_error().c_str());
+    }
+    std::fflush(nullptr);
+    mpi_job()->abort(code);
+  }
+#else
+  (void)raised, (void)root;
+#endif
+  return code;
+}
+
+// The chosen command's exit code; errors printed (rank 0), or by another rank with its number.
+int run_command(const std::vector<Command>& commands, bool root, bool* raised) {
+  const int rank = vrelab::core::process_rank();
+  auto report = [&](const char* kind, const char* what) {
+    *raised = true;
+    if (root) std::cerr << "vrelab: " << kind << what << "\n";
+    else worker_error() = std::string("vrelab: rank ").append(std::to_string(rank)).append(": ").append(kind).append(what);
+  };
+  try {
+    for (const Command& c : commands)
+      if (*c.sub) {
+        if (!root && !c.distributed()) return 0;  // rank 0 runs it alone
+        return c.run();
+      }
+  } catch (const InputError& e) {
+    report("error: ", e.what());
+    return 2;
+  } catch (const vrelab::plant::SolverError& e) {
+    report("error: ", e.what());
+    return 2;
+  } catch (const std::invalid_argument& e) {
+    // The library rejects parameters it cannot work with (e.g. an unstable loop
+    // design): input that passed the case reader's checks but not the physics.
+    report("error: ", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    report("internal error: ", e.what());
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+#ifdef VRELAB_HAVE_MPI
+  // Only under mpirun; without it the program runs on threads, as it does without MPI.
+  std::unique_ptr<vrelab::core::MpiJob> mpi;
+  try {
+    mpi = vrelab::core::start_mpi(&argc, &argv);
+  } catch (const std::exception& e) {
+    std::cerr << "vrelab: internal error: " << e.what() << "\n";
+    return 1;
+  }
+  mpi_job() = mpi.get();
+  const bool root = vrelab::core::is_root_process();
+#else
+  // Built without MPI but started by mpirun: rank 0 runs the command on its threads, the
+  // others leave at once (N copies would each write the same files).
+  const char* rank_env = std::getenv("OMPI_COMM_WORLD_RANK") ? std::getenv("OMPI_COMM_WORLD_RANK") : std::getenv("PMI_RANK");
+  if (rank_env && std::string(rank_env) != "0") return 0;
+  if (rank_env)
+    std::cerr << "vrelab: note: built without MPI (-DVRELAB_MPI=ON, docs/mpi.md): running on rank 0's threads alone\n";
+  const bool root = true;
+#endif
+  if (!root) {  // no output, no progress from the other ranks
+    std::cout.setstate(std::ios::badbit);
+    std::cerr.setstate(std::ios::badbit);
+  }
   CLI::App app{
       "vrelab: a virtual shaker laboratory for the vibration "
       "rectification error of accelerometers"};
@@ -239,23 +358,7 @@ int main(int argc, char** argv) {
     const int rc = app.exit(e);
     return rc == 0 ? 0 : 2;
   }
-  try {
-    for (const Command& c : commands)
-      if (*c.sub) return c.run();
-  } catch (const InputError& e) {
-    std::cerr << "vrelab: error: " << e.what() << "\n";
-    return 2;
-  } catch (const vrelab::plant::SolverError& e) {
-    std::cerr << "vrelab: error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::invalid_argument& e) {
-    // The library rejects parameters it cannot work with (e.g. an unstable loop
-    // design): input that passed the case reader's checks but not the physics.
-    std::cerr << "vrelab: error: " << e.what() << "\n";
-    return 2;
-  } catch (const std::exception& e) {
-    std::cerr << "vrelab: internal error: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  bool raised = false;
+  const int code = run_command(commands, root, &raised);
+  return exit_code(code, raised, root);
 }

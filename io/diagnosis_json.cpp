@@ -226,6 +226,7 @@ json to_json(const validation::BlindResult& r) {
           {"seed", r.settings.seed},
           {"wall_s", r.wall_s},
           {"threads", r.threads},
+          {"ranks", r.ranks},
           {"top1_accuracy", BlindScores::rate(s.single_right, s.single)},
           {"single_effect_campaigns", s.single},
           {"single_effect_campaigns_below_5_sigma", s.small},

@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include "core/dispatch.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "io/csv.hpp"
@@ -505,15 +506,16 @@ std::string sweep_line(const rectification::SweepRow& r) {
 
 // The file's header: the fingerprint ties a results file to the case and the program (a
 // resumed sweep must not mix rows of different settings).
-std::string sweep_header(const Case& c, const std::string& fingerprint) {
+std::string sweep_header(const Case& c, const std::string& fingerprint, int threads) {
   const auto& ro = c.shake.readout;
   return fmt::format(
       "# vrelab {} ({}) sweep {}\n# fingerprint {} conditions {} seed {}\n"
       "# settings: CVODE BDF, relative_tolerance {:g}, settle_decay {:g}, blocks {}, min_measure_s {:g}, "
-      "readout sample_rate_Hz {:g} noise_sigma_g {:g} quantisation_lsb_g {:g}; units: g, Hz, s\n{}\n",
+      "readout sample_rate_Hz {:g} noise_sigma_g {:g} quantisation_lsb_g {:g}; units: g, Hz, s\n"
+      "# run: {} MPI rank(s) x {} thread(s) (the last run of this file; rows do not depend on it)\n{}\n",
       kProgramVersion, kGitDescribe, c.path, fingerprint, c.sweep->size(), c.seed, c.shake.relative_tolerance,
       c.shake.settle_decay, c.shake.blocks, c.shake.min_measure_s, ro.sample_rate_Hz, ro.noise_sigma_g,
-      ro.quantisation_lsb_g, kSweepColumns);
+      ro.quantisation_lsb_g, core::process_count(), threads, kSweepColumns);
 }
 
 // The rows of an earlier run of the same sweep (index -> line); a partial last line dropped.
@@ -578,27 +580,32 @@ SweepStudy sweep(const Case& c, const std::string& out_path, bool restart, int t
   if (std::string why; !grid.IsValid(&why)) throw InputError(c.path + ": [sweep] " + why);
   if (std::string why; !c.shake.IsValid(&why)) throw InputError(c.path + ": [shake] " + why);
   const std::string fingerprint = fmt::format("{:016x}", fnv1a(c.content.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + kProgramVersion + kGitDescribe));
-  const std::string header = sweep_header(c, fingerprint);
+  const int used = core::threads_per_process(threads >= 0 ? threads : c.sweep_threads);
+  const std::string header = sweep_header(c, fingerprint, used);
   const fs::path path(out_path);
-  if (path.has_parent_path()) fs::create_directories(path.parent_path());
+  // Under mpirun only rank 0 reads and writes the file; the others compute the conditions it
+  // hands out (core/dispatch.hpp).
+  const bool writer = core::is_root_process();
+  if (writer && path.has_parent_path()) fs::create_directories(path.parent_path());
   std::map<std::size_t, std::string> rows;
   SweepStudy s;
-  if (fs::exists(path) && !restart) rows = resumed_rows(out_path, fingerprint, grid.size(), &s.recomputed);
-  write_atomic(out_path, sweep_text(header, rows));  // the kept rows; then appended as conditions finish
+  if (writer && fs::exists(path) && !restart) rows = resumed_rows(out_path, fingerprint, grid.size(), &s.recomputed);
+  if (writer) write_atomic(out_path, sweep_text(header, rows));  // the kept rows; then appended as conditions finish
   std::vector<std::size_t> skip;
   for (const auto& [i, l] : rows) skip.push_back(i);
-  const int used = core::thread_count(threads >= 0 ? threads : c.sweep_threads);
   out << header_line("sweep", c, c.seed);
   out << fmt::format("Grid: {} frequencies x {} amplitudes x {} directions x {} orientations = {} conditions; "
-                     "{} already in {}; {} thread(s)\n",
+                     "{} already in {}; {} thread(s){}\n",
                      grid.frequencies_Hz.size(), grid.amplitudes_g.size(), grid.directions.size(),
-                     grid.orientations_g.size(), grid.size(), rows.size(), out_path, used);
+                     grid.orientations_g.size(), grid.size(), rows.size(), out_path, used,
+                     core::process_count() > 1 ? fmt::format(" on each of {} MPI ranks", core::process_count()) : "");
   for (const auto& r : s.recomputed) out << "  " << r << "\n";
   out.flush();
   s.conditions = grid.size();
   s.ran = grid.size() - skip.size();
-  std::ofstream append(out_path, std::ios::app);
-  core::Progress bar(std::cerr, "sweep", s.ran, progress);
+  std::ofstream append;
+  if (writer) append.open(out_path, std::ios::app);
+  core::Progress bar(std::cerr, "sweep", s.ran, progress && writer);
   const auto start = std::chrono::steady_clock::now();
   rectification::run_sweep(
       c.plant, *c.coefficients, c.shake, grid, skip, used,
@@ -616,7 +623,7 @@ SweepStudy sweep(const Case& c, const std::string& out_path, bool restart, int t
   bar.finish();
   append.close();
   s.wall_s = seconds_since(start);
-  write_atomic(out_path, sweep_text(header, rows));  // every row, sorted by condition
+  if (writer) write_atomic(out_path, sweep_text(header, rows));  // every row, sorted by condition
   s.written = rows.size();
   return s;
 }

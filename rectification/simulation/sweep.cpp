@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <stdexcept>
 
-#include "core/parallel.hpp"
+#include "core/dispatch.hpp"
 #include "plant/ode_solver.hpp"
 #include "rectification/prediction/eq3.hpp"
 
@@ -63,6 +64,31 @@ std::vector<double> spaced(double f1, double f2, int n, bool logarithmic) {
   return f;
 }
 
+namespace {
+
+// A row's result as text: ok, the numbers (17 significant digits: read back exactly), the
+// error last (any characters).
+std::string row_text(const SweepRow& r) {
+  char head[256];
+  std::snprintf(head, sizeof head, "%d %.17g %.17g %.17g %.17g %.17g %ld ", r.ok ? 1 : 0, r.measured_g, r.sigma_g,
+                r.predicted_eq3_g, r.settle_s, r.wall_s, r.steps);
+  return head + r.error;
+}
+
+SweepRow row_from_text(const SweepCondition& c, const std::string& text) {
+  SweepRow r;
+  r.condition = c;
+  int ok = 0, used = 0;
+  if (std::sscanf(text.c_str(), "%d %lg %lg %lg %lg %lg %ld %n", &ok, &r.measured_g, &r.sigma_g, &r.predicted_eq3_g,
+                  &r.settle_s, &r.wall_s, &r.steps, &used) < 7)
+    throw std::runtime_error("sweep: a condition's result could not be read back");
+  r.ok = ok != 0;
+  r.error = text.substr(static_cast<std::size_t>(used));
+  return r;
+}
+
+}  // namespace
+
 void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth, const ShakeSettings& settings,
                const SweepGrid& grid,
                const std::vector<std::size_t>& skip, int threads, const std::function<void(const SweepRow&)>& on_row) {
@@ -76,12 +102,13 @@ void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth
     return (0.05 + 5 / f) * std::max(f, 50.0);
   };
   std::stable_sort(todo.begin(), todo.end(), [&](std::size_t a, std::size_t b) { return cost(a) > cost(b); });
-  std::vector<SweepRow> rows(todo.size());
-  core::parallel_for(
-      todo.size(), threads,
-      [&](std::size_t k) {
-        SweepRow& row = rows[k];
-        row.condition = sweep_condition(grid, todo[k]);
+  // Each condition's row travels as text (core::dispatch: from another rank under MPI) and
+  // is read back on rank 0 into the row the threads would have given: every number exactly.
+  core::dispatch(
+      todo, threads,
+      [&](std::size_t index) {
+        SweepRow row;
+        row.condition = sweep_condition(grid, index);
         const auto t0 = std::chrono::steady_clock::now();
         try {
           const vibration::SineVibration v = row.condition.vibration();
@@ -100,8 +127,9 @@ void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth
           row.error = e.what();
         }
         row.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        return row_text(row);
       },
-      [&](std::size_t k) { on_row(rows[k]); });  // under the pool's lock
+      [&](std::size_t index, const std::string& text) { on_row(row_from_text(sweep_condition(grid, index), text)); });
 }
 
 }  // namespace vrelab::rectification

@@ -5,7 +5,8 @@
 //        x directions (unit vectors in sensor axes; the vibration is amplitude * direction,
 //        in phase) x static orientations (gravity in sensor axes, g).
 // Gives: one SweepRow per condition (measured error, sigma, eq. (3) prediction), computed
-//        on `threads` threads (0: all cores, core::parallel_for); conditions listed in `skip` (already on disk) are not run.
+//        on `threads` threads (0: all cores) or on the ranks of mpirun (core::dispatch; the
+//        rows then reach on_row on rank 0 only); conditions listed in `skip` (already on disk) are not run.
 //        A solver failure in one condition is recorded in its row (ok = false, message
 //        naming the call and the simulated time); the others go on. With a readout, the
 //        noise of condition i is drawn from seed readout.seed + i (independent runs).
@@ -55,7 +56,7 @@ struct SweepRow {
 };
 
 // Runs every condition not in `skip` (sorted indices). `on_row` is called under a lock, from
-// the worker threads, as rows complete.
+// the worker threads (rank 0's under MPI), as rows complete.
 // `truth`: the coefficients eq. (3) is evaluated with (for a physical plant, the implied ones).
 void run_sweep(const plant::PlantConfig& plant, const plant::Coefficients& truth, const ShakeSettings& settings,
                const SweepGrid& grid,

@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "core/parallel.hpp"
+#include "core/dispatch.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 
 namespace vrelab::validation {
@@ -248,23 +248,111 @@ bool BlindSettings::IsValid(std::string* why) const {
   return w.empty();
 }
 
+namespace {
+
+// Strings in a result line: tab, newline and backslash escaped.
+std::string escaped(const std::string& s) {
+  std::string e;
+  for (char ch : s) e += ch == '\t' ? "\\t" : ch == '\n' ? "\\n" : ch == '\\' ? "\\\\" : std::string(1, ch);
+  return e;
+}
+std::string unescaped(const std::string& s) {
+  std::string u;
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '\\' && i + 1 < s.size()) {
+      ++i;
+      u += s[i] == 't' ? '\t' : s[i] == 'n' ? '\n' : s[i];
+    } else {
+      u += s[i];
+    }
+  }
+  return u;
+}
+
+}  // namespace
+
+std::string campaign_result_text(const BlindCampaign& k) {
+  const Diagnosis& d = k.diagnosis;
+  const bool has_top = !d.effects.empty();
+  std::string t = fmt::format("{:.17g}\t{:.17g}\t{:.17g}\t{:d}\t{:d}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}",
+                              k.simulate_s, k.wall_s, k.effect_max_sigma, d.gap_significant ? 1 : 0, d.explained ? 1 : 0,
+                              d.rms_before_g, d.rms_after_g, d.rms_before_sigma, d.rms_after_sigma,
+                              has_top ? d.effects.front().value : 0.0);
+  for (const std::string* x : {&k.error, &k.called, &k.top, &d.chosen, &d.where})
+    t.append("\t").append(escaped(*x));
+  t.append("\t").append(escaped(has_top ? d.effects.front().name : std::string()));
+  return t.append(has_top ? "\t1" : "\t0");
+}
+
+void read_campaign_result(const std::string& text, BlindCampaign& k) {
+  std::vector<std::string> f;
+  for (std::size_t at = 0;;) {
+    const std::size_t tab = text.find('\t', at);
+    f.push_back(text.substr(at, tab == std::string::npos ? std::string::npos : tab - at));
+    if (tab == std::string::npos) break;
+    at = tab + 1;
+  }
+  if (f.size() != 17) throw std::invalid_argument(fmt::format("blind: a campaign's result has {} fields, not 17", f.size()));
+  auto num = [&](int i) {
+    std::size_t used = 0;
+    const double x = std::stod(f[static_cast<std::size_t>(i)], &used);
+    if (used != f[static_cast<std::size_t>(i)].size()) throw std::invalid_argument("blind: not a number: " + f[static_cast<std::size_t>(i)]);
+    return x;
+  };
+  Diagnosis& d = k.diagnosis;
+  k.simulate_s = num(0), k.wall_s = num(1), k.effect_max_sigma = num(2);
+  d.gap_significant = f[3] == "1", d.explained = f[4] == "1";
+  d.rms_before_g = num(5), d.rms_after_g = num(6), d.rms_before_sigma = num(7), d.rms_after_sigma = num(8);
+  k.error = unescaped(f[10]), k.called = unescaped(f[11]), k.top = unescaped(f[12]);
+  d.chosen = unescaped(f[13]), d.where = unescaped(f[14]);
+  d.effects.clear();
+  if (f[16] == "1") {
+    EffectFit e;
+    e.name = unescaped(f[15]);
+    e.value = num(9);
+    d.effects.push_back(e);
+  }
+}
+
 BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progress) {
+  return run_blind(settings, progress, {}, {});
+}
+
+BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progress,
+                      const std::map<int, std::string>& done, const BlindCampaignDone& on_campaign) {
   std::string why;
   if (!settings.IsValid(&why)) throw std::invalid_argument("blind: " + why);
   BlindResult r;
   r.settings = settings;
-  r.threads = core::thread_count(settings.threads);
+  r.threads = core::threads_per_process(settings.threads);
+  r.ranks = core::process_count();
   for (const auto& e : effect_library()) r.library.push_back(e.name);
   for (int i = 0; i < settings.n; ++i) r.campaigns.push_back(draw_campaign(i, settings.seed, r.library));
+  std::vector<std::size_t> todo;
+  for (int i = 0; i < settings.n; ++i) {
+    const auto it = done.find(i);
+    if (it == done.end()) todo.push_back(static_cast<std::size_t>(i));
+    else read_campaign_result(it->second, r.campaigns[static_cast<std::size_t>(i)]);
+  }
   const auto start = Clock::now();
-  std::size_t done = 0;
+  std::size_t finished = done.size();
   const auto n = static_cast<std::size_t>(settings.n);
-  core::parallel_for(
-      n, r.threads, [&](std::size_t i) { simulate_and_diagnose(r.campaigns[i], settings.diagnose); },
-      [&](std::size_t) {
-        if (progress) progress(++done, n);
+  // A campaign's result travels as its text (from another rank under MPI) and is read back
+  // on rank 0: the same numbers whatever ran it.
+  core::dispatch(
+      todo, r.threads,
+      [&](std::size_t i) {
+        BlindCampaign k = r.campaigns[i];  // the key, drawn on every rank alike
+        simulate_and_diagnose(k, settings.diagnose);
+        return campaign_result_text(k);
+      },
+      [&](std::size_t i, const std::string& text) {
+        read_campaign_result(text, r.campaigns[i]);
+        if (on_campaign) on_campaign(static_cast<int>(i), text);
+        if (progress) progress(++finished, n);
       });
   r.wall_s = seconds_since(start);
+  if (!core::is_root_process()) return r;  // rank 0 holds the results
   std::vector<double> shrink, shrink_sigma;  // of the held-out gap rms in g, and in each run's sigma
   for (const BlindCampaign& k : r.campaigns) score(k, r, shrink, shrink_sigma);
   r.scores.median_shrinkage = median(shrink);
@@ -274,7 +362,8 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
 
 std::string BlindResult::BriefReport() const {
   const BlindScores& s = scores;
-  std::string t = fmt::format("blind --n {} --seed {}: {:.1f} s wall on {} threads\n", settings.n, settings.seed, wall_s, threads);
+  std::string t = fmt::format("blind --n {} --seed {}: {:.1f} s wall on {} threads{}\n", settings.n, settings.seed, wall_s, threads,
+                              ranks > 1 ? fmt::format(" x {} MPI ranks", ranks) : "");
   t += fmt::format("  top-1 attribution (single in-library effects, verdict 'explained by' the hidden one): {}/{} = {:.0f} %\n",
                    s.single_right, s.single, 100 * BlindScores::rate(s.single_right, s.single));
   t += fmt::format("  hidden effect ranked first whatever the verdict: {}/{}\n", s.single_top_right, s.single);

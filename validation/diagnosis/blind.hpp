@@ -87,7 +87,8 @@ struct BlindScores {
 
 struct BlindResult {
   BlindSettings settings;
-  int threads = 1;    // used
+  int threads = 1;    // used (per rank)
+  int ranks = 1;      // MPI ranks (1 without mpirun)
   double wall_s = 0;
   std::vector<std::string> library;  // the effect library's names (the confusion matrix's order)
   std::vector<BlindCampaign> campaigns;
@@ -108,5 +109,20 @@ using BlindProgress = std::function<void(std::size_t done, std::size_t total)>;
 // Invalid settings throw std::invalid_argument naming the key. A campaign whose simulation or
 // diagnosis fails is kept with its error (called "error").
 BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progress = {});
+
+// The same, resumable and across the ranks of mpirun (core/dispatch.hpp): campaigns in `done`
+// (index -> campaign_result_text, from an earlier run with the same seed and diagnose
+// settings) are read back, not run; each campaign run is passed to on_campaign (rank 0, under
+// the lock) as it finishes. Under mpirun only rank 0's result is complete (the others return
+// theirs unscored).
+using BlindCampaignDone = std::function<void(int index, const std::string& text)>;
+BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progress,
+                      const std::map<int, std::string>& done, const BlindCampaignDone& on_campaign);
+
+// What the diagnosis found for campaign k (not its key, which the draw gives), as one line of
+// text (no newline; numbers to 17 digits: read back exactly), and back into a drawn campaign.
+// read_campaign_result throws std::invalid_argument for a line it cannot read.
+std::string campaign_result_text(const BlindCampaign& k);
+void read_campaign_result(const std::string& text, BlindCampaign& k);
 
 }  // namespace vrelab::validation

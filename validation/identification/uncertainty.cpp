@@ -2,8 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
 #include <random>
 #include <stdexcept>
+
+#include "core/dispatch.hpp"
 
 namespace vrelab::validation {
 
@@ -42,30 +47,91 @@ Propagation propagate_first_order(const Estimator& estimator, const std::vector<
   return p;
 }
 
+namespace {
+
+// Trials per item: the unit a worker takes (a rank's share of a million trials costs seconds,
+// a block a few milliseconds: small next to the work, large next to a message).
+constexpr int kTrialsPerBlock = 256;
+
+// Block b's own random stream, from the seed and b alone (std::seed_seq is specified to the
+// bit): the trials are the same whatever ranks and threads ran them.
+std::mt19937_64 block_rng(std::uint64_t seed, std::uint64_t b) {
+  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                    static_cast<std::uint32_t>(b), static_cast<std::uint32_t>(b >> 32)};
+  return std::mt19937_64(seq);
+}
+
+}  // namespace
+
 std::vector<MonteCarloStats> monte_carlo(const std::vector<Estimator>& estimators,
                                          const plant::Coefficients& truth, const OutputSource& source,
                                          const std::vector<Position>& positions,
-                                         const StaticTestErrors& errors, int n, std::uint64_t seed) {
+                                         const StaticTestErrors& errors, int n, std::uint64_t seed, int threads) {
   if (n < 2) throw std::invalid_argument("Monte Carlo needs at least 2 trials");
-  std::mt19937_64 rng(seed);
-  std::vector<MonteCarloStats> stats(estimators.size());
-  std::vector<CoefArray> m2(estimators.size(), CoefArray{});
-  for (int t = 1; t <= n; ++t) {
-    const std::vector<Reading> readings = simulate_static_test(source, truth[plant::K1], positions, errors, rng);
-    for (std::size_t e = 0; e < estimators.size(); ++e) {
-      const Estimate est = estimators[e](readings);
-      MonteCarloStats& s = stats[e];
-      for (int k = 0; k < plant::kNumCoefficients; ++k) {  // Welford's running mean/variance
-        const double x = est.value[k] - truth[k];
-        const double d = x - s.mean_error[k];
-        s.mean_error[k] += d / t;
-        m2[e][k] += d * (x - s.mean_error[k]);
-      }
+  const std::size_t ne = estimators.size(), nk = plant::kNumCoefficients;
+  const std::size_t blocks = (static_cast<std::size_t>(n) + kTrialsPerBlock - 1) / kTrialsPerBlock;
+  // Per block: for each estimator and coefficient its mean error and sum of squared
+  // deviations (Welford within the block), as hexadecimal floats (exact).
+  std::vector<std::vector<double>> partial(blocks);
+  std::vector<std::size_t> items(blocks);
+  for (std::size_t b = 0; b < blocks; ++b) items[b] = b;
+  core::dispatch(
+      items, threads,
+      [&](std::size_t b) {
+        std::mt19937_64 rng = block_rng(seed, b);
+        const int trials = static_cast<int>(std::min<std::size_t>(kTrialsPerBlock, static_cast<std::size_t>(n) - b * kTrialsPerBlock));
+        std::vector<double> mean(ne * nk, 0.0), m2(ne * nk, 0.0);
+        for (int t = 1; t <= trials; ++t) {
+          const std::vector<Reading> readings = simulate_static_test(source, truth[plant::K1], positions, errors, rng);
+          for (std::size_t e = 0; e < ne; ++e) {
+            const Estimate est = estimators[e](readings);
+            for (std::size_t k = 0; k < nk; ++k) {
+              const double x = est.value[k] - truth[k];
+              const double d = x - mean[e * nk + k];
+              mean[e * nk + k] += d / t;
+              m2[e * nk + k] += d * (x - mean[e * nk + k]);
+            }
+          }
+        }
+        std::string text;
+        char cell[64];
+        for (std::size_t i = 0; i < ne * nk; ++i) {
+          std::snprintf(cell, sizeof cell, "%a %a ", mean[i], m2[i]);
+          text += cell;
+        }
+        return text;
+      },
+      [&](std::size_t b, const std::string& text) {
+        std::vector<double>& v = partial[b];
+        const char* p = text.c_str();
+        for (char* end = nullptr;; p = end) {
+          const double x = std::strtod(p, &end);
+          if (end == p) break;
+          v.push_back(x);
+        }
+        if (v.size() != 2 * ne * nk) throw std::runtime_error("monte_carlo: a block's result could not be read back");
+      });
+  // The blocks merged in their order (Chan et al.'s pairwise update): one sum, whatever order
+  // they finished in. (Under MPI only rank 0 has them; the others return zeros.)
+  std::vector<MonteCarloStats> stats(ne);
+  std::vector<double> mean(ne * nk, 0.0), m2(ne * nk, 0.0);
+  double count = 0;
+  for (std::size_t b = 0; b < blocks && !partial[b].empty(); ++b) {
+    const double nb = static_cast<double>(std::min<std::size_t>(kTrialsPerBlock, static_cast<std::size_t>(n) - b * kTrialsPerBlock));
+    const double total = count + nb;
+    for (std::size_t i = 0; i < ne * nk; ++i) {
+      const double d = partial[b][2 * i] - mean[i];
+      mean[i] += d * nb / total;
+      m2[i] += partial[b][2 * i + 1] + d * d * count * nb / total;
     }
+    count = total;
   }
-  for (std::size_t e = 0; e < estimators.size(); ++e) {
+  for (std::size_t e = 0; e < ne; ++e) {
     stats[e].n = n;
-    for (int k = 0; k < plant::kNumCoefficients; ++k) stats[e].std[k] = std::sqrt(m2[e][k] / (n - 1));
+    for (std::size_t k = 0; k < nk; ++k) {
+      stats[e].mean_error[k] = mean[e * nk + k];
+      stats[e].std[k] = std::sqrt(m2[e * nk + k] / (n - 1));
+    }
   }
   return stats;
 }

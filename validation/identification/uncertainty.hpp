@@ -38,10 +38,13 @@ struct MonteCarloStats {
   CoefArray std{};         // sample standard deviation of the estimate
 };
 
-// Runs `n` simulated tests from `seed`; one MonteCarloStats per estimator.
+// Runs `n` simulated tests from `seed`; one MonteCarloStats per estimator. The trials go in
+// blocks of 256, block b drawn from its own stream (seed, b), on `threads` threads (0: all
+// cores) or the ranks of mpirun (core/dispatch.hpp); the blocks' means and squared deviations
+// are merged in block order: the result is the same to the bit whatever ran them.
 std::vector<MonteCarloStats> monte_carlo(const std::vector<Estimator>& estimators,
                                          const plant::Coefficients& truth, const OutputSource& source,
                                          const std::vector<Position>& positions,
-                                         const StaticTestErrors& errors, int n, std::uint64_t seed);
+                                         const StaticTestErrors& errors, int n, std::uint64_t seed, int threads = 0);
 
 }  // namespace vrelab::validation
