@@ -2,9 +2,14 @@
 // settings' checks, the confusion matrix's CSV (no campaign is simulated: fast).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "io/case_file.hpp"
 #include "io/csv.hpp"
@@ -181,4 +186,90 @@ TEST(CsvText, ClosestColumnNameIsSuggested) {
   EXPECT_EQ(io::closest_name("frequency_hz", names), "frequency_Hz");
   EXPECT_EQ(io::closest_name("amplitud_g", names), "amplitude_g");
   EXPECT_EQ(io::closest_name("temperature_C", names), "");
+}
+
+namespace {
+
+// A lab CSV file's data rows (comment lines and the header dropped), split at commas.
+std::vector<std::vector<std::string>> csv_rows(const fs::path& p) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream in(vrelab::test::read_file(p));
+  bool header = true;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (header) {
+      header = false;
+      continue;
+    }
+    std::vector<std::string> cells;
+    std::stringstream ls(line);
+    for (std::string cell; std::getline(ls, cell, ',');) cells.push_back(cell);
+    if (line.back() == ',') cells.emplace_back();
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+// The mean square (g^2) of a PSD file, all its axis columns summed: between breakpoints the
+// level is a straight line in log-log (a power law S1 (f/f1)^n), whose integral is closed-form.
+double psd_mean_square_g2(const fs::path& p) {
+  const auto rows = csv_rows(p);
+  double s = 0;
+  for (std::size_t k = 1; k < rows.size(); ++k)
+    for (std::size_t col = 1; col < rows[k].size(); ++col) {
+      const double f1 = std::stod(rows[k - 1][0]), f2 = std::stod(rows[k][0]);
+      const double s1 = std::stod(rows[k - 1][col]), s2 = std::stod(rows[k][col]);
+      const double n = std::log(s2 / s1) / std::log(f2 / f1);
+      s += std::abs(n + 1) < 1e-12 ? s1 * f1 * std::log(f2 / f1) : s1 * f1 / (n + 1) * (std::pow(f2 / f1, n + 1) - 1);
+    }
+  return s;
+}
+
+}  // namespace
+
+// diagnose --json's per-run VRC (measured and predicted) against one recomputed here from the
+// same JSON's errors and the run's amplitudes: a sine's input rms^2 is sum_i a_i^2 / 2 (a_i the
+// peak along axis i), a random part's the PSD's integral (read from its file, integrated in
+// closed form here), a sine on random both added; VRC = 1e6 error / rms^2 in ug/g^2. A wrong
+// rms (peak for rms, a missing part) or unit (g, mg) is off by >= 2x; the bound is 1e-9.
+TEST(DiagnosisJson, RunVrcIsErrorOverTheSineAndRandomPartsMeanSquareInMicroGPerG2) {
+  const fs::path dir = fs::path(VRELAB_CASES_DIR) / "lab-random";
+  const validation::Campaign c = io::read_campaign(dir.string());
+  validation::Diagnosis d;
+  d.runs.resize(c.runs.size());
+  for (std::size_t k = 0; k < c.runs.size(); ++k) d.runs[k].predicted_g = 0.9 * c.runs[k].measured_g + 1e-6;
+  const nlohmann::json runs = io::to_json(d, c)["runs"];
+  const auto rows = csv_rows(dir / "runs.csv");
+  ASSERT_EQ(runs.size(), rows.size());
+  int kinds[3] = {0, 0, 0};
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    const auto& row = rows[k];
+    const auto& r = runs[k];
+    ASSERT_EQ(r["id"], row[0]);
+    const std::string kind = row[11];
+    double ms = 0;
+    if (kind != "random") {
+      // The JSON's peak amplitude along its unit direction, per axis; the direction is the
+      // file's normalised (d_* = 0.7071, 0.7071 is a unit vector to 1e-5 only).
+      const double a = r["amplitude_g"];
+      double n2 = 0;
+      for (int i = 0; i < 3; ++i) n2 += std::pow(std::stod(row[3 + static_cast<std::size_t>(i)]), 2);
+      for (int i = 0; i < 3; ++i) ms += std::pow(a * r["direction"][static_cast<std::size_t>(i)].get<double>(), 2) / 2;
+      EXPECT_NEAR(ms, a * a / 2, 1e-12 * a * a) << row[0];
+      EXPECT_NEAR(std::stod(row[2]), a, 1e-12) << row[0];
+      EXPECT_GT(n2, 0.99) << row[0];
+    }
+    if (kind != "sine") ms += psd_mean_square_g2(dir / row[12]);
+    ++kinds[kind == "sine" ? 0 : kind == "random" ? 1 : 2];
+    EXPECT_NEAR(r["input_rms_g"].get<double>(), std::sqrt(ms), 1e-9 * std::sqrt(ms)) << row[0];
+    const double measured = r["measured_g"], predicted = r["predicted_g"];
+    EXPECT_NEAR(measured, std::stod(row[9]) * 1e-6, 1e-15) << row[0];  // the file's ug, in g
+    const double vm = 1e6 * measured / ms, vp = 1e6 * predicted / ms;
+    EXPECT_NEAR(r["measured_vrc_ug_per_g2"].get<double>(), vm, 1e-9 * std::abs(vm)) << row[0];
+    EXPECT_NEAR(r["predicted_vrc_ug_per_g2"].get<double>(), vp, 1e-9 * std::abs(vp)) << row[0];
+  }
+  // The shipped case has all three kinds (the test means something for each).
+  EXPECT_EQ(kinds[0], 10);
+  EXPECT_GE(kinds[1], 4);
+  EXPECT_GE(kinds[2], 1);
 }

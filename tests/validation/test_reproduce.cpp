@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <cmath>
 #include <cstdlib>
 #include <numbers>
 #include <random>
@@ -230,6 +231,31 @@ TEST(Reproduce, SmallCaseAgreesAtLowFrequencyFlagsFrequencyAndRecoversTheInvisib
   const auto& cf = s["confirmation"];
   EXPECT_LT(std::abs(cf["measured_g"].get<double>() - cf["predicted_g"].get<double>()),
             4 * std::hypot(cf["sigma_g"].get<double>(), cf["sigma_predicted_g"].get<double>()));
+  // The VRC beside each error, recomputed here from the same JSON: a sine of peak a_i = A u_i
+  // along the axes has input rms^2 = sum_i a_i^2 / 2; VRC = 1e6 error / rms^2 in ug/g^2. A peak
+  // taken for the rms (2x) or the VRC in g/g^2 (1e-6x) fails by far more than the 1e-9 bound.
+  const auto sine_mean_square = [](double amplitude, const json& unit) {
+    double ms = 0;
+    for (const auto& u : unit) ms += std::pow(amplitude * u.get<double>(), 2) / 2;
+    return ms;
+  };
+  const auto expect_vrc = [](const json& j, const char* key, double error_g, double ms) {
+    const double v = 1e6 * error_g / ms;
+    EXPECT_NEAR(j[key].get<double>(), v, 1e-9 * std::abs(v)) << key << " " << j.dump();
+  };
+  for (const auto& r : runs) {
+    const double ms = sine_mean_square(r["amplitude_g"], r["direction_unit"]);
+    EXPECT_NEAR(r["input_rms_g"].get<double>(), std::sqrt(ms), 1e-12 * std::sqrt(ms));
+    expect_vrc(r, "measured_vrc_ug_per_g2", r["measured_g"], ms);
+    expect_vrc(r, "predicted_vrc_ug_per_g2", r["predicted_g"], ms);
+    expect_vrc(r, "at_frequency_vrc_ug_per_g2", r["at_frequency_g"], ms);
+  }
+  {
+    const double ms = sine_mean_square(cf["amplitude_g"], cf["direction"]);
+    EXPECT_NEAR(cf["input_rms_g"].get<double>(), std::sqrt(ms), 1e-12 * std::sqrt(ms));
+    expect_vrc(cf, "measured_vrc_ug_per_g2", cf["measured_g"], ms);
+    expect_vrc(cf, "predicted_vrc_ug_per_g2", cf["predicted_g"], ms);
+  }
   // Its record: the rest at t < 0 as long as the measuring interval, then the vibration.
   const std::string rec = read_file(d.path / "out" / "confirmation.csv");
   EXPECT_NE(rec.find("t_s,output,deviation_g,integral_g_s,integral_without_oscillation_g_s"), std::string::npos);

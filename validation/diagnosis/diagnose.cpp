@@ -56,18 +56,40 @@ struct Table {
   Eigen::MatrixXd G;     // d pred / d coefficient
 };
 
-// The loop responses, per (dynamics-changing effect value, frequency).
+// The loop responses, per (dynamics-changing effect value, frequency). A plant without a
+// servo of its own gets the one its dynamics imply, designed once per dynamics here rather than
+// in every loop_response (design_servo scans 3000 frequencies: it was ~85 % of a diagnosis with
+// random runs, whose PSD grid asks for hundreds of frequencies per effect value). The servo is
+// the same function of the same numbers, so the responses are bit for bit the same.
 class ResponseCache {
  public:
   const rectification::LoopResponse& get(const PlantConfig& cfg, const std::string& key, double f) {
     auto k = std::make_pair(key, f);
     auto it = cache_.find(k);
-    if (it == cache_.end()) it = cache_.emplace(k, rectification::loop_response(cfg, f)).first;
+    if (it == cache_.end()) {
+      if (cfg.servo) {
+        it = cache_.emplace(k, rectification::loop_response(cfg, f)).first;
+      } else {
+        PlantConfig with_servo = cfg;
+        with_servo.servo = servo(cfg.dynamics);
+        it = cache_.emplace(k, rectification::loop_response(with_servo, f)).first;
+      }
+    }
     return it->second;
   }
 
  private:
+  // Every field of plant::Dynamics (design_servo's only input).
+  using DynamicsKey = std::tuple<double, double, double, double, double, bool, double, double>;
+  const plant::Servo& servo(const plant::Dynamics& d) {
+    const DynamicsKey k{d.pendulum_frequency_Hz, d.pendulum_damping_ratio, d.angle_gain_rad_per_s2_per_g, d.loop_bandwidth_Hz,
+                        d.phase_margin_deg,      d.integrator,             d.integrator_zero_ratio,       d.antialias_Hz};
+    auto it = servos_.find(k);
+    if (it == servos_.end()) it = servos_.emplace(k, plant::design_servo(d)).first;
+    return it->second;
+  }
   std::map<std::pair<std::string, double>, rectification::LoopResponse> cache_;
+  std::map<DynamicsKey, plant::Servo> servos_;
 };
 
 // What the static test took up of an effect that acts at rest, per unit of (p - nominal)
@@ -367,9 +389,16 @@ double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effec
   if (e) e->apply(p, cfg, m);  // a random run: what the effect does to the table's motion is not applied
   if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
   std::map<double, rectification::LoopResponse> responses;
+  std::optional<PlantConfig> loop_cfg;  // cfg with its servo designed once (ResponseCache)
   const rectification::ResponseAt h = [&](double f) {
     auto it = responses.find(f);
-    if (it == responses.end()) it = responses.emplace(f, rectification::loop_response(cfg, f)).first;
+    if (it == responses.end()) {
+      if (!loop_cfg) {
+        loop_cfg = cfg;
+        if (!loop_cfg->servo) loop_cfg->servo = plant::design_servo(cfg.dynamics);
+      }
+      it = responses.emplace(f, rectification::loop_response(*loop_cfg, f)).first;
+    }
     return it->second;
   };
   if (r.random) {
