@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <set>
 #include <string>
@@ -47,6 +48,20 @@ Campaign with_drift(double drift_g_per_h, double rest_sigma_g, bool log_rest = t
     if (log_rest) r.rest_g = drift_g_per_h * r.time_h + rest_sigma_g * n01(rng);
   }
   return c;
+}
+
+// A truth as blind draws it: the paper-like coefficients, each perturbed (validation/diagnosis/blind.cpp).
+plant::PlantConfig blind_like_truth(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.7, 1.3);
+  std::bernoulli_distribution sign(0.5);
+  plant::PlantConfig p;
+  auto& c = p.coefficients;
+  c[plant::K1] = 1.25 * u(rng), c[plant::k0] = 1.5e-3 * u(rng), c[plant::k1_asym] = 2e-5 * u(rng);
+  c[plant::k2] = 1.5e-5 * u(rng), c[plant::k3] = 1e-6 * u(rng), c[plant::k4] = 2e-7 * u(rng);
+  c[plant::delta_OA] = 1e-4 * u(rng), c[plant::delta_PA] = -5e-5 * u(rng);
+  for (int i : {plant::k_IP, plant::k_IO, plant::k_PO}) c[i] = (sign(rng) ? 1 : -1) * 5e-6 * u(rng);
+  return p;
 }
 
 }  // namespace
@@ -127,4 +142,28 @@ TEST(Nuisances, JsonCarriesEachNuisanceWithItsNameValueSigmaAndUnit) {
     names.insert(x["name"].get<std::string>());
   }
   EXPECT_TRUE(names.count("bias_drift") && names.count("sigma_scale"));
+}
+
+// A physical gap is not a nuisance (issue 15): a squeeze film (its truth through the ODE,
+// gap 1.04 mrad, as blind draws it) in the default design with the stated sigma right. Its
+// gap is mostly taken up by the coefficients' errors and what is left is weakly structured,
+// so the scatter test alone took it for understated sigma (blind --seed 8001: x1.50 and x1.97
+// applied on its two squeeze films). Seed 160 was not used to develop the diagnosis.
+TEST(Nuisances, ASqueezeFilmWithTheStatedSigmaRightIsNotCalledSigmaUnderstated) {
+  const std::vector<HiddenEffect> film{{"squeeze_film_damping", 1 / 1.02e-3}};
+  const std::uint64_t seed = 162;
+  Campaign c = simulate_campaign(blind_like_truth(seed), film, default_design(), seed, 2);
+  // The lab's log as blind writes it: 3 min a run, a rest reading (sigma 0.3 ug) before each.
+  std::mt19937_64 rng(seed + 29);
+  std::normal_distribution<double> n01;
+  for (std::size_t k = 0; k < c.runs.size(); ++k) c.runs[k].time_h = 0.05 * static_cast<double>(k), c.runs[k].rest_g = 0.3e-6 * n01(rng);
+  const Diagnosis d = diagnose(c);
+  const Nuisance* x = d.nuisance("sigma_scale");
+  ASSERT_NE(x, nullptr);
+  std::printf("verdict: %s\nsigma_scale: %.3f +- %.3f, applied %d; %s\nbest: %s evidence %.1f\n", d.verdict.c_str(), x->value,
+              x->sigma, x->applied ? 1 : 0, x->note.c_str(), d.effects.empty() ? "-" : d.effects[0].name.c_str(),
+              d.effects.empty() ? 0.0 : d.effects[0].evidence);
+  EXPECT_FALSE(x->applied) << d.verdict << "; " << x->note;
+  EXPECT_EQ(d.verdict.find("sigma understated"), std::string::npos) << d.verdict;
+  EXPECT_TRUE(d.gap_significant) << d.verdict;  // the film is seen (the test can fail)
 }
