@@ -13,15 +13,11 @@
 namespace vrelab::vibration {
 namespace {
 
-// Margin of the prefilter on each side of a stretch: |z1|^48 = 0.4306^48 ~ 3e-18.
-constexpr std::int64_t kMargin = 48;
+constexpr std::int64_t kMargin = kQuinticPrefilterMargin;
 constexpr double kPoles[2] = {-0.43057534709997379, -0.043096288203264653};
 
 using detail::num;
 
-// In place: samples -> quintic B-spline coefficients (Unser's causal/anticausal recursions).
-// Outside the buffer the input is taken as zero; callers give kMargin samples of real
-// context on each side, so that assumption's error has decayed below 3e-18 in the middle.
 void prefilter(std::vector<double>& c) {
   const std::size_t n = c.size();
   double gain = 1;
@@ -93,6 +89,8 @@ class Lru {
 using Coefficients3 = std::array<std::vector<double>, 3>;
 
 }  // namespace
+
+void quintic_prefilter(std::vector<double>& c) { prefilter(c); }
 
 // ---------------------------------------------------------------- SampledExcitation
 

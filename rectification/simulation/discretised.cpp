@@ -32,22 +32,8 @@ double basis_derivative(int i, int d, double u) {
   return s / 120;
 }
 
-// The samples -> quintic B-spline coefficients prefilter of vibration/sampled.cpp (Unser's
-// causal/anticausal recursions, the same poles); the caller gives kMargin samples of context
-// on each side (truncation error below 0.4306^48 ~ 3e-18 of the signal in the middle).
-constexpr std::int64_t kMargin = 48;
-constexpr double kPoles[2] = {-0.43057534709997379, -0.043096288203264653};
-void prefilter(std::vector<double>& c) {
-  const std::size_t n = c.size();
-  double gain = 1;
-  for (double z : kPoles) gain *= (1 - z) * (1 - 1 / z);
-  for (double& v : c) v *= gain;
-  for (double z : kPoles) {
-    for (std::size_t i = 1; i < n; ++i) c[i] += z * c[i - 1];
-    c[n - 1] *= z / (z * z - 1);
-    for (std::size_t i = n - 1; i-- > 0;) c[i] = z * (c[i + 1] - c[i]);
-  }
-}
+// The quintic B-spline prefilter of vibration/sampled.hpp and its context on each side.
+constexpr std::int64_t kMargin = vibration::kQuinticPrefilterMargin;
 
 // fs / rate = p / q in lowest terms with q <= 256, or q = 0 when there is none.
 std::pair<std::int64_t, std::int64_t> rational_ratio(double ratio) {
@@ -123,7 +109,7 @@ struct DiscretisedRandomPlant::Coefficients {
     c.resize(axes.size());
     for (std::size_t a = 0; a < axes.size(); ++a) {
       std::vector<double> v = s.samples_g[static_cast<std::size_t>(axes[a])];
-      prefilter(v);
+      vibration::quintic_prefilter(v);
       c[a].assign(v.begin() + kMargin, v.end() - kMargin);
     }
     for (int axis = 0; axis < 3; ++axis)

@@ -14,6 +14,7 @@
 
 #include "io/diagnosis_json.hpp"
 #include "support/instrument.hpp"
+#include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 
@@ -50,18 +51,10 @@ Campaign with_drift(double drift_g_per_h, double rest_sigma_g, bool log_rest = t
   return c;
 }
 
-// A truth as blind draws it: the paper-like coefficients, each perturbed (validation/diagnosis/blind.cpp).
+// A truth as blind draws it (validation/diagnosis/blind.hpp).
 plant::PlantConfig blind_like_truth(std::uint64_t seed) {
   std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0.7, 1.3);
-  std::bernoulli_distribution sign(0.5);
-  plant::PlantConfig p;
-  auto& c = p.coefficients;
-  c[plant::K1] = 1.25 * u(rng), c[plant::k0] = 1.5e-3 * u(rng), c[plant::k1_asym] = 2e-5 * u(rng);
-  c[plant::k2] = 1.5e-5 * u(rng), c[plant::k3] = 1e-6 * u(rng), c[plant::k4] = 2e-7 * u(rng);
-  c[plant::delta_OA] = 1e-4 * u(rng), c[plant::delta_PA] = -5e-5 * u(rng);
-  for (int i : {plant::k_IP, plant::k_IO, plant::k_PO}) c[i] = (sign(rng) ? 1 : -1) * 5e-6 * u(rng);
-  return p;
+  return blind_truth(rng);
 }
 
 }  // namespace

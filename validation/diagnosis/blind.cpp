@@ -18,18 +18,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// The truth of a blind campaign: paper-like coefficients, each perturbed, drawn from rng.
-plant::PlantConfig random_truth(std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> u(0.7, 1.3);
-  std::bernoulli_distribution sign(0.5);
-  plant::PlantConfig p;
-  auto& c = p.coefficients;
-  c[plant::K1] = 1.25 * u(rng), c[plant::k0] = 1.5e-3 * u(rng), c[plant::k1_asym] = 2e-5 * u(rng);
-  c[plant::k2] = 1.5e-5 * u(rng), c[plant::k3] = 1e-6 * u(rng), c[plant::k4] = 2e-7 * u(rng);
-  c[plant::delta_OA] = 1e-4 * u(rng), c[plant::delta_PA] = -5e-5 * u(rng);
-  for (int i : {plant::k_IP, plant::k_IO, plant::k_PO}) c[i] = (sign(rng) ? 1 : -1) * 5e-6 * u(rng);
-  return p;
-}
 
 // A hidden effect's parameter, drawn by the effect itself (its `draw`: where its gap is
 // several sigma in the default design).
@@ -89,7 +77,7 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
   const auto t0 = Clock::now();
   try {
     std::mt19937_64 rng(k.seed + 17);
-    const plant::PlantConfig truth = random_truth(rng);
+    const plant::PlantConfig truth = blind_truth(rng);
     Campaign camp = simulate_campaign(truth, k.hidden, default_design(), k.seed, 1);
     apply_lab_log(camp, k);
     k.simulate_s = seconds_since(t0);
@@ -238,6 +226,18 @@ void score(const BlindCampaign& k, BlindResult& r, std::vector<double>& shrink, 
 }
 
 }  // namespace
+
+plant::PlantConfig blind_truth(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.7, 1.3);
+  std::bernoulli_distribution sign(0.5);
+  plant::PlantConfig p;
+  auto& c = p.coefficients;
+  c[plant::K1] = 1.25 * u(rng), c[plant::k0] = 1.5e-3 * u(rng), c[plant::k1_asym] = 2e-5 * u(rng);
+  c[plant::k2] = 1.5e-5 * u(rng), c[plant::k3] = 1e-6 * u(rng), c[plant::k4] = 2e-7 * u(rng);
+  c[plant::delta_OA] = 1e-4 * u(rng), c[plant::delta_PA] = -5e-5 * u(rng);
+  for (int i : {plant::k_IP, plant::k_IO, plant::k_PO}) c[i] = (sign(rng) ? 1 : -1) * 5e-6 * u(rng);
+  return p;
+}
 
 bool BlindSettings::IsValid(std::string* why) const {
   std::string w;

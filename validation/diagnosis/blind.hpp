@@ -24,6 +24,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -104,6 +105,9 @@ struct BlindResult {
 };
 
 // Called after each campaign (under the pool's lock): campaigns done, of total.
+// The truth of a blind campaign: paper-like coefficients, each perturbed, drawn from rng.
+plant::PlantConfig blind_truth(std::mt19937_64& rng);
+
 using BlindProgress = std::function<void(std::size_t done, std::size_t total)>;
 
 // Invalid settings throw std::invalid_argument naming the key. A campaign whose simulation or
