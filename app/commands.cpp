@@ -42,6 +42,7 @@ void write_json(const std::string& path, const nlohmann::json& j) {
 }  // namespace
 
 void run_identify(const IdentifyOptions& o, std::ostream& out) {
+  if (!o.checkpoint_path.empty() && o.monte_carlo == 0) throw InputError("--checkpoint needs --monte-carlo N");
   Case c = read_case(o.case_path);
   if (o.seed) c.seed = *o.seed;
   if (o.work_limit) check_identify_work(c, o.monte_carlo);

@@ -46,5 +46,6 @@ check "rerun on a finished checkpoint = uninterrupted" same_json "$tmp/plain.jso
 # Another run's file is not mixed in.
 expect 2 'holds another run' identify "$case" --monte-carlo 3000 --seed 9 --checkpoint "$tmp/ck"
 expect 2 'holds another run' identify "$case" --monte-carlo 2000 --checkpoint "$tmp/ck"
+expect 2 'needs --monte-carlo' identify "$case" --checkpoint "$tmp/ck"
 echo "mc_checkpoint: $pass passed, $fail failed"
 [ "$fail" -eq 0 ]
