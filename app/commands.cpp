@@ -42,10 +42,11 @@ void write_json(const std::string& path, const nlohmann::json& j) {
 }  // namespace
 
 void run_identify(const IdentifyOptions& o, std::ostream& out) {
+  if (!o.checkpoint_path.empty() && o.monte_carlo == 0) throw InputError("--checkpoint needs --monte-carlo N");
   Case c = read_case(o.case_path);
   if (o.seed) c.seed = *o.seed;
   if (o.work_limit) check_identify_work(c, o.monte_carlo);
-  const IdentifyStudy s = identify(c, o.monte_carlo);
+  const IdentifyStudy s = identify(c, o.monte_carlo, o.checkpoint_path);
   if (!core::is_root_process()) return;  // under mpirun the Monte Carlo's results are rank 0's
   nlohmann::json j = identify_json(c, s);
   if (o.monte_carlo > 0) {  // where the trials ran (they do not depend on it: blocks seeded by their index)

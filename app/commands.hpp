@@ -18,6 +18,7 @@ struct IdentifyOptions {
   std::string case_path;
   std::string json_path;
   int monte_carlo = 0;
+  std::string checkpoint_path;  // --checkpoint: the Monte Carlo's resume file
   std::optional<std::uint64_t> seed;
   bool work_limit = true;  // false: --no-work-limit
 };

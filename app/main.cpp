@@ -46,6 +46,9 @@ Command add_identify(CLI::App& app) {
   cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
   cmd->add_option("--monte-carlo", o.monte_carlo, "Also run N simulated tests for Monte Carlo uncertainty")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--checkpoint", o.checkpoint_path,
+                  "With --monte-carlo: keep each block of trials in this file as it ends; a rerun with the "
+                  "same file runs only the missing blocks (docs/mpi.md)");
   cmd->add_option("--seed", o.seed, "Override the case's [run] seed");
   cmd->add_flag_callback(
       "--no-work-limit", [&o] { o.work_limit = false; },

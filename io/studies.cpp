@@ -48,6 +48,12 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+std::uint64_t fnv1a(const std::string& s) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char ch : s) h = (h ^ ch) * 1099511628211ull;
+  return h;
+}
+
 }  // namespace
 
 std::string header_line(const std::string& command, const Case& c, std::uint64_t seed) {
@@ -56,7 +62,7 @@ std::string header_line(const std::string& command, const Case& c, std::uint64_t
 
 // ---------------------------------------------------------------- identify
 
-IdentifyStudy identify(const Case& c, int monte_carlo_trials) {
+IdentifyStudy identify(const Case& c, int monte_carlo_trials, const std::string& checkpoint) {
   require(c, c.coefficients.has_value(), "coefficients", "identify");
   require(c, c.dividing_head.has_value(), "dividing_head", "identify");
   const DividingHead& head = *c.dividing_head;
@@ -64,6 +70,11 @@ IdentifyStudy identify(const Case& c, int monte_carlo_trials) {
   s.settings.fixed = c.fixed;
   s.settings.seed = c.seed;
   s.settings.monte_carlo_trials = monte_carlo_trials;
+  if (!checkpoint.empty()) {  // ties the file to the case's content (not its path) and the program
+    s.settings.monte_carlo_checkpoint.path = checkpoint;
+    s.settings.monte_carlo_checkpoint.fingerprint = fmt::format(
+        "case+program {:016x}", fnv1a(c.content.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + kProgramVersion + kGitDescribe));
+  }
   if (head.from_ode) {
     const plant::PlantConfig plant = c.plant;
     s.settings.source = [plant](const Vec3& a) { return plant.coefficients[plant::K1] * plant::settled_output_g(plant, a); };
@@ -474,12 +485,6 @@ std::string measure_report(const MeasureStudy& s) {
 // ---------------------------------------------------------------- sweep
 
 namespace {
-
-std::uint64_t fnv1a(const std::string& s) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char ch : s) h = (h ^ ch) * 1099511628211ull;
-  return h;
-}
 
 // `checksum` is FNV-1a (32 bits, 8 hex digits) of the row's text before it ("index,...,steps"):
 // a resumed sweep verifies it, so a row edited by hand is found. wall_s, a timing and not a

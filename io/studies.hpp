@@ -34,7 +34,8 @@ struct IdentifyStudy {
   validation::StaticTestReport report;
 };
 // Needs [coefficients] and [dividing_head]; a rank-deficient set is InputError in words.
-IdentifyStudy identify(const Case& c, int monte_carlo_trials);
+// checkpoint: the Monte Carlo's resume file (empty: none; docs/mpi.md).
+IdentifyStudy identify(const Case& c, int monte_carlo_trials, const std::string& checkpoint = "");
 std::string identify_report(const Case& c, const IdentifyStudy& s);
 
 // ---- predict: eq. (3) corrected for the case's vibration, and through the dynamics.

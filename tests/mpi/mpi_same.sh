@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The four distributed commands under `mpirun -n 3` give the rows the threaded run gives
 # (docs/mpi.md): a small sweep, a batch of campaigns with a bad folder among them, identify
-# --monte-carlo, a small blind benchmark; then a sweep, a blind and a batch resumed under
+# --monte-carlo, a small blind benchmark; then a sweep, a blind, a batch and a Monte Carlo resumed under
 # mpirun from files cut short as a killed run leaves them equal the uninterrupted ones.
 # Rows are compared as text, every column but wall time (and the header comments, which
 # record the ranks and threads). Usage:
@@ -79,6 +79,13 @@ expect 0 'Monte Carlo' identify "$cases/paper-static.toml" --monte-carlo 3000 --
 run_mpi 0 identify "$cases/paper-static.toml" --monte-carlo 3000 --json "$tmp/mc-mpi.json"
 check "identify --monte-carlo: the same to the bit under mpirun -n 3" same_json "$tmp/mc-threads.json" "$tmp/mc-mpi.json"
 check "identify --monte-carlo: the JSON records 3 ranks" grep -q '"monte_carlo_ranks": 3' "$tmp/mc-mpi.json"
+# Killed mid-run with --checkpoint: 4 blocks and half of the 5th in the file; resumed under mpirun.
+run_mpi 0 identify "$cases/paper-static.toml" --monte-carlo 3000 --checkpoint "$tmp/mc-ck"
+head -n 5 "$tmp/mc-ck" >"$tmp/mc-cut"
+sed -n '6p' "$tmp/mc-ck" | head -c 300 >>"$tmp/mc-cut"
+run_mpi 0 identify "$cases/paper-static.toml" --monte-carlo 3000 --json "$tmp/mc-resumed.json" --checkpoint "$tmp/mc-cut"
+check "identify --monte-carlo: resumed under mpirun from a cut checkpoint = uninterrupted" same_json "$tmp/mc-threads.json" "$tmp/mc-resumed.json"
+check "identify --monte-carlo: the resume ran only the missing blocks" grep -q '4 of 12 blocks already in' "$tmp/err"
 
 # ---- diagnose of many campaigns: a folder of three campaigns, and a bad folder.
 mkdir -p "$tmp/units" "$tmp/bad"

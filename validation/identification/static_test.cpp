@@ -65,7 +65,8 @@ StaticTestReport run_static_test(const plant::Coefficients& truth, const std::ve
                          report.identifiability.parameters);
   if (!report.fit.problem.empty()) throw std::invalid_argument("least squares: " + report.fit.problem);
   if (settings.monte_carlo_trials > 0) {
-    const auto stats = monte_carlo(fns, truth, source, positions, errors, settings.monte_carlo_trials, settings.seed + 1);
+    const auto stats = monte_carlo(fns, truth, source, positions, errors, settings.monte_carlo_trials, settings.seed + 1,
+                                    0, settings.monte_carlo_checkpoint);
     for (std::size_t i = 0; i < stats.size(); ++i) report.methods[i].monte_carlo = stats[i];
   }
   return report;

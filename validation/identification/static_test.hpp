@@ -34,6 +34,7 @@ struct StaticTestSettings {
   OutputSource source;  // empty: model (1) with the true coefficients
   std::uint64_t seed = 1;
   int monte_carlo_trials = 0;  // 0: none; else at least 2
+  MonteCarloCheckpoint monte_carlo_checkpoint;  // the trials' resume file (uncertainty.hpp); none by default
   // False (with the reason, naming the setting, in *why) for settings no run can use.
   bool IsValid(std::string* why) const {
     if (monte_carlo_trials == 1 || monte_carlo_trials < 0) {

@@ -4,9 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <string>
+#include <filesystem>
+#include <fstream>
 #include <random>
+#include <sstream>
 #include <stdexcept>
+#include <string>
 
 #include "core/dispatch.hpp"
 
@@ -61,20 +64,107 @@ std::mt19937_64 block_rng(std::uint64_t seed, std::uint64_t b) {
   return std::mt19937_64(seq);
 }
 
+std::uint64_t fnv1a64(const std::string& text) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const unsigned char ch : text) h = (h ^ ch) * 1099511628211ull;
+  return h;
+}
+
+// Reads a block's numbers ("%a %a ..."): false unless there are `count` of them.
+bool read_block(const std::string& text, std::size_t count, std::vector<double>* v) {
+  v->clear();
+  const char* p = text.c_str();
+  for (char* end = nullptr;; p = end) {
+    const double x = std::strtod(p, &end);
+    if (end == p) break;
+    v->push_back(x);
+  }
+  return v->size() == count;
+}
+
+// The checkpoint's line of block b: "b <index> <numbers> <checksum of what precedes it>".
+std::string checkpoint_line(std::size_t b, const std::string& numbers) {
+  std::string line = "b " + std::to_string(b) + " " + numbers;
+  char sum[24];
+  std::snprintf(sum, sizeof sum, "%016llx", static_cast<unsigned long long>(fnv1a64(line)));
+  return line.append(sum).append("\n");
+}
+
+// The blocks a checkpoint file holds (a cut, altered or repeated line is dropped: the block
+// runs again), after checking its header; rewrites the file with them alone (atomically), so
+// that the lines appended after start on a line of their own.
+std::size_t read_checkpoint(const std::string& path, const std::string& header, std::size_t blocks,
+                            std::size_t count, std::vector<std::vector<double>>* partial) {
+  namespace fs = std::filesystem;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::invalid_argument("--checkpoint " + path + ": cannot be read");
+  std::string line, kept = header, numbers;
+  std::getline(in, line);
+  if (line + "\n" != header)
+    throw std::invalid_argument("--checkpoint " + path +
+                                ": holds another run (case, program, seed or trials); remove it or name another file");
+  std::size_t found = 0;
+  while (std::getline(in, line)) {
+    if (in.eof()) break;  // the last line without its newline: cut by a kill
+    const std::size_t sp = line.rfind(' ');
+    if (line.rfind("b ", 0) != 0 || sp == std::string::npos) continue;
+    char* end = nullptr;
+    const unsigned long long b = std::strtoull(line.c_str() + 2, &end, 10);
+    if (end == line.c_str() + 2 || *end != ' ' || b >= blocks || !(*partial)[b].empty()) continue;
+    numbers = line.substr(static_cast<std::size_t>(end - line.c_str()) + 1, sp - static_cast<std::size_t>(end - line.c_str()));
+    if (checkpoint_line(b, numbers) != line + "\n") continue;
+    if (!read_block(numbers, count, &(*partial)[b])) {
+      (*partial)[b].clear();
+      continue;
+    }
+    kept += line + "\n";
+    ++found;
+  }
+  in.close();
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << kept;
+    if (!(out.flush())) throw std::runtime_error("--checkpoint " + path + ": cannot be written");
+  }
+  fs::rename(tmp, path);
+  return found;
+}
+
 }  // namespace
 
 std::vector<MonteCarloStats> monte_carlo(const std::vector<Estimator>& estimators,
                                          const plant::Coefficients& truth, const OutputSource& source,
                                          const std::vector<Position>& positions,
-                                         const StaticTestErrors& errors, int n, std::uint64_t seed, int threads) {
+                                         const StaticTestErrors& errors, int n, std::uint64_t seed, int threads,
+                                         const MonteCarloCheckpoint& checkpoint) {
   if (n < 2) throw std::invalid_argument("Monte Carlo needs at least 2 trials");
   const std::size_t ne = estimators.size(), nk = plant::kNumCoefficients;
   const std::size_t blocks = (static_cast<std::size_t>(n) + kTrialsPerBlock - 1) / kTrialsPerBlock;
   // Per block: for each estimator and coefficient its mean error and sum of squared
   // deviations (Welford within the block), as hexadecimal floats (exact).
   std::vector<std::vector<double>> partial(blocks);
-  std::vector<std::size_t> items(blocks);
-  for (std::size_t b = 0; b < blocks; ++b) items[b] = b;
+  // The checkpoint (rank 0's: it alone decides the items and writes): the blocks already
+  // there are not run again.
+  std::ofstream save;
+  if (!checkpoint.path.empty() && core::is_root_process()) {
+    char head[160];
+    std::snprintf(head, sizeof head, " trials %d seed %llu block %d estimators %zu\n", n,
+                  static_cast<unsigned long long>(seed), kTrialsPerBlock, ne);
+    const std::string header = "# vrelab identify --monte-carlo checkpoint " + checkpoint.fingerprint + head;
+    if (std::filesystem::exists(checkpoint.path)) {
+      const std::size_t found = read_checkpoint(checkpoint.path, header, blocks, 2 * ne * nk, &partial);
+      std::fprintf(stderr, "vrelab: --checkpoint %s: %zu of %zu blocks already in\n", checkpoint.path.c_str(), found,
+                   blocks);
+    } else {
+      std::ofstream(checkpoint.path, std::ios::binary) << header;
+    }
+    save.open(checkpoint.path, std::ios::binary | std::ios::app);
+    if (!save) throw std::invalid_argument("--checkpoint " + checkpoint.path + ": cannot be written");
+  }
+  std::vector<std::size_t> items;
+  for (std::size_t b = 0; b < blocks; ++b)
+    if (partial[b].empty()) items.push_back(b);
   core::dispatch(
       items, threads,
       [&](std::size_t b) {
@@ -102,14 +192,13 @@ std::vector<MonteCarloStats> monte_carlo(const std::vector<Estimator>& estimator
         return text;
       },
       [&](std::size_t b, const std::string& text) {
-        std::vector<double>& v = partial[b];
-        const char* p = text.c_str();
-        for (char* end = nullptr;; p = end) {
-          const double x = std::strtod(p, &end);
-          if (end == p) break;
-          v.push_back(x);
+        if (!read_block(text, 2 * ne * nk, &partial[b]))
+          throw std::runtime_error("monte_carlo: a block's result could not be read back");
+        if (save.is_open()) {  // one line and a flush: a kill leaves at most the last one cut
+          save << checkpoint_line(b, text);
+          save.flush();
+          if (!save) throw std::runtime_error("--checkpoint " + checkpoint.path + ": cannot be written");
         }
-        if (v.size() != 2 * ne * nk) throw std::runtime_error("monte_carlo: a block's result could not be read back");
       });
   // The blocks merged in their order (Chan et al.'s pairwise update): one sum, whatever order
   // they finished in. (Under MPI only rank 0 has them; the others return zeros.)

@@ -10,6 +10,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "plant/model1.hpp"
@@ -42,9 +43,22 @@ struct MonteCarloStats {
 // blocks of 256, block b drawn from its own stream (seed, b), on `threads` threads (0: all
 // cores) or the ranks of mpirun (core/dispatch.hpp); the blocks' means and squared deviations
 // are merged in block order: the result is the same to the bit whatever ran them.
+//
+// With `checkpoint.path` set, each block's result is appended to that file (one line, its
+// numbers as hexadecimal floats, a checksum) as rank 0 receives it, under a header naming
+// `checkpoint.fingerprint`, the trials and the seed; a run that finds the file reads the
+// blocks back (a cut or altered line is dropped and its block run again) and runs only the
+// others: the result is that of an uninterrupted run to the bit. A header that differs
+// throws std::invalid_argument. The file is kept at the end (docs/mpi.md).
+struct MonteCarloCheckpoint {
+  std::string path;         // empty: none
+  std::string fingerprint;  // one line: the case and the program (the caller's choice)
+};
+
 std::vector<MonteCarloStats> monte_carlo(const std::vector<Estimator>& estimators,
                                          const plant::Coefficients& truth, const OutputSource& source,
                                          const std::vector<Position>& positions,
-                                         const StaticTestErrors& errors, int n, std::uint64_t seed, int threads = 0);
+                                         const StaticTestErrors& errors, int n, std::uint64_t seed, int threads = 0,
+                                         const MonteCarloCheckpoint& checkpoint = {});
 
 }  // namespace vrelab::validation

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# identify --monte-carlo --checkpoint on threads, without MPI (docs/mpi.md, Resuming): the
+# checkpoint of a finished run, cut as a kill leaves it (whole lines and half a line), then
+# the rerun equals the uninterrupted run's JSON to the bit; a finished checkpoint reruns
+# nothing; another seed's checkpoint is refused (exit 2). Usage: mc_checkpoint.sh <vrelab> <cases dir>
+set -u
+bin=$1
+cases=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/../cli/expect.sh"
+
+same_json() {  # equal but for times, threads, ranks and the program record
+  python3 - "$1" "$2" <<'PY'
+import json, sys
+def strip(x):
+    if isinstance(x, dict):
+        return {k: strip(v) for k, v in x.items()
+                if k not in ("wall_s", "simulate_s", "threads", "ranks", "program",
+                             "monte_carlo_ranks", "monte_carlo_threads_per_rank")}
+    if isinstance(x, list):
+        return [strip(v) for v in x]
+    return x
+a, b = (strip(json.load(open(p))) for p in sys.argv[1:3])
+sys.exit(0 if a == b else 1)
+PY
+}
+
+case=$cases/paper-static.toml
+# 3000 trials: 12 blocks (the last one short).
+expect 0 'Monte Carlo' identify "$case" --monte-carlo 3000 --json "$tmp/plain.json"
+expect 0 'Monte Carlo' identify "$case" --monte-carlo 3000 --json "$tmp/full.json" --checkpoint "$tmp/ck"
+check "a checkpointed run = a plain run" same_json "$tmp/plain.json" "$tmp/full.json"
+check "the checkpoint holds a header and 12 blocks" test "$(grep -c '^b ' "$tmp/ck")" -eq 12
+# Killed after 5 blocks were in and half of the 6th: the rerun runs 7 blocks.
+head -n 6 "$tmp/ck" >"$tmp/cut"
+sed -n '7p' "$tmp/ck" | head -c 300 >>"$tmp/cut"
+# and a block whose line was altered runs again too
+sed -i '3s/0x1/0x2/' "$tmp/cut"
+expect 0 '4 of 12 blocks already in' identify "$case" --monte-carlo 3000 --json "$tmp/resumed.json" --checkpoint "$tmp/cut"
+check "resumed from a cut checkpoint = uninterrupted" same_json "$tmp/plain.json" "$tmp/resumed.json"
+check "the resumed checkpoint holds the 12 blocks" test "$(grep -c '^b ' "$tmp/cut")" -eq 12
+# A finished checkpoint: nothing to run, the same result.
+expect 0 '12 of 12 blocks already in' identify "$case" --monte-carlo 3000 --json "$tmp/again.json" --checkpoint "$tmp/ck"
+check "rerun on a finished checkpoint = uninterrupted" same_json "$tmp/plain.json" "$tmp/again.json"
+# Another run's file is not mixed in.
+expect 2 'holds another run' identify "$case" --monte-carlo 3000 --seed 9 --checkpoint "$tmp/ck"
+expect 2 'holds another run' identify "$case" --monte-carlo 2000 --checkpoint "$tmp/ck"
+expect 2 'needs --monte-carlo' identify "$case" --checkpoint "$tmp/ck"
+echo "mc_checkpoint: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
