@@ -9,22 +9,8 @@ cases=$2
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 . "$(dirname "$0")/../cli/expect.sh"
+. "$(dirname "$0")/same_json.sh"
 
-same_json() {  # equal but for times, threads, ranks and the program record
-  python3 - "$1" "$2" <<'PY'
-import json, sys
-def strip(x):
-    if isinstance(x, dict):
-        return {k: strip(v) for k, v in x.items()
-                if k not in ("wall_s", "simulate_s", "threads", "ranks", "program",
-                             "monte_carlo_ranks", "monte_carlo_threads_per_rank")}
-    if isinstance(x, list):
-        return [strip(v) for v in x]
-    return x
-a, b = (strip(json.load(open(p))) for p in sys.argv[1:3])
-sys.exit(0 if a == b else 1)
-PY
-}
 
 case=$cases/paper-static.toml
 # 3000 trials: 12 blocks (the last one short).

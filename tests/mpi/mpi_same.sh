@@ -14,6 +14,7 @@ mpiexec=$3
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 . "$(dirname "$0")/../cli/expect.sh"
+. "$(dirname "$0")/same_json.sh"
 
 # mpirun refuses to start as root unless told (CI may run as root); three ranks on any
 # machine (--oversubscribe: more ranks than cores).
@@ -24,21 +25,6 @@ rows() {  # rows <csv>: data rows without the header comments and the last (wall
   grep -v '^#' "$1" | sed 's/,[^,]*$//'
 }
 same_rows() { diff <(rows "$1") <(rows "$2") >"$tmp/diff" || { cat "$tmp/diff"; return 1; }; }
-same_json() {  # same_json <a> <b>: equal but for times, threads, ranks and the program record
-  python3 - "$1" "$2" <<'PY'
-import json, sys
-def strip(x):
-    if isinstance(x, dict):
-        return {k: strip(v) for k, v in x.items()
-                if k not in ("wall_s", "simulate_s", "threads", "ranks", "program",
-                             "monte_carlo_ranks", "monte_carlo_threads_per_rank")}
-    if isinstance(x, list):
-        return [strip(v) for v in x]
-    return x
-a, b = (strip(json.load(open(p))) for p in sys.argv[1:3])
-sys.exit(0 if a == b else 1)
-PY
-}
 run_mpi() {  # run_mpi <want rc> <args...>: vrelab under mpirun
   local want=$1
   shift
