@@ -12,7 +12,8 @@ packages=(build-essential cmake git pkg-config
           libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libfftw3-dev libsundials-dev
           libgtest-dev libbenchmark-dev python3-matplotlib
           python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest
-          libopenmpi-dev openmpi-bin)
+          libopenmpi-dev openmpi-bin
+          libboost-dev)
 
 run_main=1
 [ "${1:-}" = "--no-run" ] && run_main=0

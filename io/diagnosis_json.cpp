@@ -144,6 +144,7 @@ json nuisances_json(const validation::Diagnosis& d) {
                  {"unit", x.unit},
                  {"estimated", x.estimated},
                  {"applied", x.applied},
+                 {"significant", x.significant},
                  {"note", x.note}});
   return a;
 }

@@ -151,11 +151,13 @@ void score_family(const BlindCampaign& k, BlindResult& r) {
   const Nuisance* scale = d.nuisance("sigma_scale");
   const Nuisance* drift = d.nuisance("bias_drift");
   bool right = false, family = false;
-  if (k.category == "clean") right = !d.gap_significant;
+  // A nuisance reported where there is none is a false alarm as much as a gap is.
+  const bool scale_flagged = scale && scale->significant, drift_flagged = drift && drift->significant;
+  if (k.category == "clean") right = !d.gap_significant && !scale_flagged && !drift_flagged;
   else if (k.category == "out_of_library") right = d.gap_significant && !d.explained;
-  else if (k.category == "sigma_understated") right = !d.explained && scale && scale->applied;
+  else if (k.category == "sigma_understated") right = !d.explained && scale_flagged;
   else if (k.category == "drift")
-    right = !d.explained && drift && drift->estimated && std::abs(drift->value) > 3 * drift->sigma &&
+    right = !d.explained && drift_flagged &&
             std::abs(drift->value - k.drift_g_per_h * 1e6) < 3 * drift->sigma + 0.1 * std::abs(k.drift_g_per_h * 1e6);
   else if (k.category == "two") {
     right = called.size() == 2 && is_truth(called[0]) && is_truth(called[1]);
@@ -210,7 +212,8 @@ void score(const BlindCampaign& k, BlindResult& r, std::vector<double>& shrink, 
 
   } else if (k.category == "clean") {
     ++s.clean;
-    s.false_alarms += called != "clean";
+    const bool nuisance_flagged = std::any_of(d.nuisances.begin(), d.nuisances.end(), [](const Nuisance& x) { return x.significant; });
+    s.false_alarms += called != "clean" || nuisance_flagged;
 
   } else if (k.category == "out_of_library") {
     ++s.out_of_library;
@@ -271,6 +274,12 @@ std::string unescaped(const std::string& s) {
 
 }  // namespace
 
+// The fields: 17 fixed (times, scores' numbers, names), then the verdict, the ambiguous
+// effects (their count, then each), the nuisances (their count, then 8 fields each): what the
+// scoring reads. (Before, the verdict, the nuisances and the ambiguity were not sent, so a
+// nuisance campaign scored "no gap" whatever its diagnosis said.)
+constexpr std::size_t kFixedResultFields = 17, kNuisanceFields = 8;
+
 std::string campaign_result_text(const BlindCampaign& k) {
   const Diagnosis& d = k.diagnosis;
   const bool has_top = !d.effects.empty();
@@ -281,7 +290,15 @@ std::string campaign_result_text(const BlindCampaign& k) {
   for (const std::string* x : {&k.error, &k.called, &k.top, &d.chosen, &d.where})
     t.append("\t").append(escaped(*x));
   t.append("\t").append(escaped(has_top ? d.effects.front().name : std::string()));
-  return t.append(has_top ? "\t1" : "\t0");
+  t.append(has_top ? "\t1" : "\t0");
+  t.append("\t").append(escaped(d.verdict));
+  t.append(fmt::format("\t{}", d.ambiguous_with.size()));
+  for (const std::string& a : d.ambiguous_with) t.append("\t").append(escaped(a));
+  t.append(fmt::format("\t{}", d.nuisances.size()));
+  for (const Nuisance& x : d.nuisances)
+    t.append(fmt::format("\t{}\t{}\t{:.17g}\t{:.17g}\t{:d}\t{:d}\t{:d}\t{}", escaped(x.name), escaped(x.unit), x.value, x.sigma,
+                         x.estimated ? 1 : 0, x.applied ? 1 : 0, x.significant ? 1 : 0, escaped(x.note)));
+  return t;
 }
 
 void read_campaign_result(const std::string& text, BlindCampaign& k) {
@@ -292,13 +309,27 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
     if (tab == std::string::npos) break;
     at = tab + 1;
   }
-  if (f.size() != 17) throw std::invalid_argument(fmt::format("blind: a campaign's result has {} fields, not 17", f.size()));
-  auto num = [&](int i) {
+  const auto bad = [&](const std::string& what) {
+    return std::invalid_argument(fmt::format("blind: a campaign's result ({} fields): {}", f.size(), what));
+  };
+  auto num = [&](std::size_t i) {
+    if (i >= f.size()) throw bad(fmt::format("field {} missing", i + 1));
     std::size_t used = 0;
-    const double x = std::stod(f[static_cast<std::size_t>(i)], &used);
-    if (used != f[static_cast<std::size_t>(i)].size()) throw std::invalid_argument("blind: not a number: " + f[static_cast<std::size_t>(i)]);
+    double x = 0;
+    try {
+      x = std::stod(f[i], &used);
+    } catch (const std::exception&) {
+      used = std::string::npos;
+    }
+    if (used != f[i].size()) throw bad("not a number: " + f[i]);
     return x;
   };
+  auto count = [&](std::size_t i) {
+    const double x = num(i);
+    if (!(x >= 0 && x < 1e6 && x == std::floor(x))) throw bad("not a count: " + f[i]);
+    return static_cast<std::size_t>(x);
+  };
+  if (f.size() < kFixedResultFields + 3) throw bad(fmt::format("at least {} expected", kFixedResultFields + 3));
   Diagnosis& d = k.diagnosis;
   k.simulate_s = num(0), k.wall_s = num(1), k.effect_max_sigma = num(2);
   d.gap_significant = f[3] == "1", d.explained = f[4] == "1";
@@ -311,6 +342,24 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
     e.name = unescaped(f[15]);
     e.value = num(9);
     d.effects.push_back(e);
+  }
+  std::size_t at = kFixedResultFields;
+  d.verdict = unescaped(f[at++]);
+  const std::size_t n_ambiguous = count(at++);
+  if (f.size() < at + n_ambiguous + 1) throw bad("the ambiguous effects cut short");
+  d.ambiguous_with.clear();
+  for (std::size_t i = 0; i < n_ambiguous; ++i) d.ambiguous_with.push_back(unescaped(f[at++]));
+  const std::size_t n_nuisances = count(at++);
+  if (f.size() != at + kNuisanceFields * n_nuisances) throw bad(fmt::format("{} nuisances of {} fields expected", n_nuisances, kNuisanceFields));
+  d.nuisances.clear();
+  for (std::size_t i = 0; i < n_nuisances; ++i) {
+    Nuisance x;
+    x.name = unescaped(f[at]), x.unit = unescaped(f[at + 1]);
+    x.value = num(at + 2), x.sigma = num(at + 3);
+    x.estimated = f[at + 4] == "1", x.applied = f[at + 5] == "1", x.significant = f[at + 6] == "1";
+    x.note = unescaped(f[at + 7]);
+    d.nuisances.push_back(x);
+    at += kNuisanceFields;
   }
 }
 

@@ -14,6 +14,8 @@
 #include <stdexcept>
 
 #include <Eigen/Dense>
+#include <boost/math/distributions/chi_squared.hpp>
+#include <boost/math/distributions/students_t.hpp>
 
 #include "rectification/prediction/frequency.hpp"
 #include "rectification/prediction/random.hpp"
@@ -423,6 +425,13 @@ const Nuisance* Diagnosis::nuisance(const std::string& name) const {
 
 namespace {
 
+// The level every nuisance is tested at: the one-sided tail of a normal deviate beyond 3,
+// 1 - Phi(3) = 1.35e-3 (a clean campaign is flagged for drift with twice that, both signs,
+// and for an understated sigma with it: 0.4 % in all, within the 2 % false alarms
+// with room for the gap's own test). The thresholds are this tail's quantiles of each
+// statistic's distribution under "no nuisance", not values tuned on campaigns.
+constexpr double kNuisanceTail = 1.3498980316300946e-3;
+
 // Bias drift: a line through the rest readings over the campaign's time (unweighted least
 // squares; its scatter gives the readings' sigma), removed from every run with a time, the
 // line's own variance added to the run's. The runs without time are left as they are.
@@ -451,6 +460,12 @@ Nuisance remove_drift(Campaign& c) {
   const double s2 = rest.size() > 2 ? rss / (m - 2) : 0.0;
   nu.estimated = true, nu.applied = true;
   nu.value = b * 1e6, nu.sigma = std::sqrt(s2 / stt) * 1e6;
+  // Without a drift, b / sigma_b is Student's t with m - 2 degrees of freedom (a line fit to m
+  // readings with Gaussian noise of unknown sigma): significant beyond its two-sided quantile
+  // at the 3-sigma level (3.05 for 168 readings; 4.9 for 10).
+  double t_crit = INFINITY;
+  if (rest.size() > 2) t_crit = boost::math::quantile(boost::math::students_t(m - 2), 1 - kNuisanceTail);
+  nu.significant = s2 > 0 ? std::abs(b) > t_crit * std::sqrt(s2 / stt) : b != 0;
   for (RunRecord& r : c.runs) {
     if (!std::isfinite(r.time_h)) continue;
     r.measured_g -= a + b * r.time_h;
@@ -552,17 +567,25 @@ Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s) {
                   rho_sigma, pairs);
     scale.note = buf;
   }
-  // Scaled when the excess is beyond chance (3 sigma of its own estimate) and it is scatter:
-  // measured by repeats, or a gap no effect explains whose neighbours are not alike.
-  const bool excess = scale.value > 1 + 3 * scale.sigma;
-  const bool scatter = from_repeats || (d.gap_significant && !d.explained && rho_sigma < s.structure_sigma);
+  // Overdispersion beyond chance: with the stated sigma right, the repeats' pooled chi^2 is
+  // chi^2 with rep_dof degrees of freedom exactly (Gaussian noise); the gaps' sum of z^2 is at
+  // most chi^2 with n (the coefficients' errors taken out under their prior use up a little:
+  // the test errs on the side of not flagging). Beyond its quantile at kNuisanceTail: 1.13 x
+  // the stated sigma for 168 runs, 2.2 x for 5 degrees of freedom of repeats.
+  const double chi2 = from_repeats ? rep_chi2 : z2;
+  const double chi2_crit = boost::math::quantile(boost::math::chi_squared(kdof), 1 - kNuisanceTail);
+  const bool excess = chi2 > chi2_crit;
+  // It is scatter when measured by repeats, or when no effect explains the gaps and their
+  // neighbours are not alike (structure is physics). Whatever the gap's verdict: an
+  // overdispersion below the gap's own 5-sigma test is still reported.
+  const bool scatter = from_repeats || (!d.explained && rho_sigma < s.structure_sigma);
   // A physical gap is not scatter: scaled from the gaps alone (no repeats), the scaling is not
   // applied when, judged with the corrected sigma, one library effect's held-out evidence still
   // exceeds the targeted test's level (significance^2 = 25). With the right sigma, 30 clean
   // campaigns gave a best evidence of at most 7.0 (docs/diagnose.md step 3), so an excess that
   // is scatter leaves none above 25 once corrected; a squeeze film's weakly structured gap does.
   // Then the gap is judged with the stated sigma, and only repeats can measure the scatter.
-  if (excess && scatter && !(d.explained && !from_repeats)) {
+  if (excess && scatter) {
     Campaign scaled = c;
     for (RunRecord& r : scaled.runs) r.sigma_g *= scale.value;
     Diagnosis ds = diagnose_once(scaled, s);
@@ -576,13 +599,16 @@ Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s) {
       scale.note += buf;
     } else {
       d = std::move(ds);
-      scale.applied = true;
+      scale.applied = true, scale.significant = true;
       char buf[80];
       std::snprintf(buf, sizeof buf, " (sigma understated x%.2f; judged with the corrected sigma)", scale.value);
       d.verdict += buf;
     }
+  } else if (excess) {
+    scale.note += d.explained ? "; not applied: the chosen effect explains the gap (only repeated runs would tell scatter apart)"
+                              : "; not applied: the gaps are alike between neighbouring runs (structure, not scatter)";
   }
-  if (drift.applied && std::abs(drift.value) > 3 * drift.sigma) {
+  if (drift.significant) {
     char buf[120];
     std::snprintf(buf, sizeof buf, " (bias drift %.3g +- %.2g ug/h removed)", drift.value, drift.sigma);
     d.verdict += buf;

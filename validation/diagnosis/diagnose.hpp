@@ -144,6 +144,11 @@ struct Nuisance {
   double value = 0, sigma = NAN;
   bool estimated = false;  // the data allowed an estimate
   bool applied = false;    // removed from the data (drift) or used to judge the gap (sigma)
+  // The data show it beyond chance (reported in the verdict whatever the gap's): the drift's
+  // rate beyond 3 sigma of its own estimate (Student's t of the line fit); the stated sigma's
+  // overdispersion beyond the chi^2 quantile at the same one-sided level (from repeats; or
+  // from the gaps when no effect explains them). docs/diagnose.md, "Lab nuisances".
+  bool significant = false;
   std::string note;
 };
 

@@ -24,7 +24,7 @@ std::string nuisance_lines(const Diagnosis& d) {
       continue;
     }
     t += fmt::format("Nuisance {}: {:.4g} +- {:.2g} {}{}; {}\n", x.name, x.value, x.sigma, x.unit == "1" ? "" : x.unit,
-                     x.applied ? " (applied)" : "", x.note);
+                     x.significant ? " (significant)" : " (not flagged)", x.note);
   }
   return t;
 }
@@ -65,7 +65,7 @@ std::string Diagnosis::BriefReport() const {
   const Diagnosis& d = *this;
   std::string t = "Verdict: " + d.verdict + "\n" + heldout_line(d, -1);
   for (const auto& x : d.nuisances)
-    if (x.applied && x.estimated && (x.name != "bias_drift" || std::abs(x.value) > 3 * x.sigma))
+    if (x.significant)
       t += fmt::format("Nuisance {}: {:.4g} +- {:.2g} {}\n", x.name, x.value, x.sigma, x.unit == "1" ? "" : x.unit);
   return t + next_run_lines(d);
 }
