@@ -65,6 +65,19 @@ struct Table {
 // the same function of the same numbers, so the responses are bit for bit the same.
 class ResponseCache {
  public:
+  // The tables (tabulate) and what the static test takes up, per effect and value, for one
+  // identified plant and one set of runs' physics (their sigma is not an input): the
+  // diagnose() wrapper's second pass (the sigma scaled) asks for the same ones again. bind()
+  // forgets everything when the plant differs from the one bound (exactly).
+  void bind(const PlantConfig& plant) {
+    const bool same = bound_ && plant.coefficients.v == plant_.coefficients.v && key(plant.dynamics) == key(plant_.dynamics);
+    if (same) return;
+    plant_ = plant, bound_ = true;
+    tables_.clear(), absorbed_.clear(), cache_.clear();
+  }
+  std::map<std::string, std::shared_ptr<const Table>> tables_;
+  std::map<std::string, plant::Coefficients> absorbed_;
+
   const rectification::LoopResponse& get(const PlantConfig& cfg, const std::string& key, double f) {
     auto k = std::make_pair(key, f);
     auto it = cache_.find(k);
@@ -83,23 +96,45 @@ class ResponseCache {
  private:
   // Every field of plant::Dynamics (design_servo's only input).
   using DynamicsKey = std::tuple<double, double, double, double, double, bool, double, double>;
+  static DynamicsKey key(const plant::Dynamics& d) {
+    return {d.pendulum_frequency_Hz, d.pendulum_damping_ratio, d.angle_gain_rad_per_s2_per_g, d.loop_bandwidth_Hz,
+            d.phase_margin_deg,      d.integrator,             d.integrator_zero_ratio,       d.antialias_Hz};
+  }
   const plant::Servo& servo(const plant::Dynamics& d) {
-    const DynamicsKey k{d.pendulum_frequency_Hz, d.pendulum_damping_ratio, d.angle_gain_rad_per_s2_per_g, d.loop_bandwidth_Hz,
-                        d.phase_margin_deg,      d.integrator,             d.integrator_zero_ratio,       d.antialias_Hz};
+    const DynamicsKey k = key(d);
     auto it = servos_.find(k);
     if (it == servos_.end()) it = servos_.emplace(k, plant::design_servo(d)).first;
     return it->second;
   }
   std::map<std::pair<std::string, double>, rectification::LoopResponse> cache_;
   std::map<DynamicsKey, plant::Servo> servos_;
+  PlantConfig plant_;
+  bool bound_ = false;
 };
 
 // What the static test took up of an effect that acts at rest, per unit of (p - nominal)
 // (taken_up_by_static_test): subtracted from the identified coefficients under the effect.
 using Absorbed = std::map<std::string, Coefficients>;
 
+Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e, double p,
+                    ResponseCache& cache, const Absorbed& absorbed);
+
+// The table of every run under (e, p), computed once per plant the cache is bound to.
 Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e, double p,
                ResponseCache& cache, const Absorbed& absorbed) {
+  cache.bind(nominal);
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "=%.17g", p);
+  const std::string key = e ? e->name + buf : std::string("(nominal)");
+  const auto it = cache.tables_.find(key);
+  if (it != cache.tables_.end() && it->second->pred.size() == static_cast<Eigen::Index>(runs.size())) return *it->second;
+  auto t = std::make_shared<const Table>(tabulate_runs(nominal, runs, e, p, cache, absorbed));
+  cache.tables_[key] = t;
+  return *t;
+}
+
+Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e, double p,
+                    ResponseCache& cache, const Absorbed& absorbed) {
   const int n = static_cast<int>(runs.size());
   Table t{Eigen::VectorXd(n), Eigen::MatrixXd(n, plant::kNumCoefficients)};
   for (int k = 0; k < n; ++k) {
@@ -364,25 +399,37 @@ vibration::SineVibration RunRecord::vibration() const {
   return v;
 }
 
-Coefficients taken_up_by_static_test(const Effect& e, const PlantConfig& plant, const std::vector<Position>& positions,
-                                     const std::vector<double>& weights, const FixedSet& fixed) {
+namespace {
+// The fit to the plant's own settled readings (the "without" of taken_up_by_static_test; the
+// same for every effect: diagnose computes it once).
+Coefficients settled_fit(const PlantConfig& plant, const std::vector<Position>& positions, const std::vector<double>& weights,
+                         const FixedSet& fixed) {
+  std::vector<Reading> readings;
+  const double K1 = plant.coefficients[plant::K1];
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    readings.push_back({static_cast<int>(i), K1 * plant::settled_output_g(plant, positions[i].nominal_g)});
+  return least_squares(positions, readings, weights, fixed).estimate.value;
+}
+
+Coefficients taken_up_given_base(const Effect& e, const PlantConfig& plant, const std::vector<Position>& positions,
+                                 const std::vector<double>& weights, const FixedSet& fixed, const Coefficients& b) {
   if (!e.fitted().linear) throw std::logic_error("diagnose: " + e.name + " acts at rest but is not linear");
   PlantConfig with = plant;
   TableMotion unused;
   e.apply(e.fitted().unit_value, with, unused);
   // Least squares is linear in the readings: the difference of the fits to the plant's
   // settled readings with and without the effect.
-  std::vector<Reading> base, moved;
-  const double K1 = plant.coefficients[plant::K1];
-  for (std::size_t i = 0; i < positions.size(); ++i) {
-    base.push_back({static_cast<int>(i), K1 * plant::settled_output_g(plant, positions[i].nominal_g)});
-    moved.push_back({static_cast<int>(i), K1 * plant::settled_output_g(with, positions[i].nominal_g)});
-  }
-  const Coefficients b = least_squares(positions, base, weights, fixed).estimate.value;
-  const Coefficients m = least_squares(positions, moved, weights, fixed).estimate.value;
+  const Coefficients m = settled_fit(with, positions, weights, fixed);
   Coefficients diff;
   for (int i = 0; i < plant::kNumCoefficients; ++i) diff[i] = (m[i] - b[i]) / (e.fitted().unit_value - e.fitted().nominal);
   return diff;
+}
+}  // namespace
+
+Coefficients taken_up_by_static_test(const Effect& e, const PlantConfig& plant, const std::vector<Position>& positions,
+                                     const std::vector<double>& weights, const FixedSet& fixed) {
+  if (!e.fitted().linear) throw std::logic_error("diagnose: " + e.name + " acts at rest but is not linear");
+  return taken_up_given_base(e, plant, positions, weights, fixed, settled_fit(plant, positions, weights, fixed));
 }
 
 double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effect* e, double p) {
@@ -414,7 +461,9 @@ double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effec
 }
 
 namespace {
-Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s);
+// cache: the tables and what the static test takes up, shared by the wrapper's passes over the
+// same campaign (the runs' sigma may differ between them, nothing else).
+Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCache& cache);
 }  // namespace
 
 const Nuisance* Diagnosis::nuisance(const std::string& name) const {
@@ -531,7 +580,8 @@ std::pair<double, int> repeat_scatter(const Campaign& c) {
 Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s) {
   Campaign c = c0;
   const Nuisance drift = remove_drift(c);
-  Diagnosis d = diagnose_once(c, s);
+  ResponseCache cache;
+  Diagnosis d = diagnose_once(c, s, cache);
   // The stated sigma: from repeated runs when there are enough (their scatter is the
   // measurement's alone), else from the gaps no effect explains (the nominal's adjusted gaps
   // when unexplained, the chosen effect's held-out ones when explained).
@@ -588,7 +638,7 @@ Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s) {
   if (excess && scatter) {
     Campaign scaled = c;
     for (RunRecord& r : scaled.runs) r.sigma_g *= scale.value;
-    Diagnosis ds = diagnose_once(scaled, s);
+    Diagnosis ds = diagnose_once(scaled, s, cache);
     const double level = s.significance_sigma * s.significance_sigma;
     if (!from_repeats && !ds.effects.empty() && ds.effects.front().evidence > level) {
       char buf[240];
@@ -619,7 +669,7 @@ Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s) {
 
 namespace {
 
-Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s) {
+Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCache& cache) {
   if (c.statics.empty()) throw std::invalid_argument("diagnose: the campaign has no static readings");
   if (c.runs.empty()) throw std::invalid_argument("diagnose: the campaign has no usable shaker runs");
   Diagnosis d;
@@ -664,12 +714,22 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s) {
   // What the static test takes up of each effect that acts at rest: the identification of the
   // change the effect (at its unit value) makes to the readings, at the campaign's own
   // positions and weights (least squares is linear in the readings: the difference of two fits).
+  // (The plant's own fit is the same for every effect; all of it is kept in the cache for the
+  // wrapper's second pass, whose static test is the same.)
   Absorbed absorbed;
-  for (const Effect& e : effect_library())
-    if (e.acts_at_rest) absorbed[e.name] = taken_up_by_static_test(e, plant, positions, weights, c.fixed);
+  cache.bind(plant);
+  std::optional<Coefficients> base_fit;
+  for (const Effect& e : effect_library()) {
+    if (!e.acts_at_rest) continue;
+    auto it = cache.absorbed_.find(e.name);
+    if (it == cache.absorbed_.end()) {
+      if (!base_fit) base_fit = settled_fit(plant, positions, weights, c.fixed);
+      it = cache.absorbed_.emplace(e.name, taken_up_given_base(e, plant, positions, weights, c.fixed, *base_fit)).first;
+    }
+    absorbed[e.name] = it->second;
+  }
 
   // 2. The nominal simulation: gap, significance, where.
-  ResponseCache cache;
   const Table nominal = tabulate(plant, c.runs, nullptr, 0, cache, absorbed);
   for (int k = 0; k < n; ++k) data.sigma2(k) += std::pow(s.model_accuracy * nominal.pred(k), 2);
   std::vector<int> all(static_cast<std::size_t>(n));
