@@ -179,9 +179,9 @@ void score_family(const BlindCampaign& k, BlindResult& r) {
   } else if (d.gap_significant) {
     ++f.unexplained;
   } else {
-    ++f.no_gap;
+    ++f.no_gap;  // (a clean campaign here: no gap, but a nuisance flagged)
   }
-  r.wrong.push_back(why);
+  r.wrong.push_back(k.category == "clean" && !d.gap_significant ? why + " (a nuisance flagged on a clean campaign)" : why);
 }
 
 // Scores one campaign against its key into r (counts, confusion, the wrong ones).
