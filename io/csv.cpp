@@ -265,7 +265,7 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
     }
     // The reader's own check (read_series_hdf5 makes the same): time strictly increasing.
     if (!(value[0] > last_t))
-      throw InputError(fmt::format("{}: time does not increase ({} s after {:.17g} s)", where, f[tcol], last_t));
+      throw InputError(fmt::format("{}: time does not increase ({} s after {} s)", where, f[tcol], last_t));
     last_t = value[0];
     try {
       sample(value[0], value[1]);

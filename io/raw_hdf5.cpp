@@ -245,13 +245,13 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
           throw InputError(fmt::format("{}: dataset {}[{}]: a sample is not a finite number ({})", path, ch[k].name, at,
                                        ch[k].block[j]));
       if (!(t > last_t))
-        throw InputError(fmt::format("{}: dataset time_s[{}]: time does not increase ({:.17g} s after {:.17g} s)", path, at, t,
+        throw InputError(fmt::format("{}: dataset time_s[{}]: time does not increase ({} s after {} s)", path, at, t,
                                      last_t));
       last_t = t;
       try {
         sample(t, u);
       } catch (const std::invalid_argument& e) {
-        throw InputError(fmt::format("{}: dataset {}[{}]: {} (t = {:.17g}, {} = {:.17g})", path, out_name, at, e.what(), t,
+        throw InputError(fmt::format("{}: dataset {}[{}]: {} (t = {}, {} = {})", path, out_name, at, e.what(), t,
                                      out_name, u));
       }
       if (any_ref) {
