@@ -307,13 +307,24 @@ Hdf5SeriesWriter::Hdf5SeriesWriter(const std::string& path, const std::string& o
   if (ec) throw InputError("cannot create the folder of " + path + ": " + ec.message());
   s_->file = Id(H5Fcreate(s_->tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
   if (!s_->file.ok()) throw InputError(with_reason("cannot write " + s_->tmp));
+  try {
+    create_datasets(output_unit, run_id, comment);
+  } catch (...) {
+    s_->ch.clear();
+    s_->file.reset();
+    fs::remove(s_->tmp, ec);
+    throw;
+  }
+}
+
+void Hdf5SeriesWriter::create_datasets(const std::string& output_unit, const std::string& run_id, const std::string& comment) {
   write_string_attribute(s_->file.get(), "format", "vrelab raw record (docs/data-format.md)", s_->tmp);
   if (!run_id.empty()) write_string_attribute(s_->file.get(), "run_id", run_id, s_->tmp);
   if (!comment.empty()) write_string_attribute(s_->file.get(), "comment", comment, s_->tmp);
   std::vector<std::pair<std::string, std::string>> channels{{"time_s", "s"}, {"output_" + output_unit, output_unit}};
   static const std::array<const char*, 3> axes{"IA", "PA", "OA"};
   for (std::size_t i = 0; i < 3; ++i)
-    if (reference[i]) channels.emplace_back(std::string("ref_") + axes[i] + "_g", "g");
+    if (s_->reference[i]) channels.emplace_back(std::string("ref_") + axes[i] + "_g", "g");
   const hsize_t zero = 0, unlimited = H5S_UNLIMITED, chunk = kHdf5BlockSamples;
   for (const auto& [name, unit] : channels) {
     Id space(H5Screate_simple(1, &zero, &unlimited), H5Sclose);

@@ -49,6 +49,7 @@ class Hdf5SeriesWriter {
   struct State;
   std::unique_ptr<State> s_;
   void flush();
+  void create_datasets(const std::string& output_unit, const std::string& run_id, const std::string& comment);
 };
 
 }  // namespace vrelab::io
