@@ -9,7 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")"
 
 packages=(build-essential cmake git pkg-config
-          libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libfftw3-dev libsundials-dev
+          libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libfftw3-dev libsundials-dev libhdf5-dev
           libgtest-dev libbenchmark-dev python3-matplotlib
           python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest
           libopenmpi-dev openmpi-bin

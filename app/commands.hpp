@@ -86,6 +86,7 @@ struct CampaignOptions {
   std::optional<std::uint64_t> seed;
   bool progress = true;
   bool work_limit = true;
+  std::string raw_format = "csv";  // --raw-format: the raw records' files, csv or hdf5
 };
 void run_campaign(const CampaignOptions& o, std::ostream& out);
 

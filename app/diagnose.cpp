@@ -29,7 +29,8 @@ std::string program() { return fmt::format("vrelab {} ({}) ", kProgramVersion, k
 
 void run_campaign(const CampaignOptions& o, std::ostream& out) {
   if (o.work_limit) check_campaign_work(io::read_case(o.case_path));
-  const io::CampaignWritten w = io::write_virtual_campaign({o.case_path, o.out_dir, o.key_path, o.seed, o.progress});
+  const io::CampaignWritten w = io::write_virtual_campaign(
+      {o.case_path, o.out_dir, o.key_path, o.seed, o.progress, o.raw_format == "hdf5" ? io::RawFormat::hdf5 : io::RawFormat::csv});
   out << program() << w.FullReport();
 }
 

@@ -96,8 +96,10 @@ Command add_shake(CLI::App& app) {
 Command add_measure(CLI::App& app) {
   auto owned = std::make_shared<MeasureOptions>();
   MeasureOptions& o = *owned;
-  CLI::App* cmd = app.add_subcommand("measure", "Vibration error from a recorded output series (CSV)");
-  cmd->add_option("series", o.series_path, "CSV: time_s first, then output column(s); '#' lines are comments")
+  CLI::App* cmd = app.add_subcommand("measure", "Vibration error from a recorded output series (CSV or HDF5)");
+  cmd->add_option("series", o.series_path,
+                  "CSV (time_s, else the first column, then output column(s); '#' lines are comments) or, named "
+                  "*.h5 / *.hdf5, HDF5 (datasets time_s and output_<unit>; docs/data-format.md)")
       ->required();
   cmd->add_option("--on", o.on_s, "Vibration interval FROM,TO in s")->delimiter(',')->expected(2)->required();
   cmd->add_option("--baseline", o.baseline_s, "Baseline (at rest) interval FROM,TO in s")
@@ -106,7 +108,7 @@ Command add_measure(CLI::App& app) {
       ->required();
   cmd->add_option("--frequency", o.frequency_Hz, "Sine frequency in Hz: measure over whole periods");
   cmd->add_option("--K1", o.K1, "Scale factor, output units per g (default 1: output in g)");
-  cmd->add_option("--column", o.column, "Output column name (default: the last column)");
+  cmd->add_option("--column", o.column, "Output column name (default: the one output_* column or dataset, else the last column)");
   cmd->add_option("--blocks", o.blocks, "Blocks for the batch-means uncertainty (default 4)");
   cmd->add_option("--input-rms-g", o.input_rms_g,
                   "The input's rms in g (magnitude over the axes): the VRC, error / rms^2 in ug/g^2, is reported too");
@@ -184,6 +186,11 @@ Command add_campaign(CLI::App& app) {
   cmd->add_option("--out", o.out_dir, "Campaign folder (docs/data-format.md)")->required();
   cmd->add_option("--key", o.key_path, "Answer key (JSON; default <out>.key.json); diagnose never reads it");
   cmd->add_option("--seed", o.seed, "Seed (default: the case's [run] seed)");
+  cmd->add_option("--raw-format", o.raw_format,
+                  "Raw records (a case with [campaign] raw_series = true) as records/<id>.csv or records/<id>.h5 "
+                  "(HDF5, docs/data-format.md)")
+      ->check(CLI::IsMember({"csv", "hdf5"}))
+      ->capture_default_str();
   cmd->add_flag_callback("--no-progress", [&o] { o.progress = false; }, "No progress bar");
   cmd->add_flag_callback(
       "--no-work-limit", [&o] { o.work_limit = false; },

@@ -172,13 +172,24 @@ int series_column(const std::vector<std::string>& header, const std::string& nam
   if (header.size() < 2) throw InputError(where + ": the header needs a time column and an output column");
   int column = -1;
   if (name.empty()) {
+    // The one output_<unit> column (as the HDF5 reader's one output_<unit> dataset), else the last.
     column = static_cast<int>(header.size()) - 1;
+    if (std::count_if(header.begin(), header.end(), [](const std::string& h) { return h.rfind("output_", 0) == 0; }) == 1)
+      column = static_cast<int>(std::find_if(header.begin(), header.end(),
+                                             [](const std::string& h) { return h.rfind("output_", 0) == 0; }) -
+                                header.begin());
   } else {
     for (std::size_t i = 0; i < header.size(); ++i)
       if (header[i] == name) column = static_cast<int>(i);
-    if (column < 1) throw InputError(fmt::format("{}: no column named '{}'", where, name));
+    if (column < 0) {
+      std::string found;
+      for (const auto& h : header) found += (found.empty() ? "" : ", ") + h;
+      throw InputError(fmt::format("{}: no column named '{}' (the header has: {})", where, name, found));
+    }
   }
-  if (column == 0) throw InputError(where + ": the output column cannot be the time column");
+  // The time column: time_s, else the first.
+  if (column == 0 && std::find(header.begin(), header.end(), "time_s") == header.end())
+    throw InputError(where + ": the output column cannot be the time column");
   // A header names the columns: a first line of numbers means the header is missing.
   if (std::all_of(header.begin(), header.end(), is_number))
     throw InputError(where + ": expected a header line naming the columns (e.g. time_s,output), got numbers");
@@ -205,9 +216,11 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
   long line_no = 0;
   std::size_t column = 0;
   std::vector<std::string> header;
+  std::size_t tcol = 0;  // the column time_s, else the first
   std::array<std::size_t, 3> ref_col{};
   std::array<bool, 3> ref_present{};
   bool any_ref = false;
+  double last_t = -INFINITY;
   while (std::getline(in, line)) {
     ++line_no;
     check_text_line(line, line_no, path);
@@ -224,6 +237,9 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
       header = f;
       column = static_cast<std::size_t>(series_column(header, column_name, where));
       name = header[column];
+      if (const auto it = std::find(header.begin(), header.end(), "time_s"); it != header.end())
+        tcol = static_cast<std::size_t>(it - header.begin());
+      if (tcol == column) throw InputError(where + ": the output column cannot be the time column");
       static const std::array<const char*, 3> axes{"IA", "PA", "OA"};
       for (std::size_t i = 0; i < 3 && reference; ++i)
         for (const std::string prefix : {"ref_", "input_"}) {
@@ -237,29 +253,36 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
       throw InputError(fmt::format("{}: {} fields, the header has {}", where, f.size(), header.size()));
     double value[2] = {0, 0};
     for (int k = 0; k < 2; ++k) {
-      const std::size_t col = k == 0 ? 0 : column;
+      const std::size_t col = k == 0 ? tcol : column;
       const auto x = parse_decimal(f[col]);
       if (!x) {
         const std::string why = why_not_decimal(f[col]);
         if (why == "not finite")
-          throw InputError(fmt::format("{}: sample is not a finite number (column {}, '{}')", where, col + 1, f[col]));
+          throw InputError(fmt::format("{}: a sample is not a finite number (column {}, '{}')", where, col + 1, f[col]));
         throw InputError(fmt::format("{}: not a number in '{}' (column {}, '{}': {})", where, line, col + 1, f[col], why));
       }
       value[k] = *x;
     }
+    // The reader's own check (read_series_hdf5 makes the same): time strictly increasing.
+    if (!(value[0] > last_t))
+      throw InputError(fmt::format("{}: time does not increase ({} s after {} s)", where, f[tcol], last_t));
+    last_t = value[0];
     try {
       sample(value[0], value[1]);
     } catch (const std::invalid_argument& e) {
-      throw InputError(fmt::format("{}: {} (t = {}, {} = {})", where, e.what(), f[0], name, f[column]));
+      throw InputError(fmt::format("{}: {} (t = {}, {} = {})", where, e.what(), f[tcol], name, f[column]));
     }
     if (any_ref) {
       std::array<double, 3> ref{};
       for (std::size_t i = 0; i < 3; ++i) {
         if (!ref_present[i]) continue;
         const auto x = parse_decimal(f[ref_col[i]]);
-        if (!x)
-          throw InputError(fmt::format("{}: reference column {} ('{}'): {}", where, header[ref_col[i]], f[ref_col[i]],
-                                       why_not_decimal(f[ref_col[i]])));
+        if (!x) {
+          const std::string why = why_not_decimal(f[ref_col[i]]);
+          if (why == "not finite")
+            throw InputError(fmt::format("{}: a sample is not a finite number (column {}, '{}')", where, ref_col[i] + 1, f[ref_col[i]]));
+          throw InputError(fmt::format("{}: reference column {} ('{}'): {}", where, header[ref_col[i]], f[ref_col[i]], why));
+        }
         ref[i] = *x;
       }
       reference(value[0], ref, ref_present);

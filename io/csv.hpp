@@ -46,11 +46,12 @@ void check_separator(const std::string& header_line, long line_no, const std::st
 // distance at most 3), or "" when none is close.
 std::string closest_name(const std::string& name, const std::vector<std::string>& names);
 
-// A recorded output series: a header naming the columns, time (s) in the first column.
-// Streams (t, value of `column`) to `sample` row by row (`column` empty: the last column) and
-// returns the column's name. Anything wrong (no file, no header, a field count, not a
-// number, `sample` rejecting a row with std::invalid_argument) is InputError naming the
-// file and the line.
+// A recorded output series: a header naming the columns, time (s) in the column time_s, else
+// the first column. Streams (t, value of `column`) to `sample` row by row (`column` empty:
+// the one column named output_<unit>, else the last column) and returns the column's name. Anything wrong (no file, no header, a
+// field count, not a number, time not strictly increasing, `sample` rejecting a row with
+// std::invalid_argument) is InputError naming the file and the line. read_series
+// (io/series.hpp) chooses this reader or the HDF5 one by the file's extension.
 std::string read_series_csv(const std::string& path, const std::string& column,
                             const std::function<void(double t_s, double value)>& sample);
 // Reference-accelerometer channels (the table's measured motion, g, sensor axes): columns

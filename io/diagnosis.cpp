@@ -28,6 +28,9 @@ CampaignWritten write_virtual_campaign(const CampaignRequest& request) {
   if (c.physical) throw InputError(c.path + ": campaign takes a plant built from coefficients");
   if (request.seed) c.seed = *request.seed;
   const CampaignSpec& spec = *c.campaign;
+  if (request.raw_format == RawFormat::hdf5 && !(spec.design.raw_sample_rate_Hz > 0))
+    throw InputError(c.path + ": campaign --raw-format hdf5: the case writes summaries, not raw records (set [campaign] "
+                              "raw_series = true)");
   CampaignWritten w;
   w.request = request;
   w.request.seed = c.seed;
@@ -42,7 +45,7 @@ CampaignWritten write_virtual_campaign(const CampaignRequest& request) {
   camp.name = spec.name;
   LabManifest m;
   m.name = spec.name, m.output_unit = c.output_unit, m.g_m_per_s2 = c.g_m_per_s2;
-  write_campaign(request.out_dir, camp, m);  // with the raw records, when simulated
+  write_campaign(request.out_dir, camp, m, {}, request.raw_format);  // with the raw records, when simulated
   nlohmann::json key = result_record("campaign", c);
   key["hidden"] = nlohmann::json::array();
   for (const auto& h : spec.hidden) key["hidden"].push_back({{"name", h.name}, {"parameter", h.parameter}});
@@ -62,7 +65,7 @@ std::string CampaignWritten::FullReport() const {
   return BriefReport() +
          fmt::format("Wrote {} static readings and {} shaker runs ({}) to {} (lab data format, docs/data-format.md); the "
                      "answer key to {} ({:.1f} s wall)\n",
-                     statics, runs, raw_records ? "raw records in records/" : "summaries", request.out_dir,
+                     statics, runs, raw_records ? (request.raw_format == RawFormat::hdf5 ? "raw records in records/ (HDF5)" : "raw records in records/") : "summaries", request.out_dir,
                      request.key_path, wall_s);
 }
 

@@ -24,12 +24,13 @@ struct CampaignRequest {
   std::string key_path;               // the answer key; "": <out_dir>.key.json
   std::optional<std::uint64_t> seed;  // default: the case's [run] seed
   bool progress = false;              // draw core::Progress on stderr
+  RawFormat raw_format = RawFormat::csv;  // raw records (the case's [campaign] raw_sample_rate_Hz) as CSV or HDF5
 };
 
 struct CampaignWritten {
   CampaignRequest request;  // key_path and seed filled in
   std::size_t statics = 0, runs = 0;
-  bool raw_records = false;  // runs written as raw records (records/<id>.csv)
+  bool raw_records = false;  // runs written as raw records (records/<id>.csv or .h5)
   double wall_s = 0;         // simulation and writing
   std::string BriefReport() const;
   std::string FullReport() const;

@@ -16,6 +16,8 @@
 #include "io/case_file.hpp"
 #include "io/csv.hpp"
 #include "io/output.hpp"
+#include "io/raw_hdf5.hpp"
+#include "io/series.hpp"
 #include "rectification/measurement/series.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/identification/dividing_head.hpp"
@@ -484,54 +486,23 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       const std::string spath = (fs::path(dir) / file).string();
       try {
         win.validate();
-        std::ifstream in(spath);
-        if (!in) throw std::invalid_argument(spath + ": cannot open (no such file)");
         rectification::SeriesMeasurer meas(win);
-        std::string line;
-        int ln = 0;
-        std::size_t tcol = 0, ucol = 1, columns = 0;
-        bool header = false;
+        // The record, CSV or HDF5 by its extension (io/series.hpp): time_s and output_<unit>.
         double last_t = -INFINITY, first_dt = 0;
-        while (std::getline(in, line)) {
-          ++ln;
-          check_text_line(line, ln, spath);
-          if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
-          const auto cells = split(line, spath + ":" + std::to_string(ln));
-          if (!header) {
-            header = true;
-            check_separator(line, ln, spath);
-            columns = cells.size();
-            bool found_t = false, found_u = false;
-            for (std::size_t i = 0; i < cells.size(); ++i) {
-              if (cells[i] == "time_s") tcol = i, found_t = true;
-              if (cells[i] == "output_" + m.output_unit) ucol = i, found_u = true;
-            }
-            if (!found_t || !found_u)
-              throw std::invalid_argument(fmt::format("{}:{}: the header needs time_s and output_{}", spath, ln, m.output_unit));
-            continue;
-          }
-          if (tcol >= cells.size() || ucol >= cells.size())
-            throw std::invalid_argument(fmt::format("{}:{}: too few columns", spath, ln));
-          if (cells.size() > columns)
-            throw std::invalid_argument(fmt::format("{}:{}:{}: {} cells, the header has {}", spath, ln, columns + 1, cells.size(), columns));
-          const auto tx = parse_decimal(cells[tcol]), ux = parse_decimal(cells[ucol]);
-          if (!tx || !ux) {
-            const std::size_t col = tx ? ucol : tcol;
-            throw std::invalid_argument(fmt::format("{}:{}: a sample is not a finite number (column {}, '{}': {})", spath, ln,
-                                                    col + 1, cells[col], why_not_decimal(cells[col])));
-          }
-          const double t = *tx, u = *ux;
-          if (!(t > last_t)) throw std::invalid_argument(fmt::format("{}:{}: time does not increase", spath, ln));
+        read_series(spath, "output_" + m.output_unit, [&](double t, double u) {
           if (std::isfinite(last_t) && first_dt == 0) first_dt = t - last_t;  // as SeriesMeasurer detects it
           last_t = t;
           meas.add(t, u);
-        }
+        });
         // Half-open windows, decided as `measure` does (rectification/measurement/series.hpp).
         if (!rectification::record_covers_window_end(rectification::used_on_to_s(win), last_t, first_dt))
           throw std::invalid_argument(fmt::format("{}: the record ends at {:g} s, before on_to_s = {:g} s", spath, last_t, *ot));
         const rectification::SeriesResult res = meas.finish();
         r.measured_g = res.measured_g, r.sigma_g = res.sigma_g;
       } catch (const std::invalid_argument& e) {
+        c.skipped.push_back(label + ": " + e.what());
+        continue;
+      } catch (const InputError& e) {
         c.skipped.push_back(label + ": " + e.what());
         continue;
       }
@@ -563,13 +534,19 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
 }
 
 void write_campaign(const std::string& dir, const validation::Campaign& c, const LabManifest& m,
-                    const std::vector<RawSeriesRef>& raw_series) {
+                    const std::vector<RawSeriesRef>& raw_series, RawFormat raw_format) {
   std::vector<RawSeriesRef> raw = raw_series;
   if (raw.empty())
     for (std::size_t k = 0; k < c.raw.size(); ++k) {
       const validation::RawRecord& rec = c.raw[k];
-      const std::string file = "records/" + c.runs[k].id + ".csv";
-      write_atomic(dir + "/" + file, raw_record_csv(c.runs[k].id, rec, m.output_unit));
+      const std::string file = "records/" + c.runs[k].id + (raw_format == RawFormat::hdf5 ? ".h5" : ".csv");
+      if (raw_format == RawFormat::hdf5) {
+        Hdf5SeriesWriter w(dir + "/" + file, m.output_unit, {}, c.runs[k].id, "at rest for t < 0");
+        for (std::size_t i = 0; i < rec.t_s.size(); ++i) w.add(rec.t_s[i], rec.output[i]);
+        w.commit();
+      } else {
+        write_atomic(dir + "/" + file, raw_record_csv(c.runs[k].id, rec, m.output_unit));
+      }
       raw.push_back({file, rec.rest_from_s, rec.rest_to_s, rec.on_from_s, rec.on_to_s});
     }
   const plant::Dynamics& d = c.dynamics;

@@ -40,12 +40,15 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
 // Writes manifest.toml, static.csv and runs.csv (summaries). `raw_series`, when non-empty,
 // gives per run a recorded series already written under DIR (file name, rest and on
 // windows) to reference instead of the summary; else, when the campaign holds raw records
-// (Campaign::raw), they are written as DIR/records/<run id>.csv and referenced.
+// (Campaign::raw), they are written as DIR/records/<run id>.csv (RawFormat::csv) or
+// DIR/records/<run id>.h5 (RawFormat::hdf5, docs/data-format.md "Raw records in HDF5"),
+// each atomically, and referenced.
+enum class RawFormat { csv, hdf5 };
 struct RawSeriesRef {
   std::string file;
   double rest_from_s = 0, rest_to_s = 0, on_from_s = 0, on_to_s = 0;
 };
 void write_campaign(const std::string& dir, const validation::Campaign& c, const LabManifest& m,
-                    const std::vector<RawSeriesRef>& raw_series = {});
+                    const std::vector<RawSeriesRef>& raw_series = {}, RawFormat raw_format = RawFormat::csv);
 
 }  // namespace vrelab::io

@@ -23,6 +23,7 @@
 #include "io/csv.hpp"
 #include "io/output.hpp"
 #include "io/results_json.hpp"
+#include "io/series.hpp"
 #include "rectification/measurement/vrc.hpp"
 #include "rectification/prediction/random.hpp"
 #include "rectification/simulation/sweep.hpp"
@@ -446,7 +447,7 @@ MeasureStudy measure(const std::string& series_path, const std::string& column, 
     ++n_ref;
     for (int i = 0; i < 3; ++i) sum[i] += g[static_cast<std::size_t>(i)], sum2[i] += g[static_cast<std::size_t>(i)] * g[static_cast<std::size_t>(i)];
   };
-  s.column = read_series_csv(series_path, column, [&m](double t, double u) { m.add(t, u); }, ref);
+  s.column = read_series(series_path, column, [&m](double t, double u) { m.add(t, u); }, ref);
   if (n_ref > 1) {
     const double n = static_cast<double>(n_ref);
     for (int i = 0; i < 3; ++i) s.reference_rms_g[i] = std::sqrt(std::max(0.0, sum2[i] / n - (sum[i] / n) * (sum[i] / n)));

@@ -222,7 +222,7 @@ TEST(CliMeasure, ReproducesShakeFromItsOwnRecordAndRejectsBadSeries) {
   };
   std::string short_record;  // 0 .. 1.5 s: ends inside the vibration interval [1, 2)
   for (int k = 0; k < 300; ++k) short_record += std::to_string(k * 0.005) + ",1.0\n";
-  rejects("0.0,1.0\n0.1,nan\n", R"(bad\.csv:3: sample is not a finite number)");
+  rejects("0.0,1.0\n0.1,nan\n", R"(bad\.csv:3: a sample is not a finite number)");
   rejects("0.0,1.0\n0.2,1.0\n0.1,1.0\n", R"(bad\.csv:4: time does not increase)");
   rejects("0.0,1.0\n0.1,abc\n", R"(bad\.csv:3: not a number)");
   rejects(short_record, R"(too few samples.*shorter than the interval)");
