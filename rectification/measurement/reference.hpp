@@ -11,7 +11,9 @@
 //        the window's samples: W_h = 2 j mean(x e^{-j h w t}), the sine convention of
 //        vibration::SineVibration, a = Im(W e^{j h w t})) and the residual's rms; for a
 //        random run the one-sided PSD and cross-spectra by Welch (periodic Hann window, 50 %
-//        overlap, each segment's mean removed, density scaling as vibration::welch_psd).
+//        overlap, each segment's mean removed, density scaling as vibration::welch_psd,
+//        then each axis scaled so that its bins sum to the window's mean square: Welch for
+//        the spectrum's shape, the samples for its integral).
 //        Then how the motion departs from the command (MotionDeparture).
 // Memory is bounded: sums for a sine run, one segment per axis and the spectra's sums for a
 // random run (the segment at most 4096 samples), whatever the record's length.
