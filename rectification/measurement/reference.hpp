@@ -129,7 +129,8 @@ MotionDeparture sine_departure(const ReferenceAnalysis& a, const Vec3& commanded
 MotionDeparture random_departure(const ReferenceAnalysis& a, const Eigen::Matrix3d& commanded_covariance_g2);
 
 // The measured motion a prediction takes: per-axis tones (sine) or PSD tables from the Welch
-// bins in [from_Hz, to_Hz] (random; bins <= 0 raised to 1e-12 of the largest).
+// bins in [from_Hz, to_Hz] (random; welch_table: each bin a step over its width, so that the
+// table integrates to the bins' sum; bins <= 0 raised to 1e-12 of the largest).
 struct MeasuredMotion {
   std::array<bool, 3> present{};
   double frequency_Hz = 0;
