@@ -277,15 +277,19 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
       for (std::size_t i = 0; i < 3; ++i) {
         if (!ref_present[i]) continue;
         const auto x = parse_decimal(f[ref_col[i]]);
-        if (!x) {
-          const std::string why = why_not_decimal(f[ref_col[i]]);
-          if (why == "not finite")
-            throw InputError(fmt::format("{}: a sample is not a finite number (column {}, '{}')", where, ref_col[i] + 1, f[ref_col[i]]));
-          throw InputError(fmt::format("{}: reference column {} ('{}'): {}", where, header[ref_col[i]], f[ref_col[i]], why));
-        }
+        if (!x)
+          throw InputError(fmt::format("{}:{}: reference column {}: {} (a reference channel must have a sample on every row: "
+                                       "the same length and rate as the output)",
+                                       where, ref_col[i] + 1, header[ref_col[i]],
+                                       f[ref_col[i]].empty() ? std::string("missing value")
+                                                             : "'" + f[ref_col[i]] + "' is " + why_not_decimal(f[ref_col[i]])));
         ref[i] = *x;
       }
-      reference(value[0], ref, ref_present);
+      try {
+        reference(value[0], ref, ref_present);
+      } catch (const std::invalid_argument& e) {
+        throw InputError(fmt::format("{}: {}", where, e.what()));
+      }
     }
   }
   if (header.empty()) throw InputError(path + ": no header line and no samples");

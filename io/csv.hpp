@@ -57,7 +57,11 @@ std::string read_series_csv(const std::string& path, const std::string& column,
 // Reference-accelerometer channels (the table's measured motion, g, sensor axes): columns
 // ref_IA_g, ref_PA_g, ref_OA_g, or input_IA_g, input_PA_g, input_OA_g as `vrelab shake
 // --series` writes the virtual table's motion (ref_ preferred), any of the three; `present`
-// says which the header has. Called per row after `sample` when the header has any.
+// says which the header has. Called per row after `sample` when the header has any. A cell
+// that is missing or not a finite decimal, or the sink throwing std::invalid_argument (e.g.
+// rectification::ReferenceAnalyzer: another rate, another set of axes), is InputError naming
+// the file and the line ("f.csv:12:3: reference column ref_PA_g: 'nan' is not finite ...").
+// Another reader (HDF5) calls the sink the same way, once per output sample.
 using ReferenceSink = std::function<void(double t_s, const std::array<double, 3>& ref_g, const std::array<bool, 3>& present)>;
 // The same from a stream (`path` only names it in messages): the in-memory entry point.
 std::string read_series_csv(std::istream& in, const std::string& path, const std::string& column,

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "io/case_file.hpp"
+#include "io/diagnosis_json.hpp"
 #include "io/output.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "core/progress.hpp"
@@ -104,6 +105,7 @@ std::string header(const FolderDiagnosis& f) {
   t += fmt::format("{} static readings, {} shaker runs ({} skipped)\n", c.statics.size(), c.runs.size(), c.skipped.size());
   for (const auto& s : c.skipped) t += "  skipped: " + s + "\n";
   if (!f.manifest.dynamics_given) t += "Nominal dynamics: defaults (the manifest has no [dynamics])\n";
+  t += motion_summary_text(f.diagnosis, c);
   return t;
 }
 

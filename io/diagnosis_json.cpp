@@ -64,6 +64,10 @@ json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
                     {"z", x.z},
                     {"heldout_before_g", x.heldout_before_g},
                     {"heldout_after_g", x.heldout_after_g}});
+    if (r.motion) {
+      runs.back()["motion"] = to_json(r.motion->departure);
+      runs.back()["motion"]["used_by_prediction"] = !r.motion->tones.empty() || r.motion->random.has_value();
+    }
   }
   return runs;
 }
@@ -201,6 +205,101 @@ json to_json(const validation::Diagnosis& d, const validation::Campaign& c) {
           {"runs", runs_json(d, c)}};
 }
 
+json to_json(const rectification::MotionDeparture& m) {
+  json j = {{"kind", m.kind},
+            {"axes", m.axes},
+            {"sample_rate_Hz", m.sample_rate_Hz},
+            {"samples", m.samples},
+            {"commanded_rms_g", m.commanded_rms_g},
+            {"measured_rms_g", m.measured_rms_g},
+            {"measured_rms_axis_g", vec_json(m.measured_rms_axis_g)},
+            {"rms_ratio", finite_or_null(m.rms_ratio)},
+            {"transverse_ratio", finite_or_null(m.transverse_ratio)},
+            {"transverse_sigma", finite_or_null(m.transverse_sigma)},
+            {"transverse_axis_ratio",
+             {finite_or_null(m.transverse_axis_ratio[0]), finite_or_null(m.transverse_axis_ratio[1]),
+              finite_or_null(m.transverse_axis_ratio[2])}}};
+  if (m.kind == "sine") {
+    j["fundamental_ratio"] = finite_or_null(m.fundamental_ratio);
+    j["harmonic2_ratio"] = finite_or_null(m.harmonic2_ratio);
+    j["harmonic2_sigma"] = finite_or_null(m.harmonic2_sigma);
+    j["harmonic3_ratio"] = finite_or_null(m.harmonic3_ratio);
+    j["harmonic3_sigma"] = finite_or_null(m.harmonic3_sigma);
+  } else {
+    j["welch"] = {{"resolution_Hz", m.resolution_Hz}, {"segments", m.segments}, {"dof", m.dof}};
+  }
+  return j;
+}
+
+namespace {
+
+// The run with the largest finite value of `field`, or null.
+const validation::RunRecord* largest(const validation::Campaign& c, double rectification::MotionDeparture::*field) {
+  const validation::RunRecord* best = nullptr;
+  for (const auto& r : c.runs)
+    if (r.motion && std::isfinite(r.motion->departure.*field) &&
+        (!best || r.motion->departure.*field > best->motion->departure.*field))
+      best = &r;
+  return best;
+}
+
+}  // namespace
+
+json motion_summary_json(const validation::Diagnosis& d, const validation::Campaign& c) {
+  int sine = 0, sine_measured = 0;
+  double rmin = INFINITY, rmax = -INFINITY;
+  for (const auto& r : c.runs) {
+    if (!r.random) ++sine, sine_measured += r.motion ? 1 : 0;
+    if (r.motion && std::isfinite(r.motion->departure.rms_ratio))
+      rmin = std::min(rmin, r.motion->departure.rms_ratio), rmax = std::max(rmax, r.motion->departure.rms_ratio);
+  }
+  const auto peak = [&](double rectification::MotionDeparture::*field, double rectification::MotionDeparture::*sigma) {
+    const validation::RunRecord* r = largest(c, field);
+    if (!r) return json(nullptr);
+    return json{{"run", r->id}, {"value", r->motion->departure.*field}, {"sigma", finite_or_null(r->motion->departure.*sigma)}};
+  };
+  using MD = rectification::MotionDeparture;
+  return {{"runs_with_reference", d.runs_with_measured_motion},
+          {"sine_runs", sine},
+          {"sine_runs_with_reference", sine_measured},
+          {"rms_ratio_range", {finite_or_null(rmin), finite_or_null(rmax)}},
+          {"largest_transverse_ratio", peak(&MD::transverse_ratio, &MD::transverse_sigma)},
+          {"largest_harmonic2_ratio", peak(&MD::harmonic2_ratio, &MD::harmonic2_sigma)},
+          {"largest_harmonic3_ratio", peak(&MD::harmonic3_ratio, &MD::harmonic3_sigma)},
+          {"measured_not_fitted", d.measured_effects},
+          {"policy",
+           d.measured_effects.empty()
+               ? "some sine runs have no reference: the table-motion effects stay candidates, their hypotheses applied to "
+                 "the runs without one only"
+               : "every sine run's motion is measured: the table-motion effects are measured, not fitted"}};
+}
+
+std::string motion_summary_text(const validation::Diagnosis& d, const validation::Campaign& c) {
+  if (d.runs_with_measured_motion == 0) return "";
+  const json j = motion_summary_json(d, c);
+  std::string t = fmt::format("Reference channels: {} of {} runs measure the table's motion", d.runs_with_measured_motion,
+                              c.runs.size());
+  if (j["rms_ratio_range"][0].is_number())
+    t += fmt::format("; rms / commanded {:.4g} to {:.4g}", j["rms_ratio_range"][0].get<double>(),
+                     j["rms_ratio_range"][1].get<double>());
+  for (const auto& [key, what] : {std::pair<const char*, const char*>{"largest_transverse_ratio", "transverse"},
+                                  {"largest_harmonic2_ratio", "2nd harmonic"},
+                                  {"largest_harmonic3_ratio", "3rd harmonic"}})
+    if (!j[key].is_null())
+      t += fmt::format("; {} up to {:.4g}{} ({})", what, j[key]["value"].get<double>(),
+                       j[key]["sigma"].is_number() ? fmt::format(" +- {:.2g}", j[key]["sigma"].get<double>()) : std::string(),
+                       j[key]["run"].get<std::string>());
+  t += "\n";
+  if (!d.measured_effects.empty()) {
+    std::string names;
+    for (const auto& n : d.measured_effects) names += (names.empty() ? "" : ", ") + n;
+    t += "  measured, not fitted: " + names + "\n";
+  } else {
+    t += "  some sine runs have no reference: the table-motion effects are fitted on those runs only\n";
+  }
+  return t;
+}
+
 json to_json(const FolderDiagnosis& f) {
   const validation::Campaign& c = f.campaign;
   json j = {{"program", program_record()}, {"command", "diagnose"}, {"data", f.dir}, {"campaign", c.name}};
@@ -211,6 +310,7 @@ json to_json(const FolderDiagnosis& f) {
   j["settings"]["from"] = f.settings_from;
   j["wall_s"] = f.wall_s;
   j.update(to_json(f.diagnosis, c));
+  if (f.diagnosis.runs_with_measured_motion > 0) j["motion"] = motion_summary_json(f.diagnosis, c);
   j["units"] = {{"gap", "g"}, {"parameter", "see each effect's unit"}};
   return j;
 }

@@ -22,6 +22,12 @@ nlohmann::json to_json(const plant::Dynamics& d);
 // The diagnosis of campaign c (same runs, same order): gap, effects, pairs, shrinkage, runs.
 nlohmann::json to_json(const validation::Diagnosis& d, const validation::Campaign& c);
 nlohmann::json to_json(const FolderDiagnosis& f);
+// Reference channels (docs/data-format.md): how a run's measured motion departs from the
+// command (`motion` of a run), the campaign's summary (`motion` at the top; only when some
+// run has reference channels), and its line in the text report ("" when no run has them).
+nlohmann::json to_json(const rectification::MotionDeparture& m);
+nlohmann::json motion_summary_json(const validation::Diagnosis& d, const validation::Campaign& c);
+std::string motion_summary_text(const validation::Diagnosis& d, const validation::Campaign& c);
 nlohmann::json to_json(const validation::BlindResult& r);
 std::string confusion_csv(const validation::BlindResult& r);
 // `blind --out`'s report.html: the per-family table, the confusion matrix, every miss with why.

@@ -58,6 +58,7 @@ void write_diagnosis_report(const FolderDiagnosis& f, const std::string& dir) {
   rep.paragraph(fmt::format("vrelab {} ({}). {} static readings, {} shaker runs, {} skipped.", kProgramVersion, kGitDescribe,
                             c.statics.size(), c.runs.size(), c.skipped.size()));
   if (!c.skipped.empty()) rep.list(c.skipped);
+  if (const std::string motion = motion_summary_text(f.diagnosis, c); !motion.empty()) rep.paragraph(motion);
   rep.heading("1. Where the gap lies");
   rep.paragraph(f.diagnosis.where + ".");
   rep.heading("2. Which effect");

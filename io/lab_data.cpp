@@ -18,6 +18,7 @@
 #include "io/output.hpp"
 #include "io/raw_hdf5.hpp"
 #include "io/series.hpp"
+#include "rectification/measurement/reference.hpp"
 #include "rectification/measurement/series.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/identification/dividing_head.hpp"
@@ -231,6 +232,53 @@ std::string raw_record_csv(const std::string& id, const validation::RawRecord& r
       fmt::format("# {} raw record: time in s, output in {}; at rest for t < 0\ntime_s,output_{}\n", id, unit, unit);
   for (std::size_t i = 0; i < rec.t_s.size(); ++i) text += fmt::format("{:.9g},{:.12g}\n", rec.t_s[i], rec.output[i]);
   return text;
+}
+
+// A run's measured motion from its reference channels (docs/data-format.md, "Reference
+// channels"): a sine run's tones (axes without a channel: the commanded), a random run's
+// Welch PSD over the commanded band (axes without a channel: the commanded table); a sine
+// on random run's is reported (its sine's tones) but not used by the prediction.
+rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, const rectification::ReferenceAnalysis& a) {
+  rectification::MeasuredMotion mm;
+  mm.present = a.present;
+  mm.frequency_Hz = a.frequency_Hz;
+  if (!r.random || r.sine_part) {
+    const vibration::SineVibration cmd = r.vibration();
+    Vec3 signed_g;
+    for (int i = 0; i < 3; ++i) signed_g[i] = cmd.amplitude_g[i] * std::cos(cmd.phase_rad[i]);
+    mm.departure = rectification::sine_departure(a, signed_g);
+    if (!r.random)
+      for (int h = 1; h <= 3; ++h) {
+        Eigen::Vector3cd W = a.harmonic_g[static_cast<std::size_t>(h)];
+        for (std::size_t i = 0; i < 3; ++i)
+          if (!a.present[i]) W[static_cast<int>(i)] = h == 1 ? std::complex<double>(signed_g[static_cast<int>(i)], 0) : 0.0;
+        mm.tones.emplace_back(h, W);
+      }
+    return mm;
+  }
+  const vibration::RandomProfile& cmd = *r.random;
+  const Eigen::Matrix3d C = vibration::gaussian_equivalent(cmd).covariance_g2();
+  mm.departure = rectification::random_departure(a, C);
+  double lo = INFINITY, hi = 0;
+  for (const auto& t : cmd.psd)
+    if (t) lo = std::min(lo, t->rows.front().frequency_Hz), hi = std::max(hi, t->rows.back().frequency_Hz);
+  // Two bins beyond each end: the Hann window's main lobe spreads a sharp band edge over
+  // +-2 bins, and that power is the motion's (left out, it was ~1 % of a 20-500 Hz table's
+  // variance at 7.8 Hz bins).
+  lo = std::max(lo - 2 * a.resolution_Hz, a.bin_Hz.empty() ? 0.0 : a.bin_Hz.front());
+  hi += 2 * a.resolution_Hz;
+  vibration::RandomProfile p = cmd;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!a.present[i]) continue;
+    vibration::PsdTable t = rectification::welch_table(a, static_cast<int>(i), lo, hi);
+    if (t.rows.size() < 2)
+      throw std::invalid_argument(fmt::format("reference channels: Welch's PSD ({:g} Hz bins) has fewer than 2 bins in the "
+                                              "commanded band {:g} - {:g} Hz",
+                                              a.resolution_Hz, lo, hi));
+    p.psd[i] = t;
+  }
+  mm.random = p;
+  return mm;
 }
 
 }  // namespace
@@ -487,18 +535,39 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       try {
         win.validate();
         rectification::SeriesMeasurer meas(win);
-        // The record, CSV or HDF5 by its extension (io/series.hpp): time_s and output_<unit>.
+        // Reference channels (docs/data-format.md, "Reference channels"): the table's motion
+        // over the vibration window, analysed as it streams (harmonics, or Welch's PSD).
+        rectification::ReferenceWindow rwin;
+        rwin.from_s = win.on_from_s, rwin.to_s = rectification::used_on_to_s(win);
+        rwin.frequency_Hz = r.random ? (r.sine_part ? r.frequency_Hz : 0.0) : r.frequency_Hz;
+        std::optional<rectification::ReferenceAnalyzer> refan;
+        const ReferenceSink reference = [&](double t_s, const std::array<double, 3>& ref_g, const std::array<bool, 3>& present) {
+          if (!refan) refan.emplace(rwin);
+          refan->add(t_s, ref_g, present);
+        };
+        // The record, CSV or HDF5 by its extension (io/series.hpp): time_s, output_<unit> and
+        // the optional reference channels.
         double last_t = -INFINITY, first_dt = 0;
-        read_series(spath, "output_" + m.output_unit, [&](double t, double u) {
-          if (std::isfinite(last_t) && first_dt == 0) first_dt = t - last_t;  // as SeriesMeasurer detects it
-          last_t = t;
-          meas.add(t, u);
-        });
+        read_series(
+            spath, "output_" + m.output_unit,
+            [&](double t, double u) {
+              if (std::isfinite(last_t) && first_dt == 0) first_dt = t - last_t;  // as SeriesMeasurer detects it
+              last_t = t;
+              meas.add(t, u);
+            },
+            reference);
         // Half-open windows, decided as `measure` does (rectification/measurement/series.hpp).
         if (!rectification::record_covers_window_end(rectification::used_on_to_s(win), last_t, first_dt))
           throw std::invalid_argument(fmt::format("{}: the record ends at {:g} s, before on_to_s = {:g} s", spath, last_t, *ot));
         const rectification::SeriesResult res = meas.finish();
         r.measured_g = res.measured_g, r.sigma_g = res.sigma_g;
+        if (refan) {
+          try {
+            r.motion = measured_motion(r, refan->finish());
+          } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(fmt::format("{}: {}", spath, e.what()));
+          }
+        }
       } catch (const std::invalid_argument& e) {
         c.skipped.push_back(label + ": " + e.what());
         continue;

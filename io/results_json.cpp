@@ -1,3 +1,4 @@
+#include "io/diagnosis_json.hpp"
 #include "io/results_json.hpp"
 
 #include <cmath>
@@ -312,6 +313,9 @@ json measure_json(const MeasureStudy& s) {
     json axes = json::array();
     for (int i = 0; i < 3; ++i) axes.push_back(s.reference_axes[static_cast<std::size_t>(i)]);
     j["reference"] = {{"axes_present", axes}, {"rms_g", vec_json(s.reference_rms_g)}, {"input_rms_g", s.reference_input_rms_g}};
+    // How the motion departs from one along its dominant axis (docs/data-format.md, "Reference channels").
+    if (s.motion) j["reference"]["motion"] = to_json(*s.motion);
+    else if (!s.motion_note.empty()) j["reference"]["motion_note"] = s.motion_note;
   }
   j["samples"] = {{"on", r.samples_on}, {"baseline", r.samples_baseline}};
   j["sample_rate_Hz"] = r.sample_rate_Hz;

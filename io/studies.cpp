@@ -441,8 +441,19 @@ MeasureStudy measure(const std::string& series_path, const std::string& column, 
   const double on_from = w.on_from_s, on_to = rectification::used_on_to_s(w);
   long n_ref = 0;
   Vec3 sum = Vec3::Zero(), sum2 = Vec3::Zero();
+  rectification::ReferenceWindow rwin;
+  rwin.from_s = on_from, rwin.to_s = on_to, rwin.frequency_Hz = w.frequency_Hz;
+  std::optional<rectification::ReferenceAnalyzer> refan;
   const ReferenceSink ref = [&](double t, const std::array<double, 3>& g, const std::array<bool, 3>& present) {
     s.reference = true, s.reference_axes = present;
+    if (!refan) refan.emplace(rwin);
+    if (s.motion_note.empty()) {
+      try {
+        refan->add(t, g, present);
+      } catch (const std::invalid_argument& e) {
+        s.motion_note = fmt::format("at t = {:g} s: {}", t, e.what());
+      }
+    }
     if (t < on_from || t >= on_to) return;
     ++n_ref;
     for (int i = 0; i < 3; ++i) sum[i] += g[static_cast<std::size_t>(i)], sum2[i] += g[static_cast<std::size_t>(i)] * g[static_cast<std::size_t>(i)];
@@ -452,6 +463,25 @@ MeasureStudy measure(const std::string& series_path, const std::string& column, 
     const double n = static_cast<double>(n_ref);
     for (int i = 0; i < 3; ++i) s.reference_rms_g[i] = std::sqrt(std::max(0.0, sum2[i] / n - (sum[i] / n) * (sum[i] / n)));
     s.reference_input_rms_g = s.reference_rms_g.norm();
+  }
+  if (refan && s.motion_note.empty()) {
+    // No command is given to measure: the departure from a motion along the dominant axis.
+    try {
+      const rectification::ReferenceAnalysis a = refan->finish();
+      int dom = 0;
+      if (w.frequency_Hz > 0) {
+        for (int i = 1; i < 3; ++i)
+          if (std::abs(a.harmonic_g[1][i]) > std::abs(a.harmonic_g[1][dom])) dom = i;
+        s.motion = rectification::sine_departure(a, Vec3::Unit(dom) * std::abs(a.harmonic_g[1][dom]));
+      } else {
+        a.rms_g.maxCoeff(&dom);
+        Eigen::Matrix3d cmd = Eigen::Matrix3d::Zero();
+        cmd(dom, dom) = a.rms_g[dom] * a.rms_g[dom];
+        s.motion = rectification::random_departure(a, cmd);
+      }
+    } catch (const std::invalid_argument& e) {
+      s.motion_note = e.what();
+    }
   }
   try {
     s.result = m.finish();
@@ -476,6 +506,23 @@ std::string measure_report(const MeasureStudy& s) {
   if (s.reference)
     out += fmt::format("Reference channels over the vibration window: rms [{:.6g}, {:.6g}, {:.6g}] g, magnitude {:.6g} g\n",
                        s.reference_rms_g[0], s.reference_rms_g[1], s.reference_rms_g[2], s.reference_input_rms_g);
+  if (s.motion) {
+    const rectification::MotionDeparture& m = *s.motion;
+    static const char* axis[3] = {"IA", "PA", "OA"};
+    int dom = 0;
+    m.measured_rms_axis_g.maxCoeff(&dom);
+    if (m.kind == "sine")
+      out += fmt::format("  motion: transverse to {} {:.5g} +/- {:.2g} (per axis [{:.4g}, {:.4g}, {:.4g}]), 2nd harmonic {:.5g} +/- "
+                         "{:.2g}, 3rd harmonic {:.5g} +/- {:.2g} (of the fundamental)\n",
+                         axis[dom], m.transverse_ratio, m.transverse_sigma, m.transverse_axis_ratio[0], m.transverse_axis_ratio[1],
+                         m.transverse_axis_ratio[2], m.harmonic2_ratio, m.harmonic2_sigma, m.harmonic3_ratio, m.harmonic3_sigma);
+    else
+      out += fmt::format("  motion: transverse to {} {:.5g} +/- {:.2g} (rms across / along; Welch {:.4g} Hz bins, {} segments, "
+                         "{:.3g} dof per bin)\n",
+                         axis[dom], m.transverse_ratio, m.transverse_sigma, m.resolution_Hz, m.segments, m.dof);
+  } else if (!s.motion_note.empty()) {
+    out += "  motion: not analysed: " + s.motion_note + "\n";
+  }
   if (const double rms = s.vrc_input_rms_g(); rms > 0)
     out += fmt::format("  VRC (input rms {:g} g, {})   {:>14.6f} ug/g^2 +/- {:.3g}\n", rms,
                        w.input_rms_g > 0 ? "given" : "reference channels", rectification::vrc_ug_per_g2(r.measured_g, rms),

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "io/case_file.hpp"
+#include "rectification/measurement/reference.hpp"
 #include "rectification/measurement/series.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/prediction/frequency.hpp"
@@ -76,6 +77,11 @@ struct MeasureStudy {
   std::array<bool, 3> reference_axes{};
   Vec3 reference_rms_g = Vec3::Zero();
   double reference_input_rms_g = 0;
+  // How the reference's motion departs from a pure motion along its dominant axis
+  // (rectification/measurement/reference.hpp: with --frequency the harmonics and the
+  // transverse fundamental, else Welch's PSD); motion_note says why not when it could not.
+  std::optional<rectification::MotionDeparture> motion;
+  std::string motion_note;
   // The input rms the VRC used: --input-rms-g, else the reference channels', else 0 (none).
   double vrc_input_rms_g() const { return windows.input_rms_g > 0 ? windows.input_rms_g : reference_input_rms_g; }
 };

@@ -40,6 +40,25 @@ rectification::PeriodicInput periodic_input(const TableMotion& m, double frequen
   return m.pure_sine() ? rectification::periodic_input(m.sine) : rectification::periodic_input(*m.excitation(), frequency_Hz);
 }
 
+// Reference channels (RunRecord::motion): a sine run's measured tones are its periodic input;
+// a random run's Welch PSD its random part. The table-motion effects are measured in such a
+// run, not applied to it.
+bool measured_sine(const RunRecord& r) { return r.motion && !r.motion->tones.empty(); }
+const vibration::RandomProfile& run_random(const RunRecord& r) {
+  return r.motion && r.motion->random ? *r.motion->random : *r.random;
+}
+rectification::PeriodicInput run_input(const RunRecord& r, const TableMotion& m) {
+  if (!measured_sine(r)) return periodic_input(m, r.frequency_Hz);
+  rectification::PeriodicInput in;
+  in.frequency_Hz = r.frequency_Hz;
+  in.tones = r.motion->tones;
+  return in;
+}
+void apply_effect(const Effect* e, double p, const RunRecord& r, PlantConfig& cfg, TableMotion& m) {
+  if (!e || (r.motion && e->acts_on == ActsOn::table_motion)) return;
+  e->apply(p, cfg, m);  // a random run: what the effect does to the table's motion is not applied
+}
+
 Eigen::VectorXd sub(const Eigen::VectorXd& v, const std::vector<int>& idx) {
   Eigen::VectorXd s(idx.size());
   for (std::size_t i = 0; i < idx.size(); ++i) s(i) = v(idx[i]);
@@ -141,7 +160,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     const RunRecord& r = runs[static_cast<std::size_t>(k)];
     PlantConfig cfg = nominal;
     TableMotion m = table_motion(r);
-    if (e) e->apply(p, cfg, m);  // a random run: what the effect does to the table's motion is not applied
+    apply_effect(e, p, r, cfg, m);
     if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
     // The loop responses depend on the effect's value and, for an amplitude-dependent one,
     // on the run: the key says both.
@@ -152,13 +171,13 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       key = e->name + buf;
     }
     const rectification::ResponseAt h = [&](double f) { return cache.get(cfg, key, f); };
-    const rectification::PeriodicInput input = r.random ? rectification::PeriodicInput{} : periodic_input(m, r.frequency_Hz);
+    const rectification::PeriodicInput input = r.random ? rectification::PeriodicInput{} : run_input(r, m);
     // A random or sine-on-random run: the random part's covariances through the loop, once.
     std::optional<rectification::RandomResponse> rr;
     std::optional<vibration::SineVibration> sine;
     std::optional<rectification::LoopResponse> sine_h;
     if (r.random) {
-      rr = rectification::random_response(*r.random, h, kRandomRunQuadrature);
+      rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature);
       if (r.sine_part) sine = r.vibration(), sine_h = h(r.frequency_Hz);
     }
     // Coefficients as identified, then the effect's own change of them (if any) on top.
@@ -384,6 +403,12 @@ double chi2_as_sigma(double chi2, int n) {
 TableMotion table_motion(const RunRecord& r) {
   TableMotion m;
   m.sine = r.vibration();
+  if (r.motion && !r.motion->tones.empty()) {
+    // The measured fundamental (transverse parts included); its harmonics are in run_input.
+    for (const auto& [h, W] : r.motion->tones)
+      if (h == 1)
+        for (int i = 0; i < 3; ++i) m.sine.amplitude_g[i] = std::abs(W[i]), m.sine.phase_rad[i] = std::arg(W[i]);
+  }
   m.commanded_amplitude_g = r.amplitude_g;
   m.static_gravity_g = r.orientation_g;
   return m;
@@ -435,7 +460,7 @@ Coefficients taken_up_by_static_test(const Effect& e, const PlantConfig& plant, 
 double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effect* e, double p) {
   PlantConfig cfg = nominal;
   TableMotion m = table_motion(r);
-  if (e) e->apply(p, cfg, m);  // a random run: what the effect does to the table's motion is not applied
+  apply_effect(e, p, r, cfg, m);
   if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
   std::map<double, rectification::LoopResponse> responses;
   std::optional<PlantConfig> loop_cfg;  // cfg with its servo designed once (ResponseCache)
@@ -451,13 +476,13 @@ double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effec
     return it->second;
   };
   if (r.random) {
-    const rectification::RandomResponse rr = rectification::random_response(*r.random, h, kRandomRunQuadrature);
+    const rectification::RandomResponse rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature);
     std::optional<vibration::SineVibration> sine;
     std::optional<rectification::LoopResponse> sine_h;
     if (r.sine_part) sine = r.vibration(), sine_h = h(r.frequency_Hz);
     return rectification::random_rectification_at_frequency(cfg, r.orientation_g, rr, sine, sine_h).total_g();
   }
-  return rectification::periodic_rectification(cfg, r.orientation_g, periodic_input(m, r.frequency_Hz), h).total_g();
+  return rectification::periodic_rectification(cfg, r.orientation_g, run_input(r, m), h).total_g();
 }
 
 namespace {
@@ -673,6 +698,18 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
   if (c.statics.empty()) throw std::invalid_argument("diagnose: the campaign has no static readings");
   if (c.runs.empty()) throw std::invalid_argument("diagnose: the campaign has no usable shaker runs");
   Diagnosis d;
+  // Reference channels: when every sine run's motion is measured, the table-motion effects
+  // have nothing left to explain (docs/data-format.md, "Reference channels").
+  {
+    int sine_runs = 0, measured_sine_runs = 0;
+    for (const RunRecord& r : c.runs) {
+      if (r.motion) ++d.runs_with_measured_motion;
+      if (!r.random) ++sine_runs, measured_sine_runs += r.motion ? 1 : 0;
+    }
+    if (sine_runs > 0 && measured_sine_runs == sine_runs)
+      for (const Effect& e : effect_library())
+        if (e.acts_on == ActsOn::table_motion) d.measured_effects.push_back(e.name);
+  }
   // 1. Identification from the static readings, weighted by their sigma.
   std::vector<Position> positions;
   std::vector<Reading> readings;
@@ -929,6 +966,7 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
   };
   std::map<std::string, std::unique_ptr<EffectFitter>> fitters;
   for (const Effect& e : effect_library()) {
+    if (std::find(d.measured_effects.begin(), d.measured_effects.end(), e.name) != d.measured_effects.end()) continue;
     const EffectFitter& fitter = *(fitters[e.name] = std::make_unique<EffectFitter>(e, nominal, plant, c.runs, cache, absorbed));
     Scored sc;
     sc.fit.name = e.name, sc.fit.parameter = e.fitted().name, sc.fit.unit = e.fitted().unit;
@@ -1014,7 +1052,7 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
       const double l_rest = likelihood(rest, nominal.pred, nominal.G, idx).m2logl;
       std::vector<std::pair<double, const Effect*>> drop;
       for (const Effect& eb : effect_library()) {
-        if (eb.name == ea.name) continue;
+        if (eb.name == ea.name || !fitters.count(eb.name)) continue;
         const EffectFitter& B = *fitters.at(eb.name);
         const Table tb = B.at(B.fit(rest, idx).first);
         drop.emplace_back(l_rest - likelihood(rest, tb.pred, tb.G, idx).m2logl, &eb);
@@ -1165,7 +1203,10 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
     for (int i = 0; i < plant::kNumCoefficients; ++i) corrected.coefficients[i] += dc(i);
     std::vector<int> order = all;
     // Random runs are not re-simulated here (the ODE measures them statistically, seconds each).
-    std::erase_if(order, [&](int k) { return c.runs[static_cast<std::size_t>(k)].random.has_value(); });
+    // Nor are runs with measured motion (the ODE takes the commanded sine and the effects).
+    std::erase_if(order, [&](int k) {
+      return c.runs[static_cast<std::size_t>(k)].random.has_value() || c.runs[static_cast<std::size_t>(k)].motion.has_value();
+    });
     std::sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(r(a)) > std::abs(r(b)); });
     order.resize(std::min<std::size_t>(order.size(), static_cast<std::size_t>(s.resimulate_runs)));
     double sb = 0, sa = 0;

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "plant/accelerometer.hpp"
+#include "rectification/measurement/reference.hpp"
 #include "validation/diagnosis/effect.hpp"
 #include "validation/identification/dividing_head.hpp"
 #include "validation/identification/identification.hpp"
@@ -60,6 +61,11 @@ struct RunRecord {
   // only describe it (the PSD's mean frequency, sqrt(2) x its rms, each axis's rms share).
   std::optional<vibration::RandomProfile> random;
   bool sine_part = true;
+  // The table's motion as a reference accelerometer measured it (raw records with reference
+  // channels, docs/data-format.md): for a sine run its tones, for a random run its Welch PSD;
+  // the prediction takes it instead of the commanded motion, and the table-motion effects
+  // are not applied to the run (they are measured). Empty: the commanded motion.
+  std::optional<rectification::MeasuredMotion> motion;
   vibration::SineVibration vibration() const;
 };
 
@@ -207,6 +213,13 @@ struct Diagnosis {
   int resimulated_runs = 0;
   double resimulated_rms_before_g = 0, resimulated_rms_after_g = 0;
   std::vector<std::string> resimulation_failures;
+  // Reference channels: the table-motion effects (shaker transverse motion, harmonic
+  // distortion, third harmonic, fixture rocking) left out of the candidates because every
+  // sine run's motion is measured (they are measured, not fitted), and how many runs have
+  // measured motion. In a campaign where only some sine runs have it the effects stay
+  // candidates, their hypotheses applied to the other runs only.
+  std::vector<std::string> measured_effects;
+  int runs_with_measured_motion = 0;
   // The verdict and the held-out shrinkage (brief), or everything found: where, the folds, each
   // effect and pair, the shrinkage, the ODE confirmation (full; wall_s >= 0 is printed).
   // validation/diagnosis/diagnosis_report.cpp.
