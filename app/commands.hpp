@@ -99,7 +99,8 @@ struct DiagnoseOptions {
   int threads = 0;
   bool progress = true;
 };
-void run_diagnose(const DiagnoseOptions& o, std::ostream& out);
+// Exit code: 2 when runs were skipped for bad input (the others diagnosed and written), else 0.
+int run_diagnose(const DiagnoseOptions& o, std::ostream& out);
 // diagnose DIR... --summary FILE; returns the number of campaigns that failed.
 int run_diagnose_many(const DiagnoseOptions& o, std::ostream& out);
 

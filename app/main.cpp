@@ -233,8 +233,7 @@ Command add_diagnose(CLI::App& app) {
             if (d.dirs.size() > 1)
               throw InputError("diagnose: several campaign folders need --summary FILE (one row per campaign)");
             d.dir = d.dirs.front();
-            run_diagnose(d, std::cout);
-            return 0;
+            return run_diagnose(d, std::cout);
           },
           [owned] { return !owned->summary_path.empty(); }};
 }

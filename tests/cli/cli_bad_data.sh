@@ -59,7 +59,7 @@ sed -i '6s/^1,30,/1,0x1E,/' "$tmp/hex/static.csv"
 expect 2 "hex/static\.csv:6:2: column angle_deg: '0x1E' is not a number \(hexadecimal" diagnose "$tmp/hex"
 lab hexrun
 sed -i '5s/^ia-100Hz-2g,100,/ia-100Hz-2g,0x1E,/' "$tmp/hexrun/runs.csv"
-expect 0 "skipped: run 'ia-100Hz-2g': .*hexrun/runs\.csv:5:2: column frequency_Hz: '0x1E' is not a number \(hexadecimal" diagnose --resimulate-runs 0 --no-pairs "$tmp/hexrun"
+expect 2 "skipped: run 'ia-100Hz-2g': .*hexrun/runs\.csv:5:2: column frequency_Hz: '0x1E' is not a number \(hexadecimal" diagnose --resimulate-runs 0 --no-pairs "$tmp/hexrun"
 lab inf
 sed -i '6s/^1,30,/1,inf,/' "$tmp/inf/static.csv"
 expect 2 'inf/static\.csv:6:2: column angle_deg: inf is not a finite number' diagnose "$tmp/inf"
