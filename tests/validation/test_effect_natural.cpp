@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 
@@ -45,6 +46,8 @@ void expect_within_3_sigma(const EffectFit& e, const std::vector<double>& truth_
   ASSERT_EQ(e.parameters.size(), truth_values.size());
   for (std::size_t j = 0; j < truth_values.size(); ++j) {
     const FittedParameter& q = e.parameters[j];
+    std::printf("  %s %s: %s %.6g +- %.3g (truth %.6g)\n", e.name.c_str(), q.name.c_str(), q.status.c_str(), q.value, q.sigma,
+                truth_values[j]);
     SCOPED_TRACE(q.name + " " + q.status);
     if (q.status == "fitted") {
       ASSERT_TRUE(std::isfinite(q.sigma) && q.sigma > 0);
@@ -121,5 +124,12 @@ TEST(NaturalForm, ACleanCampaignIsNotExplainedByTheRicherEffects) {
   const Diagnosis d = diagnose(c);
   EXPECT_FALSE(d.gap_significant) << d.where << "; " << d.verdict;
   EXPECT_FALSE(d.explained) << d.verdict;
-  for (const EffectFit& e : d.effects) EXPECT_LT(e.evidence, 25) << e.name;
+  for (const EffectFit& e : d.effects) {
+    EXPECT_LT(e.evidence, 25) << e.name;
+    // No discrete form chosen for an effect the runs do not see.
+    for (const FittedParameter& q : e.parameters) EXPECT_NE(q.status, "chosen") << e.name << " " << q.name;
+    for (std::size_t j = 1; j < e.parameters.size(); ++j)
+      std::printf("  %s %s: %s %.6g (evidence %.2f)\n", e.name.c_str(), e.parameters[j].name.c_str(), e.parameters[j].status.c_str(),
+                  e.parameters[j].value, e.evidence);
+  }
 }
