@@ -367,15 +367,11 @@ class EffectFitter {
         for (int j : held_after) free.erase(std::find(free.begin(), free.end(), j));
         continue;
       }
-      // Fitted: the covariance with the priors, the slopes over every run.
+      // Fitted: the covariance with the priors (the information at the last Levenberg-Marquardt
+      // point, rescaled to the objective's curvature), the slopes over every run.
       const Eigen::MatrixXd J = jacobian(v, free);
-      const Table t = at(v);
-      const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, t.G, idx));
-      const Eigen::MatrixXd Ji = rows(J, idx);
-      Eigen::MatrixXd A = Ji.transpose() * ldlt.solve(Ji);
-      for (std::size_t a = 1; a < free.size(); ++a) A(a, a) += prior_weight(free[a]);
       out.values = v, out.free = free, out.slopes = J;
-      out.cov = A.inverse();
+      out.cov = last_info_.inverse();
       for (std::size_t a = 0; a < free.size(); ++a) {
         out.status[free[a]] = "fitted";
         out.sigma[free[a]] = std::sqrt(std::max(0.0, out.cov(a, a)));
@@ -510,14 +506,35 @@ class EffectFitter {
       const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, t.G, idx));
       const Eigen::MatrixXd Ji = rows(jacobian(v, free), idx);
       const Eigen::VectorXd r = sub(d.measured, idx) - sub(t.pred, idx);
+      // The Gauss-Newton matrix J^T V^-1 J (+ the priors); the gradient of the whole objective
+      // (-2 ln L with its ln det V, which the parameters change through G, and the priors) by
+      // central differences: J^T V^-1 r alone ignores ln det V and pointed a phase away from
+      // its optimum (seen: every step rejected).
       Eigen::MatrixXd A = Ji.transpose() * ldlt.solve(Ji);
       Eigen::VectorXd g = Ji.transpose() * ldlt.solve(r);
-      for (Eigen::Index a = 1; a < k; ++a) {
-        const EffectParameter& q = e_.parameters[static_cast<std::size_t>(free[static_cast<std::size_t>(a)])];
-        const double w = prior_weight(free[static_cast<std::size_t>(a)]);
-        A(a, a) += w;
-        g(a) -= (v[static_cast<std::size_t>(free[static_cast<std::size_t>(a)])] - q.nominal) * w;
+      Eigen::VectorXd scale = Eigen::VectorXd::Ones(k);
+      for (Eigen::Index a = 0; a < k; ++a) {
+        const int j = free[static_cast<std::size_t>(a)];
+        if (a > 0) A(a, a) += prior_weight(j);
+        const double h = step(v, j);
+        const auto [lo, hi] = range(j);
+        std::vector<double> up = v, down = v;
+        up[static_cast<std::size_t>(j)] = std::min(v[static_cast<std::size_t>(j)] + h, hi);
+        down[static_cast<std::size_t>(j)] = std::max(v[static_cast<std::size_t>(j)] - h, lo);
+        const double span = up[static_cast<std::size_t>(j)] - down[static_cast<std::size_t>(j)];
+        const double fu = objective(up), fd = objective(down);
+        if (span > 0 && std::isfinite(fu) && std::isfinite(fd)) {
+          g(a) = -(fu - fd) / (2 * span);
+          // The objective's own curvature along j (half its second difference, central only):
+          // the row and column of A rescaled to it, the correlations kept from J^T V^-1 J.
+          if (up[static_cast<std::size_t>(j)] - v[static_cast<std::size_t>(j)] == v[static_cast<std::size_t>(j)] - down[static_cast<std::size_t>(j)]) {
+            const double hh = span / 2, c = (fu - 2 * f + fd) / (hh * hh) / 2;
+            if (c > 0 && A(a, a) > 0) scale(a) = std::sqrt(c / A(a, a));
+          }
+        }
       }
+      A = scale.asDiagonal() * A * scale.asDiagonal();
+      last_info_ = A;
       bool accepted = false, converged = false;
       for (int tries = 0; tries < 8 && !accepted; ++tries) {
         Eigen::MatrixXd Al = A;
@@ -643,6 +660,7 @@ class EffectFitter {
   mutable std::map<double, Table> extra_;
   std::vector<double> nominal_values_;
   mutable std::map<std::vector<double>, Table> tables_;
+  mutable Eigen::MatrixXd last_info_;  // levenberg_marquardt's information matrix at its last point
 };
 
 std::string fmt_peak(const RunRecord& run, const std::string& dir, const std::string& orient, double z) {
