@@ -909,7 +909,7 @@ void read_campaign(Table t, Case& c) {
       if (!p || !p->is_number()) t.fail(&x, "hidden", "each hidden effect needs a numeric parameter");
       h.parameter = p->value<double>().value();
       std::string why;  // the registry's check of the effect's values
-      if (!validation::find_effect(h.name)->is_valid(std::span<const double>(&h.parameter, 1), &why)) t.fail(&x, "hidden", why);
+      if (!validation::find_effect(h.name)->is_valid(h.values(*validation::find_effect(h.name)), &why)) t.fail(&x, "hidden", why);
       s.hidden.push_back(h);
     }
   }

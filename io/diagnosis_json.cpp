@@ -18,6 +18,21 @@ namespace {
 
 json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 
+// Every parameter of an effect: fitted (value, sigma), chosen (a discrete one) or held at its
+// nominal (sigma null), with its unit and prior range.
+json parameters_json(const validation::EffectFit& e) {
+  json ps = json::array();
+  for (const auto& q : e.parameters)
+    ps.push_back({{"name", q.name},
+                  {"unit", q.unit},
+                  {"value", q.value},
+                  {"sigma", finite_or_null(q.sigma)},
+                  {"status", q.status},
+                  {"at_bound", q.at_bound},
+                  {"range", json::array({finite_or_null(q.lower), finite_or_null(q.upper)})}});
+  return ps;
+}
+
 json effects_json(const validation::Diagnosis& d) {
   json effects = json::array();
   for (const auto& e : d.effects)
@@ -28,7 +43,8 @@ json effects_json(const validation::Diagnosis& d) {
                        {"sigma", finite_or_null(e.sigma)},
                        {"evidence", e.evidence},
                        {"heldout_chi2", e.heldout_chi2},
-                       {"at_bound", e.at_bound}});
+                       {"at_bound", e.at_bound},
+                       {"parameters", parameters_json(e)}});
   return effects;
 }
 

@@ -110,9 +110,16 @@ TEST(EffectRegistry, EveryEffectIsCompleteAndConsistent) {
     EXPECT_FALSE(e.is_valid(bad));
     EXPECT_FALSE(e.is_valid(std::vector<double>(e.parameters.size() + 1, 0.0)));
     for (int k = 0; k < 20; ++k) {
-      const std::vector<double> v = e.draw(rng);
+      // draw: the first parameter (the default form); draw_form: the further ones.
+      std::vector<double> v = e.values_at(e.draw(rng).front());
       std::string why;
       EXPECT_TRUE(e.is_valid(v, &why)) << why;
+      if (e.draw_form) {
+        const std::vector<double> form = e.draw_form(rng);
+        ASSERT_EQ(form.size() + 1, e.parameters.size()) << e.name;
+        std::copy(form.begin(), form.end(), v.begin() + 1);
+        EXPECT_TRUE(e.is_valid(v, &why)) << why;
+      }
     }
     std::vector<double> example;
     for (const EffectParameter& q : e.parameters) example.push_back(q.example);
@@ -162,7 +169,7 @@ TEST(EffectRegistry, BlindDrawsKeepTheirRngCalls) {
     std::mt19937_64 rng(7);
     const HiddenEffect h = draw_hidden(e, rng);
     EXPECT_EQ(h.name, e.name);
-    EXPECT_TRUE(e.is_valid(std::vector<double>{h.parameter})) << e.name;
+    EXPECT_TRUE(e.is_valid(h.values(e))) << e.name;
   }
 }
 
@@ -201,7 +208,7 @@ TEST(EffectRegistry, EachEffectsTruthAndHypothesisMakeTheSameChange) {
     // rest given back as the diagnosis does.
     VirtualLab at_rest;
     at_rest.instrument = truth();
-    e.truth(std::vector<double>{p}, at_rest);
+    e.truth(e.values_at(p), at_rest);
     plant::PlantConfig identified;
     identified.coefficients = identified_by_static_test(at_rest.instrument);
     if (e.acts_at_rest) {
@@ -216,7 +223,7 @@ TEST(EffectRegistry, EachEffectsTruthAndHypothesisMakeTheSameChange) {
       lab.table = r.vibration();
       lab.commanded_amplitude_g = r.amplitude_g;
       lab.static_gravity_g = r.orientation_g;
-      e.truth(std::vector<double>{p}, lab);
+      e.truth(e.values_at(p), lab);
       const double ode_change =
           rectification::shake_sine(lab.run_plant(), r.orientation_g, r.vibration(), {}, {}, lab.excitation().get()).measured_g -
           rectification::shake_sine(truth(), r.orientation_g, r.vibration()).measured_g;

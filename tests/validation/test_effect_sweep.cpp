@@ -101,6 +101,31 @@ std::vector<double> sweep_values(const Effect& e, bool whole_range) {
   return v;
 }
 
+// The sweep's points: each value above with the further parameters nominal (the default form)
+// and, for an effect with a natural form, the same values with forms blind draws
+// (Effect::draw_form, 3 draws; the discrete ones forced through each of their values, so a
+// mode is swept along IA, PA and OA) -- at the strongest drawn value only in the fast subset.
+std::vector<std::vector<double>> sweep_points(const Effect& e, bool whole_range) {
+  std::vector<std::vector<double>> pts;
+  const std::vector<double> firsts = sweep_values(e, whole_range);
+  for (double p : firsts) pts.push_back(e.values_at(p));
+  if (!e.draw_form) return pts;
+  std::mt19937_64 rng(16);
+  std::vector<std::vector<double>> forms;
+  for (int k = 0; k < 3; ++k) forms.push_back(e.draw_form(rng));
+  for (std::size_t j = 1; j < e.parameters.size(); ++j)
+    if (e.parameters[j].discrete)
+      for (std::size_t k = 0; k < forms.size() && k < e.parameters[j].starts.size(); ++k) forms[k][j - 1] = e.parameters[j].starts[k];
+  const std::vector<double> at = whole_range ? firsts : std::vector<double>{sweep_values(e, false).front()};
+  for (double p : at)
+    for (const auto& form : forms) {
+      std::vector<double> v = e.values_at(p);
+      std::copy(form.begin(), form.end(), v.begin() + 1);
+      pts.push_back(v);
+    }
+  return pts;
+}
+
 struct Point {
   double predicted_g, ode_g;
 };
@@ -126,14 +151,15 @@ plant::Coefficients identified_by_static_test(const plant::PlantConfig& instrume
 struct Identified {
   plant::PlantConfig base, with;
 };
-Identified identified(const Effect& e, double p) {
+Identified identified(const Effect& e, const std::vector<double>& values) {
+  const double p = values.front();
   const plant::PlantConfig truth = test::paper_like_plant();
   static const plant::Coefficients base = identified_by_static_test(truth);
   Identified out;
   out.base.coefficients = base;
   VirtualLab at_rest;
   at_rest.instrument = truth;
-  e.truth(std::vector<double>{p}, at_rest);
+  e.truth(values, at_rest);
   // An effect of the table's motion or of the runs' acquisition leaves the static test's
   // instrument, and so its identification, as it was.
   out.with.coefficients = e.acts_on == ActsOn::instrument ? identified_by_static_test(at_rest.instrument) : base;
@@ -148,7 +174,8 @@ Identified identified(const Effect& e, double p) {
   return out;
 }
 
-Point compare(const Effect& e, double p, const Identified& id, double frequency_Hz, std::map<double, double>& ode_without) {
+Point compare(const Effect& e, const std::vector<double>& values, const Identified& id, double frequency_Hz,
+              std::map<double, double>& ode_without) {
   const plant::PlantConfig truth = test::paper_like_plant();
   const RunRecord r = strong_run(frequency_Hz);
   VirtualLab lab;
@@ -156,13 +183,13 @@ Point compare(const Effect& e, double p, const Identified& id, double frequency_
   lab.table = r.vibration();
   lab.commanded_amplitude_g = r.amplitude_g;
   lab.static_gravity_g = r.orientation_g;
-  e.truth(std::vector<double>{p}, lab);
+  e.truth(values, lab);
   auto it = ode_without.find(frequency_Hz);
   if (it == ode_without.end())
     it = ode_without.emplace(frequency_Hz, rectification::shake_sine(truth, r.orientation_g, r.vibration()).measured_g).first;
   const double ode =
       rectification::shake_sine(lab.run_plant(), r.orientation_g, r.vibration(), {}, {}, lab.excitation().get()).measured_g - it->second;
-  return {predict_run_g(id.with, r, &e, p) - predict_run_g(id.base, r), ode};
+  return {predict_run_g(id.with, r, e, values) - predict_run_g(id.base, r), ode};
 }
 
 void sweep(const std::vector<double>& frequencies, bool whole_range) {
@@ -171,13 +198,16 @@ void sweep(const std::vector<double>& frequencies, bool whole_range) {
     const double rel = relative_tolerance(e.name);
     double largest = 0, worst_ratio = 0;
     std::string worst;
-    for (double p : sweep_values(e, whole_range)) {
+    for (const std::vector<double>& values : sweep_points(e, whole_range)) {
+      const double p = values.front();
+      std::string form;  // the natural form's further parameters, for the messages
+      for (std::size_t j = 1; j < values.size(); ++j) form += std::string(" ").append(e.parameters[j].name).append("=").append(std::to_string(values[j]));
       Identified id;
       for (double f : frequencies) {
         Point x{};
         try {
-          if (f == frequencies.front()) id = identified(e, p);
-          x = compare(e, p, id, f, ode_without);
+          if (f == frequencies.front()) id = identified(e, values);
+          x = compare(e, values, id, f, ode_without);
         } catch (const std::invalid_argument& why) {
           // A grid end the plant cannot be (servo_phase_margin's +32 deg needs more phase lead
           // than one network gives): the fit skips it too. Never a drawn value.
@@ -187,13 +217,13 @@ void sweep(const std::vector<double>& frequencies, bool whole_range) {
         }
         const double err = std::abs(x.predicted_g - x.ode_g);
         EXPECT_LE(err, rel * std::abs(x.ode_g) + kFloor_g)
-            << e.name << " = " << p << " at " << f << " Hz: predicted " << x.predicted_g * 1e6 << " ug, ODE " << x.ode_g * 1e6 << " ug";
+            << e.name << " = " << p << form << " at " << f << " Hz: predicted " << x.predicted_g * 1e6 << " ug, ODE " << x.ode_g * 1e6 << " ug";
         largest = std::max(largest, std::abs(x.ode_g));
         const double ratio = err / (std::abs(x.ode_g) + kFloor_g);
         if (ratio > worst_ratio) {
           worst_ratio = ratio;
           char buf[160];
-          std::snprintf(buf, sizeof buf, "%g at %g Hz (%.4g vs %.4g ug)", p, f, x.predicted_g * 1e6, x.ode_g * 1e6);
+          std::snprintf(buf, sizeof buf, "%g%s at %g Hz (%.4g vs %.4g ug)", p, form.c_str(), f, x.predicted_g * 1e6, x.ode_g * 1e6);
           worst = buf;
         }
       }

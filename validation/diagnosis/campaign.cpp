@@ -38,12 +38,26 @@ void validate(const HiddenEffect& h) {
   const Effect* e = find_effect(h.name);
   if (!e) throw std::invalid_argument("campaign: unknown hidden effect '" + h.name + "'");
   std::string why;
-  if (!e->is_valid(std::span<const double>(&h.parameter, 1), &why)) throw std::invalid_argument("campaign: " + why);
+  if (!h.form.empty() && h.form.size() + 1 != e->parameters.size())
+    throw std::invalid_argument("campaign: " + h.name + " takes " + std::to_string(e->parameters.size() - 1) + " further parameter(s)");
+  if (!e->is_valid(h.values(*e), &why)) throw std::invalid_argument("campaign: " + why);
 }
 
 HiddenEffect draw_hidden(const Effect& e, std::mt19937_64& rng) {
   if (!e.draw) throw std::invalid_argument("blind: no parameter range for " + e.name);
-  return {e.name, e.draw(rng).front()};
+  return {e.name, e.draw(rng).front(), {}};
+}
+
+HiddenEffect draw_hidden_natural(const Effect& e, std::mt19937_64& rng) {
+  HiddenEffect h = draw_hidden(e, rng);
+  if (e.draw_form) h.form = e.draw_form(rng);
+  return h;
+}
+
+std::vector<double> HiddenEffect::values(const Effect& e) const {
+  std::vector<double> v = e.values_at(parameter);
+  for (std::size_t i = 0; i < form.size() && i + 1 < v.size(); ++i) v[i + 1] = form[i];
+  return v;
 }
 
 namespace {
@@ -58,7 +72,10 @@ VirtualLab truth_lab(const plant::PlantConfig& truth, const std::vector<HiddenEf
     lab.commanded_amplitude_g = run->amplitude_g;
     lab.static_gravity_g = run->orientation_g;
   }
-  for (const HiddenEffect& h : hidden) find_effect(h.name)->truth(std::span<const double>(&h.parameter, 1), lab);
+  for (const HiddenEffect& h : hidden) {
+    const Effect& e = *find_effect(h.name);
+    e.truth(h.values(e), lab);
+  }
   return lab;
 }
 

@@ -18,6 +18,7 @@
 #include <functional>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "plant/accelerometer.hpp"
@@ -27,14 +28,24 @@
 namespace vrelab::validation {
 
 struct HiddenEffect {
+  HiddenEffect() = default;
+  HiddenEffect(std::string name_, double parameter_, std::vector<double> form_ = {})
+      : name(std::move(name_)), parameter(parameter_), form(std::move(form_)) {}
   std::string name;
-  double parameter = 0;  // the effect's first parameter (each of today's effects has one)
+  double parameter = 0;  // the effect's first parameter
+  // Its further parameters (the natural form: Effect::parameters[1..]); empty: their nominals
+  // (the library's default form).
+  std::vector<double> form;
+  std::vector<double> values(const Effect& e) const;  // every parameter's value
 };
 
 // A blind campaign's draw of the effect's parameter (Effect::draw: the ranges where its gap is
 // several sigma in the default design). The same rng calls for a given seed as before the
 // registry, so blind seeds draw the same truths.
 HiddenEffect draw_hidden(const Effect& e, std::mt19937_64& rng);
+// The same, then the further parameters away from their defaults (Effect::draw_form; the
+// default form when the effect has none).
+HiddenEffect draw_hidden_natural(const Effect& e, std::mt19937_64& rng);
 
 struct CampaignDesign {
   int positions_per_series = 12;  // 30 deg steps: rank 12 of 13, only k_PP must be held

@@ -99,6 +99,8 @@ plant::Coefficients taken_up_by_static_test(const Effect& e, const plant::PlantC
 // effect (name, parameter) applied when given. g.
 // (e must be in the library; p is its first parameter, the others nominal.)
 double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, const Effect* e = nullptr, double p = 0);
+// The same at every parameter's value (the natural form).
+double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, const Effect& e, ParameterValues values);
 
 struct DiagnoseSettings {
   double model_accuracy = 0.002;      // relative accuracy of the simulation (f_model)
@@ -126,9 +128,22 @@ struct DiagnoseSettings {
   bool IsValid(std::string* why) const;
 };
 
+// One parameter of a fitted effect: its value and sigma (fitted on all runs), or held at its
+// nominal (the data do not pin it: its sigma from the data alone would not be smaller than its
+// prior width, or its slope is in the span of the others'), with its prior range.
+struct FittedParameter {
+  std::string name, unit;
+  double value = 0, sigma = NAN;
+  std::string status;  // "fitted", "chosen" (a discrete parameter: one of its values), "held"
+  double lower = -INFINITY, upper = INFINITY;  // the prior range
+  bool at_bound = false;  // fitted, but ended on the edge of its range (its sigma ignores the edge)
+};
+
 struct EffectFit {
   std::string name, parameter, unit;
-  double value = 0, sigma = 0;   // fitted on all runs
+  double value = 0, sigma = 0;   // fitted on all runs (the first parameter)
+  std::vector<FittedParameter> parameters;  // every parameter, the first too
+  std::vector<double> values() const;       // every parameter's value
   double evidence = 0;           // held-out chi^2 reduction, summed over folds
   double heldout_chi2 = 0;       // held-out chi^2 with the effect (given the training runs), summed over folds
   bool at_bound = false;         // the fit ended on the edge of its range (no curvature: no sigma)

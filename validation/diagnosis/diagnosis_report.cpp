@@ -76,9 +76,20 @@ std::string Diagnosis::FullReport(double wall_s) const {
   t += "Cross-validation: " + d.folds + "\n";
   t += "Verdict: " + d.verdict + "\n";
   t += fmt::format("  {:<26}{:>16}{:>12}{:>12}{:>14}\n", "effect", "parameter", "sigma", "evidence", "held-out chi2");
-  for (const auto& e : d.effects)
+  for (const auto& e : d.effects) {
     t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}{:>12.1f}{:>14.1f}  {} ({})\n", e.name, e.value, e.sigma, e.evidence,
                      e.heldout_chi2, e.parameter, e.unit);
+    // The natural form's further parameters: fitted with sigma, chosen, or held at nominal.
+    for (std::size_t j = 1; j < e.parameters.size(); ++j) {
+      const auto& q = e.parameters[j];
+      if (q.status == "fitted")
+        t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}  fitted{}: {} ({})\n", "", q.value, q.sigma, q.at_bound ? " at its bound" : "",
+                         q.name, q.unit);
+      else
+        t += fmt::format("  {:<26}{:>16.5g}{:>12}  {}: {} ({}; range {:.3g} .. {:.3g})\n", "", q.value, "", q.status, q.name,
+                         q.unit, q.lower, q.upper);
+    }
+  }
   for (const auto& p : d.pairs)
     t += fmt::format("  pair {:<40}{:>12.5g},{:<12.5g}{:>12.1f}{:>14.1f}\n", p.a + " + " + p.b, p.pa, p.pb, p.evidence,
                      p.heldout_chi2);

@@ -68,11 +68,19 @@ const char* to_string(ActsOn a) {
 }
 
 void Effect::apply(double p, plant::PlantConfig& plant, TableMotion& motion) const {
+  apply(values_at(p), plant, motion);
+}
+
+void Effect::apply(ParameterValues values, plant::PlantConfig& plant, TableMotion& motion) const {
   if (!hypothesis) throw std::logic_error(name + " is not in the diagnosis' library: it has no hypothesis");
+  hypothesis(values, plant, motion);
+}
+
+std::vector<double> Effect::values_at(double p) const {
   std::vector<double> values;
   for (const EffectParameter& q : parameters) values.push_back(q.nominal);
   values.front() = p;
-  hypothesis(values, plant, motion);
+  return values;
 }
 
 bool Effect::is_valid(ParameterValues values, std::string* why) const {

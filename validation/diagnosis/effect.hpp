@@ -9,7 +9,8 @@
 //  - truth: the virtual lab's, built from its physical description with the plant's modules
 //    (plant/effects/) and the shaker's decorators (vibration/decorators.hpp), never through
 //    the hypothesis, so that a wrong sign or axis in a hypothesis shows in `blind`;
-//  - draw: a value for a blind campaign, where its gap is several sigma in the default design;
+//  - draw: a value of the first parameter for a blind campaign, where its gap is several sigma
+//    in the default design (draw_form: the natural form's further parameters);
 //  - check: the values a campaign may hide (beyond finiteness).
 // Each effect is one file in validation/diagnosis/effects/; the registry (effect_registry())
 // lists them all. The hooks take one value per parameter.
@@ -83,13 +84,32 @@ struct EffectParameter {
   std::vector<double> grid;  // values tried (nonlinear)
   // A value where the effect is clearly seen in a 4 g run (the tests' value; docs).
   double example = NAN;
+  // A further parameter (not the first): the natural form's departure from the library's
+  // default form (nominal). The diagnosis fits it where the data pin it (docs/diagnose.md,
+  // "Natural forms") and holds it at nominal where they do not.
+  //  - discrete: one of `starts` (an axis, say), chosen by likelihood; else continuous in
+  //    [lower, upper], fitted by Levenberg-Marquardt with a weak Gaussian prior of width
+  //    prior_sigma (NaN: (upper - lower) / 4) about nominal;
+  //  - starts: the values the first parameter's grid fit is repeated at (a phase's quadrants,
+  //    the axes): a start far from the truth can leave the first parameter near zero, where
+  //    the further one has no slope;
+  //  - step: the finite-difference step of its slope (NaN: 1e-3 (upper - lower)).
+  bool discrete = false;
+  bool periodic = false;  // an angle: [lower, upper) wraps round
+  std::vector<double> starts;
+  double prior_sigma = NAN, step = NAN;
+  double prior_width() const { return std::isfinite(prior_sigma) ? prior_sigma : (upper - lower) / 4; }
+  double fd_step() const { return std::isfinite(step) ? step : 1e-3 * (upper - lower); }
 };
 
 using ParameterValues = std::span<const double>;  // one value per Effect::parameters entry
 
 struct Effect {
   std::string name, physics;
-  std::vector<EffectParameter> parameters;  // at least one; the diagnosis fits the first
+  // At least one. The first is the effect's size (its nominal: no effect); the further ones its
+  // natural form (their nominals: the library's default form). The diagnosis fits the first
+  // and each further one the data pin (docs/diagnose.md, "Natural forms").
+  std::vector<EffectParameter> parameters;
   ActsOn acts_on = ActsOn::instrument;
   bool in_library = true;         // false: only the virtual lab knows it (diagnose must call it unexplained)
   int rank = 1000;                // the registry's order (the diagnosis' order: ties, output); a new effect takes the next
@@ -103,11 +123,19 @@ struct Effect {
   std::function<void(ParameterValues, plant::PlantConfig&, TableMotion&)> hypothesis;  // null: not in the library
   std::function<void(ParameterValues, VirtualLab&)> truth;
   std::function<std::vector<double>(std::mt19937_64&)> draw;
+  // The natural form's draw (blind): the further parameters (parameters[1..]) away from their
+  // defaults (damping, axis, phase, a second angle); null: none. Apart from `draw`, so that the
+  // default-form draws of a seed stay as they were.
+  std::function<std::vector<double>(std::mt19937_64&)> draw_form;
   std::function<bool(ParameterValues, std::string* why)> check;  // null: any finite values
 
   const EffectParameter& fitted() const { return parameters.front(); }
   // The hypothesis at one value of the first parameter (the others nominal).
   void apply(double p, plant::PlantConfig& plant, TableMotion& motion) const;
+  // The hypothesis at every parameter's value.
+  void apply(ParameterValues values, plant::PlantConfig& plant, TableMotion& motion) const;
+  // Every parameter at its nominal but the first at p.
+  std::vector<double> values_at(double p) const;
   // The right number of finite values that `check` accepts; why says otherwise.
   bool is_valid(ParameterValues values, std::string* why = nullptr) const;
 };

@@ -76,6 +76,17 @@ inline bool harmonic_ratio(const std::string& name, ParameterValues p, std::stri
   return false;
 }
 
+// A harmonic's phase (rad) against the fundamental, as sin(n t + phase): nominal 0 (the
+// library's default form), periodic in [-pi, pi), a start in each quadrant (at a phase far
+// from the truth the ratio's grid fit can end near 0, where the phase has no slope).
+inline EffectParameter harmonic_phase(const std::string& name) {
+  EffectParameter q(name, "rad");
+  q.nominal = 0, q.lower = -std::numbers::pi, q.upper = std::numbers::pi, q.example = std::numbers::pi / 2;
+  q.periodic = true, q.step = 1e-3;
+  q.starts = {0, std::numbers::pi / 2, -std::numbers::pi, -std::numbers::pi / 2};
+  return q;
+}
+
 // An input-axis term k_n a^n beyond model (1) (n = 5, 6), on the readout
 // (plant::OutputPolynomial): linear in k_n, acting at rest too (the static test takes part of
 // it up), the instrument's own in the virtual lab; drawn log-uniform in [lo, hi] with a sign.

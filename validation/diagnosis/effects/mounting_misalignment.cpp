@@ -1,4 +1,4 @@
-// The shaker fixture holds the sensor turned about OA from where the static test held it.
+// The shaker fixture holds the sensor turned about OA and about PA from where the static test held it.
 #include <Eigen/Geometry>
 
 #include "validation/diagnosis/effects/common.hpp"
@@ -10,31 +10,42 @@ Effect effect_mounting_misalignment() {
   e.name = "mounting_misalignment";
   e.rank = 12;
   e.acts_on = ActsOn::table_motion;
-  e.physics = "the shaker fixture holds the sensor turned by the angle about OA from where the static test "
-              "held it: the table's IA motion puts angle x w on PA and its PA motion -angle x w on IA, so the "
-              "cross term k_IP rectifies angle k_IP (w_IA^2 - w_PA^2) / 2 and k2 sees angle^2 w_PA^2; flat in "
-              "frequency where the terms are at the input, opposite in sign along IA and PA, nothing along OA";
+  e.physics = "the shaker fixture holds the sensor turned by small angles about OA and about PA from where the static "
+              "test held it: a turn about OA puts angle x w of the IA motion on PA and -angle x w of the PA motion on "
+              "IA, so k_IP rectifies angle k_IP (w_IA^2 - w_PA^2) / 2 and k2 sees angle^2 w_PA^2; a turn about PA does "
+              "the same with OA (k_IO); flat in frequency where the terms are at the input, opposite in sign along "
+              "the two axes the turn mixes";
   EffectParameter p("angle_about_OA_rad", "rad");
   p.example = 0.05;
   p.nominal = 0;
   p.grid = effects::symmetric_geometric(0.002, 0.2, 12);
-  e.parameters = {p};
+  // The natural form: the turn about PA, continuous (LM from 0), its prior +-0.2 rad.
+  EffectParameter b("angle_about_PA_rad", "rad");
+  b.nominal = 0, b.lower = -0.2, b.upper = 0.2, b.example = 0.05, b.prior_sigma = 0.1, b.step = 1e-3;
+  e.parameters = {p, b};
+  // The in-phase amplitudes turned by hand: about OA by a, then about PA by b (R_PA(b) R_OA(a)).
   e.hypothesis = [](ParameterValues v, plant::PlantConfig&, TableMotion& m) {
-    const double a0 = v[0];
-    if (a0 == 0) return;
-    const Vec3 a = effects::signed_in_phase(m.sine);  // turned about OA by a0
-    effects::set_in_phase(m.sine, Vec3(std::cos(a0) * a[0] - std::sin(a0) * a[1], std::sin(a0) * a[0] + std::cos(a0) * a[1], a[2]));
+    const double a0 = v[0], b0 = v[1];
+    if (a0 == 0 && b0 == 0) return;
+    const Vec3 a = effects::signed_in_phase(m.sine);
+    const Vec3 t(std::cos(a0) * a[0] - std::sin(a0) * a[1], std::sin(a0) * a[0] + std::cos(a0) * a[1], a[2]);
+    effects::set_in_phase(m.sine, Vec3(std::cos(b0) * t[0] + std::sin(b0) * t[2], t[1], -std::sin(b0) * t[0] + std::cos(b0) * t[2]));
   };
-  // The table's motion in sensor axes turned by the rotation about OA (the static gravity is
+  // The table's motion in sensor axes turned by the rotation matrices (the static gravity is
   // the run's stated orientation).
   e.truth = [](ParameterValues v, VirtualLab& lab) {
-    if (v[0] == 0) return;
-    const Eigen::Matrix3d turn = Eigen::AngleAxisd(v[0], Vec3::UnitZ()).toRotationMatrix();
+    if (v[0] == 0 && v[1] == 0) return;
+    const Eigen::Matrix3d turn =
+        (Eigen::AngleAxisd(v[1], Vec3::UnitY()) * Eigen::AngleAxisd(v[0], Vec3::UnitZ())).toRotationMatrix();
     effects::set_phasors(lab.table, turn.cast<std::complex<double>>() * effects::phasors(lab.table));
   };
   e.draw = [](std::mt19937_64& rng) {
     const double s = effects::random_sign(rng);
     return std::vector<double>{s * effects::log_uniform(rng, 0.02, 0.06)};  // 1.1-3.4 deg
+  };
+  e.draw_form = [](std::mt19937_64& rng) {
+    const double s = effects::random_sign(rng);
+    return std::vector<double>{s * effects::log_uniform(rng, 0.02, 0.06)};
   };
   return e;
 }

@@ -1,0 +1,135 @@
+// Effects in their natural form (issue 15): a campaign made by the virtual lab's truth hooks
+// (plant modules, shaker decorators; never the hypotheses) with a parameter set away from the
+// library's default form is diagnosed to the right effect, every fitted parameter within 3
+// sigma of the truth; and a clean campaign is not explained by the richer effects (the extra
+// freedom is judged on held-out runs fitted the same way). Seeds 51-54 were not used to develop
+// the fit. Each diagnoses a whole simulated campaign: label "campaign" (tests/CMakeLists.txt).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+#include "support/instrument.hpp"
+#include "validation/diagnosis/campaign.hpp"
+#include "validation/diagnosis/diagnose.hpp"
+
+using namespace vrelab;
+using namespace vrelab::validation;
+
+namespace {
+
+plant::PlantConfig truth() { return test::paper_like_plant(); }
+
+// One static orientation (the odd/even split is not what these tests are about), three
+// amplitudes (the folds leave one out), the directions each natural form needs.
+CampaignDesign design(std::vector<double> frequencies_Hz, std::vector<Vec3> directions) {
+  CampaignDesign d = default_design();
+  d.frequencies_Hz = std::move(frequencies_Hz);
+  d.amplitudes_g = {1, 2, 4};
+  d.directions = std::move(directions);
+  d.orientations_g = {Vec3(1, 0, 1).normalized()};
+  return d;
+}
+
+const FittedParameter& parameter(const EffectFit& e, const std::string& name) {
+  for (const FittedParameter& q : e.parameters)
+    if (q.name == name) return q;
+  throw std::logic_error(e.name + " has no parameter " + name);
+}
+
+// Every parameter the fit reports as fitted lies within 3 sigma of the truth (3 sigma: the
+// issue's bound; the first-order model's own error, 1 % of the change at most
+// (test_effect_sweep.cpp), is far inside it at these gaps); a held one sits at its nominal.
+void expect_within_3_sigma(const EffectFit& e, const std::vector<double>& truth_values) {
+  ASSERT_EQ(e.parameters.size(), truth_values.size());
+  for (std::size_t j = 0; j < truth_values.size(); ++j) {
+    const FittedParameter& q = e.parameters[j];
+    std::printf("  %s %s: %s %.6g +- %.3g (truth %.6g)\n", e.name.c_str(), q.name.c_str(), q.status.c_str(), q.value, q.sigma,
+                truth_values[j]);
+    SCOPED_TRACE(q.name + " " + q.status);
+    if (q.status == "fitted") {
+      ASSERT_TRUE(std::isfinite(q.sigma) && q.sigma > 0);
+      double diff = q.value - truth_values[j];
+      if (q.unit == "rad" && q.name.find("phase") != std::string::npos)
+        diff = std::remainder(diff, 2 * std::numbers::pi);  // a phase: the nearest turn
+      EXPECT_LE(std::abs(diff), 3 * q.sigma) << q.value << " +- " << q.sigma << " for " << truth_values[j];
+    } else if (q.status == "chosen") {
+      EXPECT_EQ(q.value, truth_values[j]);
+    }
+  }
+}
+
+}  // namespace
+
+// A mode at 1.8 kHz, damping 0.02, along PA (the default form: damping 0.05 along IA). Along
+// PA it reaches the output through k_IP (IA+PA runs) and the pendulum geometry; runs around
+// the resonance pin its damping. The axis is a discrete choice (docs/diagnose.md).
+TEST(NaturalForm, AModeAlongPaWithLowDampingIsFoundWithItsParameters) {
+  const std::vector<double> v = {1800, 0.02, 1};
+  const Campaign c = simulate_campaign(truth(), {HiddenEffect("mechanical_mode", v[0], {v[1], v[2]})},
+                                       design({100, 600, 1200, 1600, 1700, 1900, 2000},
+                                              {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0).normalized()}),
+                                       51, 2);
+  const Diagnosis d = diagnose(c);
+  ASSERT_TRUE(d.gap_significant) << d.where;
+  EXPECT_TRUE(d.explained) << d.verdict;
+  ASSERT_EQ(d.effects.front().name, "mechanical_mode") << d.verdict;
+  const EffectFit& e = d.effects.front();
+  EXPECT_EQ(parameter(e, "axis").status, "chosen");
+  EXPECT_EQ(parameter(e, "damping_ratio").status, "fitted");
+  expect_within_3_sigma(e, v);
+}
+
+// A 2nd harmonic at 90 degrees (the default form: phase 0): <a^3> = -(3/4) h sin(phi) w^3 acts
+// at the input, first order in h, so the phase is pinned.
+TEST(NaturalForm, ASecondHarmonicAtNinetyDegreesIsFoundWithItsPhase) {
+  const std::vector<double> v = {0.2, std::numbers::pi / 2};
+  const Campaign c = simulate_campaign(truth(), {HiddenEffect("shaker_harmonic_distortion", v[0], {v[1]})},
+                                       design({10, 100, 400, 1000}, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0).normalized()}),
+                                       52, 2);
+  const Diagnosis d = diagnose(c);
+  ASSERT_TRUE(d.gap_significant) << d.where;
+  EXPECT_TRUE(d.explained) << d.verdict;
+  ASSERT_EQ(d.effects.front().name, "shaker_harmonic_distortion") << d.verdict;
+  EXPECT_EQ(parameter(d.effects.front(), "second_harmonic_phase_rad").status, "fitted");
+  expect_within_3_sigma(d.effects.front(), v);
+}
+
+// A fixture turned 0.03 rad about OA and 0.05 rad about PA (the default form: about OA only):
+// the turn about PA mixes IA and OA through k_IO, so runs along OA are needed.
+TEST(NaturalForm, AMisalignmentAboutPaAndOaIsFoundWithBothAngles) {
+  const std::vector<double> v = {0.03, 0.05};
+  const Campaign c = simulate_campaign(truth(), {HiddenEffect("mounting_misalignment", v[0], {v[1]})},
+                                       design({10, 100, 400}, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1),
+                                                               Vec3(1, 1, 0).normalized()}),
+                                       53, 2);
+  const Diagnosis d = diagnose(c);
+  ASSERT_TRUE(d.gap_significant) << d.where;
+  EXPECT_TRUE(d.explained) << d.verdict;
+  ASSERT_EQ(d.effects.front().name, "mounting_misalignment") << d.verdict;
+  EXPECT_EQ(parameter(d.effects.front(), "angle_about_PA_rad").status, "fitted");
+  expect_within_3_sigma(d.effects.front(), v);
+}
+
+// No false alarm from the extra freedom: a clean campaign in the mode's design (every natural
+// form has something to fit there) has no gap, and no effect's held-out evidence reaches the
+// targeted test's 25 (the richer effects are fitted on the training runs as on all).
+TEST(NaturalForm, ACleanCampaignIsNotExplainedByTheRicherEffects) {
+  const Campaign c = simulate_campaign(truth(), {},
+                                       design({100, 600, 1200, 1600, 1700, 1900, 2000},
+                                              {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 0).normalized()}),
+                                       54, 2);
+  const Diagnosis d = diagnose(c);
+  EXPECT_FALSE(d.gap_significant) << d.where << "; " << d.verdict;
+  EXPECT_FALSE(d.explained) << d.verdict;
+  for (const EffectFit& e : d.effects) {
+    EXPECT_LT(e.evidence, 25) << e.name;
+    // No discrete form chosen for an effect the runs do not see.
+    for (const FittedParameter& q : e.parameters) EXPECT_NE(q.status, "chosen") << e.name << " " << q.name;
+    for (std::size_t j = 1; j < e.parameters.size(); ++j)
+      std::printf("  %s %s: %s %.6g (evidence %.2f)\n", e.name.c_str(), e.parameters[j].name.c_str(), e.parameters[j].status.c_str(),
+                  e.parameters[j].value, e.evidence);
+  }
+}
