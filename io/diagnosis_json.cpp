@@ -82,7 +82,7 @@ json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
                     {"heldout_after_g", x.heldout_after_g}});
     if (r.motion) {
       runs.back()["motion"] = to_json(r.motion->departure);
-      runs.back()["motion"]["used_by_prediction"] = !r.motion->tones.empty() || r.motion->random.has_value();
+      runs.back()["motion"]["used_by_prediction"] = r.motion->used();
     }
   }
   return runs;
@@ -265,7 +265,7 @@ json motion_summary_json(const validation::Diagnosis& d, const validation::Campa
   int sine = 0, sine_measured = 0;
   double rmin = INFINITY, rmax = -INFINITY;
   for (const auto& r : c.runs) {
-    if (!r.random) ++sine, sine_measured += r.motion ? 1 : 0;
+    if (!r.random) ++sine, sine_measured += r.motion && r.motion->used() ? 1 : 0;
     if (r.motion && std::isfinite(r.motion->departure.rms_ratio))
       rmin = std::min(rmin, r.motion->departure.rms_ratio), rmax = std::max(rmax, r.motion->departure.rms_ratio);
   }

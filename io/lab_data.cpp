@@ -242,12 +242,17 @@ rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, co
   rectification::MeasuredMotion mm;
   mm.present = a.present;
   mm.frequency_Hz = a.frequency_Hz;
+  // Only a reference on all three axes gives the motion: an axis without a channel would keep
+  // the commanded motion (no transverse part, and a phase unrelated to the measured axes'), so
+  // the table-motion effects would be neither measured nor fitted there. With fewer axes the
+  // departure is reported and the run is predicted from the command.
+  const bool all_axes = a.present[0] && a.present[1] && a.present[2];
   if (!r.random || r.sine_part) {
     const vibration::SineVibration cmd = r.vibration();
     Vec3 signed_g;
     for (int i = 0; i < 3; ++i) signed_g[i] = cmd.amplitude_g[i] * std::cos(cmd.phase_rad[i]);
     mm.departure = rectification::sine_departure(a, signed_g);
-    if (!r.random)
+    if (!r.random && all_axes)
       for (int h = 1; h <= 3; ++h) {
         Eigen::Vector3cd W = a.harmonic_g[static_cast<std::size_t>(h)];
         for (std::size_t i = 0; i < 3; ++i)
@@ -259,6 +264,7 @@ rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, co
   const vibration::RandomProfile& cmd = *r.random;
   const Eigen::Matrix3d C = vibration::gaussian_equivalent(cmd).covariance_g2();
   mm.departure = rectification::random_departure(a, C);
+  if (!all_axes) return mm;
   double lo = INFINITY, hi = 0;
   for (const auto& t : cmd.psd)
     if (t) lo = std::min(lo, t->rows.front().frequency_Hz), hi = std::max(hi, t->rows.back().frequency_Hz);
@@ -270,6 +276,10 @@ rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, co
   vibration::RandomProfile p = cmd;
   for (std::size_t i = 0; i < 3; ++i) {
     if (!a.present[i]) continue;
+    // A flat channel has no PSD to take (a disconnected reference reads a constant).
+    if (!(a.rms_g[static_cast<int>(i)] > 0))
+      throw std::invalid_argument(fmt::format("reference channel {}: flat over the vibration window (rms 0 g): no PSD to take",
+                                              i == 0 ? "ref_IA_g" : i == 1 ? "ref_PA_g" : "ref_OA_g"));
     vibration::PsdTable t = rectification::welch_table(a, static_cast<int>(i), lo, hi);
     if (t.rows.size() < 2)
       throw std::invalid_argument(fmt::format("reference channels: Welch's PSD ({:g} Hz bins) has fewer than 2 bins in the "

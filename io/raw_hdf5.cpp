@@ -263,7 +263,11 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
             throw InputError(fmt::format("{}: dataset {}[{}]: a sample is not a finite number ({})", path, c.name, at, c.block[j]));
           g[i] = c.block[j];
         }
-        reference(t, g, present);
+        try {
+          reference(t, g, present);
+        } catch (const std::invalid_argument& e) {
+          throw InputError(fmt::format("{}: sample {} (t = {} s): {}", path, at, t, e.what()));
+        }
       }
     }
   }

@@ -266,7 +266,12 @@ MotionDeparture sine_departure(const ReferenceAnalysis& a, const Vec3& commanded
     }
   }
   const double A = commanded_g.norm();
-  if (A > 0 && w1 > 0) {
+  // The harmonic and transverse ratios are about the commanded direction: only when every axis
+  // it has a part on is measured (else |W_1| is a transverse part alone).
+  bool along_measured = true;
+  for (int i = 0; i < 3; ++i) along_measured = along_measured && (commanded_g[i] == 0 || a.present[static_cast<std::size_t>(i)]);
+  if (!along_measured) d.harmonic2_ratio = d.harmonic2_sigma = d.harmonic3_ratio = d.harmonic3_sigma = NAN;
+  if (A > 0 && w1 > 0 && along_measured) {
     const Vec3 dir = commanded_g / A;
     // The part along d (complex: its phase is the table's), the rest across.
     const std::complex<double> along = dir.cast<std::complex<double>>().dot(W1);

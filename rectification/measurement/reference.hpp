@@ -137,6 +137,8 @@ struct MeasuredMotion {
   std::vector<std::pair<int, Eigen::Vector3cd>> tones;  // (h, W_h), h = 1, 2, 3
   std::optional<vibration::RandomProfile> random;
   MotionDeparture departure;
+  // The prediction takes the motion as measured (tones or random hold it); else it is reported only.
+  bool used() const { return !tones.empty() || random.has_value(); }
 };
 vibration::PsdTable welch_table(const ReferenceAnalysis& a, int axis, double from_Hz, double to_Hz);
 

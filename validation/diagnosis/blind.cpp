@@ -37,7 +37,7 @@ BlindCampaign draw_campaign(int i, std::uint64_t seed, const std::vector<std::st
     k.category = "clean";
   } else if (slot == 2) {
     k.category = "out_of_library";
-    k.hidden.push_back(draw_effect(i / 12 % 2 == 0 ? "shaker_third_harmonic" : "readout_clipping", rng));
+    k.hidden.push_back(draw_effect("readout_clipping", rng));
   } else if (slot == 4) {
     k.category = "sigma_understated";
     k.noise_scale = std::uniform_real_distribution<double>(1.8, 3.0)(rng);

@@ -44,6 +44,7 @@ rectification::PeriodicInput periodic_input(const TableMotion& m, double frequen
 // a random run's Welch PSD its random part. The table-motion effects are measured in such a
 // run, not applied to it.
 bool measured_sine(const RunRecord& r) { return r.motion && !r.motion->tones.empty(); }
+bool motion_used(const RunRecord& r) { return r.motion && r.motion->used(); }
 const vibration::RandomProfile& run_random(const RunRecord& r) {
   return r.motion && r.motion->random ? *r.motion->random : *r.random;
 }
@@ -57,7 +58,7 @@ rectification::PeriodicInput run_input(const RunRecord& r, const TableMotion& m)
 // (values: every parameter of e.) A run whose table motion was measured (reference channels)
 // already holds what a table-motion effect does.
 void apply_effect(const Effect* e, ParameterValues values, const RunRecord& r, PlantConfig& cfg, TableMotion& m) {
-  if (!e || (r.motion && e->acts_on == ActsOn::table_motion)) return;
+  if (!e || (motion_used(r) && e->acts_on == ActsOn::table_motion)) return;
   e->apply(values, cfg, m);  // a random run: what the effect does to the table's motion is not applied
 }
 
@@ -1065,8 +1066,8 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
   {
     int sine_runs = 0, measured_sine_runs = 0;
     for (const RunRecord& r : c.runs) {
-      if (r.motion) ++d.runs_with_measured_motion;
-      if (!r.random) ++sine_runs, measured_sine_runs += r.motion ? 1 : 0;
+      if (motion_used(r)) ++d.runs_with_measured_motion;
+      if (!r.random) ++sine_runs, measured_sine_runs += motion_used(r) ? 1 : 0;
     }
     if (sine_runs > 0 && measured_sine_runs == sine_runs)
       for (const Effect& e : effect_library())
@@ -1365,7 +1366,7 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
       const EffectParameter& q = e.parameters[j];
       FittedParameter fp{q.name, q.unit, mf.values[j], mf.sigma[j], mf.status[j], q.lower, q.upper};
       if (j == 0 && !q.linear && !q.grid.empty()) fp.lower = q.grid.front(), fp.upper = q.grid.back();
-      if (j == 0) fp.at_bound = sc.fit.at_bound;
+      if (j == 0) fp.at_bound = sc.fit.at_bound || fp.value <= fp.lower || fp.value >= fp.upper;
       else if (fp.status == "fitted" && !q.periodic) fp.at_bound = fp.value <= q.lower || fp.value >= q.upper;
       sc.fit.parameters.push_back(fp);
     }
