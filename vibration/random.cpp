@@ -16,17 +16,18 @@
 #include <type_traits>
 
 namespace vrelab::vibration {
+
+std::mutex& fftw_planner_mutex() {
+  static std::mutex m;
+  return m;
+}
 namespace {
 
 constexpr const char* kAxis[3] = {"IA", "PA", "OA"};
 
 // RAII owners for FFTW: buffers from fftw_malloc freed by fftw_free, plans destroyed by
-// fftw_destroy_plan. The FFTW planner is not thread-safe: creating and destroying plans
-// holds one process-wide mutex (fftw_execute itself is thread-safe).
-std::mutex& planner_mutex() {
-  static std::mutex m;
-  return m;
-}
+// fftw_destroy_plan under fftw_planner_mutex() (random.hpp).
+std::mutex& planner_mutex() { return fftw_planner_mutex(); }
 struct FftwFree {
   void operator()(void* p) const { fftw_free(p); }
 };

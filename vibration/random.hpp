@@ -28,6 +28,7 @@
 // axis), plus 16 (N/2 + 1) bytes of FFT buffer per axis while transforming. For long runs
 // use RandomExcitation (vibration/sampled.hpp), which synthesises in blocks.
 #include <array>
+#include <mutex>
 #include <cstdint>
 #include <optional>
 #include <span>
@@ -38,6 +39,11 @@
 #include "vibration/psd.hpp"
 
 namespace vrelab::vibration {
+
+// FFTW's planner is not thread-safe: every plan in the process (the excitation's synthesis
+// here, the reference channels' Welch in rectification/measurement/reference.cpp) is made and
+// destroyed under this one mutex (fftw_execute itself is thread-safe).
+std::mutex& fftw_planner_mutex();
 
 enum class AxisCoupling { independent, common };
 

@@ -9,16 +9,15 @@
 #include <fftw3.h>
 #include <fmt/format.h>
 
+#include "vibration/random.hpp"
+
 namespace vrelab::rectification {
 namespace {
 
 constexpr const char* kAxis[3] = {"IA", "PA", "OA"};
 
-// FFTW's planner is not thread-safe: plans are made and destroyed under this mutex.
-std::mutex& planner_mutex() {
-  static std::mutex m;
-  return m;
-}
+// FFTW's planner is not thread-safe: the process's one planner mutex (vibration/random.hpp).
+std::mutex& planner_mutex() { return vibration::fftw_planner_mutex(); }
 
 }  // namespace
 

@@ -493,7 +493,8 @@ class EffectFitter {
     for (std::size_t a = 0; a < free.size(); ++a) {
       const int j = free[a];
       const double h = step(v, j);
-      const auto [lo, hi] = range(j);
+      const std::pair<double, double> bounds = range(j);
+      const double lo = bounds.first, hi = bounds.second;  // (named: a lambda captures them)
       const auto pred_at = [&](double x) -> std::optional<Eigen::VectorXd> {
         if (x < lo || x > hi) return std::nullopt;
         try {
