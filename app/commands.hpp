@@ -92,6 +92,7 @@ void run_campaign(const CampaignOptions& o, std::ostream& out);
 
 struct DiagnoseOptions {
   std::string dir, json_path, report_dir;
+  bool check = false;  // read and check the folder only (no diagnosis, nothing written)
   io::DiagnoseOverrides settings;  // over the manifest's [diagnose]
   // Many campaigns (io/batch.hpp): the folders given, the summary CSV, threads, progress.
   std::vector<std::string> dirs;

@@ -35,15 +35,17 @@ void run_campaign(const CampaignOptions& o, std::ostream& out) {
 }
 
 int run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
-  const io::FolderDiagnosis f = io::diagnose_folder(o.dir, o.settings);
-  out << program() << f.FullReport();
+  if (o.check && (!o.json_path.empty() || !o.report_dir.empty()))
+    throw io::InputError("diagnose --check: reads and checks only; --json and --report need a diagnosis");
+  const io::FolderDiagnosis f = o.check ? io::read_folder(o.dir, o.settings) : io::diagnose_folder(o.dir, o.settings);
+  out << program() << (o.check ? f.CheckReport() : f.FullReport());
   if (!o.json_path.empty()) io::write_atomic(o.json_path, io::json_text(io::to_json(f)));
   if (!o.report_dir.empty()) io::write_diagnosis_report(f, o.report_dir);
   // Bad runs are input errors: the others are diagnosed and written, and the exit code says
   // that the campaign was not read whole (docs/data-format.md, "Bad input").
   if (f.campaign.skipped.empty()) return 0;
-  std::cerr << fmt::format("diagnose: {}: {} run(s) skipped for bad input (listed above); the others diagnosed\n", o.dir,
-                           f.campaign.skipped.size());
+  std::cerr << fmt::format("diagnose: {}: {} run(s) skipped for bad input (listed above); the others {}\n", o.dir,
+                           f.campaign.skipped.size(), o.check ? "read" : "diagnosed");
   return 2;
 }
 

@@ -217,6 +217,8 @@ Command add_diagnose(CLI::App& app) {
   cmd->add_flag_callback("--no-progress", [&o] { o.progress = false; }, "With --summary: no progress bar");
   cmd->add_option("--json", o.json_path, "Write the diagnosis as JSON");
   cmd->add_option("--report", o.report_dir, "Write report.md, report.html and diagnosis.json to this folder");
+  cmd->add_flag("--check", o.check,
+                "Read and check the folder only (every file, run and setting; exit 2 naming what is bad); no diagnosis");
   // DiagnoseSettings over the manifest's [diagnose] (docs/data-format.md).
   cmd->add_option("--significance-sigma", o.settings.significance_sigma,
                   "A gap is significant beyond this many sigma (5)");
@@ -229,7 +231,10 @@ Command add_diagnose(CLI::App& app) {
   return {cmd,
           [owned] {
             DiagnoseOptions& d = *owned;
-            if (!d.summary_path.empty()) return run_diagnose_many(d, std::cout) > 0 ? 2 : 0;
+            if (!d.summary_path.empty()) {
+              if (d.check) throw InputError("diagnose --check: one campaign folder at a time (not with --summary)");
+              return run_diagnose_many(d, std::cout) > 0 ? 2 : 0;
+            }
             if (d.dirs.size() > 1)
               throw InputError("diagnose: several campaign folders need --summary FILE (one row per campaign)");
             d.dir = d.dirs.front();

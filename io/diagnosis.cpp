@@ -70,7 +70,7 @@ std::string CampaignWritten::FullReport() const {
                      request.key_path, wall_s);
 }
 
-FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& o) {
+FolderDiagnosis read_folder(const std::string& dir, const DiagnoseOverrides& o) {
   FolderDiagnosis f;
   f.dir = dir;
   f.campaign = read_campaign(dir, &f.manifest);  // checks the manifest's [diagnose]
@@ -87,13 +87,19 @@ FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides&
   if (o.any()) f.settings_from += ", set over by the caller";
   std::string why;
   if (!s.IsValid(&why)) throw InputError("diagnose settings: " + why);
+  return f;
+}
+
+FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& o) {
+  FolderDiagnosis f = read_folder(dir, o);
   const auto start = Clock::now();
   try {
-    f.diagnosis = validation::diagnose(c, s);
+    f.diagnosis = validation::diagnose(f.campaign, f.settings);
   } catch (const std::invalid_argument& e) {
     throw InputError(dir + ": " + e.what());
   }
   f.wall_s = seconds_since(start);
+  f.diagnosed = true;
   return f;
 }
 
@@ -112,6 +118,20 @@ std::string header(const FolderDiagnosis& f) {
 }  // namespace
 
 std::string FolderDiagnosis::BriefReport() const { return header(*this) + diagnosis.BriefReport(); }
+
+std::string FolderDiagnosis::CheckReport() const {
+  const validation::Campaign& c = campaign;
+  int random = 0, sine_on_random = 0, referenced = 0;
+  for (const auto& r : c.runs) {
+    if (r.random) ++(r.sine_part ? sine_on_random : random);
+    if (r.motion) ++referenced;
+  }
+  return header(*this) +
+         fmt::format("Read and checked (no diagnosis): {} sine, {} random and {} sine-on-random runs; {} with a reference "
+                     "channel; the settings ({}) valid\n",
+                     c.runs.size() - static_cast<std::size_t>(random + sine_on_random), random, sine_on_random, referenced,
+                     settings_from);
+}
 
 std::string FolderDiagnosis::FullReport() const {
   return header(*this) + diagnosis.FullReport(wall_s);

@@ -34,6 +34,8 @@ struct CampaignWritten {
   double wall_s = 0;         // simulation and writing
   std::string BriefReport() const;
   std::string FullReport() const;
+  // "diagnose DIR", the counts, the skipped runs, then what was read (read_folder's result).
+  std::string CheckReport() const;
 };
 
 CampaignWritten write_virtual_campaign(const CampaignRequest& request);
@@ -57,11 +59,17 @@ struct FolderDiagnosis {
   std::string settings_from;              // where they came from (defaults, the manifest, overrides)
   validation::Diagnosis diagnosis;
   double wall_s = 0;  // the diagnosis alone
+  bool diagnosed = false;  // false: read and checked only (read_folder)
   // "diagnose DIR", the counts, then the verdict (brief) or everything the diagnosis found (full).
   std::string BriefReport() const;
   std::string FullReport() const;
+  // "diagnose DIR", the counts, the skipped runs, then what was read (read_folder's result).
+  std::string CheckReport() const;
 };
 
+// The campaign read and checked, the settings resolved and validated; no diagnosis
+// (`diagnose --check`). InputError as diagnose_folder's.
+FolderDiagnosis read_folder(const std::string& dir, const DiagnoseOverrides& overrides = {});
 FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& overrides = {});
 
 }  // namespace vrelab::io

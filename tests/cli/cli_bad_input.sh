@@ -107,8 +107,7 @@ awk 'BEGIN { print "time_s,output_mA"; for (k = 0; k <= 130; ++k) print -0.02 + 
   >"$tmp/lab/rec.csv"  # 1 kHz, 4 periods of 40 Hz under vibration; the NaN on line 72
 sed -i -e 's/^id,frequency_Hz,.*sigma_ug$/&,series,rest_from_s,rest_to_s,on_from_s,on_to_s/' \
   -e 's/^\(ia-40Hz-4g,.*\)$/\1,rec.csv,-0.0155,-0.0045,0.0045,0.1045/' "$tmp/lab/runs.csv"
-expect 2 "skipped: .*rec.csv:72: a sample is not a finite number" diagnose "$tmp/lab"
-expect 2 'Verdict: explained by pickoff_nonlinearity' diagnose "$tmp/lab"
+expect 2 "skipped: .*rec.csv:72: a sample is not a finite number" diagnose --check "$tmp/lab"
 # diagnose's settings, from the command line over the manifest's [diagnose]: a bad one exits 2
 # naming the key and why, before any output.
 expect 2 'significance_sigma = -1: must be a positive' diagnose "$cases/lab-example" --significance-sigma -1 --json "$tmp/o/s.json"
@@ -118,6 +117,9 @@ expect 2 'manifest.toml:[0-9]+: \[diagnose\] significance_sigm: unknown key' dia
 sed -i 's/^significance_sigm = .*/explained_shrinkage = 1.5/' "$tmp/lab/manifest.toml"
 expect 2 '\[diagnose\] explained_shrinkage = 1.5: .*in \(0, 1\]' diagnose "$tmp/lab"
 sed -i 's/^explained_shrinkage = .*/explained_shrinkage = 0.8/' "$tmp/lab/manifest.toml"
+# ... the settings good again: the NaN run skipped (exit 2), the others diagnosed.
 expect 2 'Verdict: explained by pickoff_nonlinearity' diagnose "$tmp/lab" --significance-sigma 4 --no-pairs --resimulate-runs 0
+expect 2 'diagnose --check: reads and checks only' diagnose --check "$cases/lab-example" --json "$tmp/o/c.json"
+[ -e "$tmp/o/c.json" ] && { echo "FAIL: diagnose --check wrote JSON"; fail=$((fail + 1)); }
 echo "$pass passed, $fail failed"
 [ "$fail" -eq 0 ]

@@ -272,15 +272,15 @@ TEST(RawHdf5, BadRecordsSkipTheRunNamingTheFileAndTheDataset) {
   camp = io::read_campaign(c.dir);
   ASSERT_EQ(camp.skipped.size(), 1u);
   EXPECT_TRUE(std::regex_search(camp.skipped[0], std::regex(R"(ia-400Hz-4g\.h5: cannot open the series)"))) << camp.skipped[0];
-  // `vrelab diagnose` on it: the run listed as skipped, the others diagnosed (exit 0, as for
-  // a bad CSV record: tests/cli/cli_bad_input.sh).
+  // `vrelab diagnose --check` on it: the run listed as skipped, exit 2 (the others diagnosed
+  // by `diagnose` itself: tests/cli/cli_bad_input.sh, a bad CSV record).
   std::ostringstream text;
   app::DiagnoseOptions o;
   o.dir = c.dir;
-  o.settings.resimulate_runs = 0;
-  app::run_diagnose(o, text);
+  o.check = true;
+  EXPECT_EQ(app::run_diagnose(o, text), 2);
   EXPECT_TRUE(std::regex_search(text.str(), std::regex(R"(ia-400Hz-4g\.h5: cannot open the series)"))) << text.str();
-  EXPECT_TRUE(std::regex_search(text.str(), std::regex("Verdict: explained by pickoff_nonlinearity"))) << text.str();
+  EXPECT_TRUE(std::regex_search(text.str(), std::regex(R"(9 shaker runs \(1 skipped\))"))) << text.str();
 }
 
 TEST(RawHdf5, MeasureReadsAnHdf5SeriesAsItsCsv) {
