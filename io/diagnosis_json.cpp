@@ -64,6 +64,7 @@ json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
     const auto& r = c.runs[k];
     const auto& x = d.runs[k];
     runs.push_back({{"id", r.id},
+                    {"kind", !r.random ? "sine" : r.sine_part ? "sine_on_random" : "random"},
                     {"frequency_Hz", r.frequency_Hz},
                     {"amplitude_g", r.amplitude_g},
                     {"direction", vec_json(r.direction)},
