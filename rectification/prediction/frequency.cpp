@@ -116,6 +116,12 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
 
 FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
                                                     std::optional<double> range_g, const LoopResponse& h) {
+  return PreparedSineRectification(config, a, v, range_g, h)(config.coefficients);
+}
+
+PreparedSineRectification::PreparedSineRectification(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
+                                                     std::optional<double> range_g, const LoopResponse& h)
+    : location_(config.location), a_(a), range_(range_g) {
   if (std::abs(h.frequency_Hz - v.frequency_Hz) > 1e-9 * v.frequency_Hz)
     throw std::invalid_argument("sine_rectification_at_frequency: the loop response is for another frequency");
   double p2 = 0.0;
@@ -123,45 +129,52 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
   for (const auto& e : config.effects) {
     p2 += e->pickoff_p2_per_rad();
     geometry = geometry || e->vibropendulous();
+    if (e->readout_averaged_in_prediction()) readout_.push_back(e);
   }
-  Eigen::Vector3cd W, F;  // the case's vibration, and what the pendulum's base feels
-  vibration::SineVibration felt = v;
+  Eigen::Vector3cd W;  // the case's vibration; F_: what the pendulum's base feels
+  felt_ = v;
   for (int i = 0; i < 3; ++i) {
     W[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
-    F[i] = h.mechanical[static_cast<std::size_t>(i)] * W[i];
-    felt.amplitude_g[i] = std::abs(F[i]);
-    felt.phase_rad[i] = std::arg(F[i]);
+    F_[i] = h.mechanical[static_cast<std::size_t>(i)] * W[i];
+    felt_.amplitude_g[i] = std::abs(F_[i]);
+    felt_.phase_rad[i] = std::arg(F_[i]);
   }
-  const std::complex<double> current = h.current[0] * W[0] + h.current[1] * W[1] + h.current[2] * W[2];
+  current_ = h.current[0] * W[0] + h.current[1] * W[1] + h.current[2] * W[2];
   const double dc_gain = h.dc_gain;
-  FrequencyPrediction out;
-  out.current_amplitude_g = current;
+  FrequencyPrediction& out = fixed_;
+  out.current_amplitude_g = current_;
   out.angle_amplitude_rad = h.angle_rad[0] * W[0] + h.angle_rad[1] * W[1] + h.angle_rad[2] * W[2];
-
-  // Terms of (1): each through the place where it acts.
-  const double amp_i = std::abs(current);
-  vibration::SineVibration through_loop = felt;
-  through_loop.amplitude_g[IA] = amp_i;
-  for (int c = k0; c < kNumCoefficients; ++c) {
-    if (c == k0 || c == delta_OA || c == delta_PA || config.coefficients[c] == 0) continue;
-    Coefficients only;
-    only[K1] = 1;
-    only[c] = config.coefficients[c];
-    const bool ia_term = c <= k4;
-    const bool filtered = ia_term && config.location[c] != Location::input;
-    const Eq3Terms t = sine_rectification(only, a, filtered ? through_loop : felt);
-    // What rectifies before the loop (input, torquer) reaches the output with the loop's DC gain.
-    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
-    for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
-  }
-  if (range_g) out.terms.g[t_clipping] = clipping_sine(a[IA], amp_i, *range_g);
+  amp_i_ = std::abs(current_);
+  through_loop_ = felt_;
+  through_loop_.amplitude_g[IA] = amp_i_;
   // Effects beyond (1), from the averaged torque balance.
   const Dynamics& d = config.dynamics;
   const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
   const std::complex<double> theta = out.angle_amplitude_rad;
   out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * std::norm(theta) / 2;
   if (geometry)
-    out.pendulum_geometry_g = dc_gain * (-0.5 * std::real(F[PA] * std::conj(theta)) - a[IA] * std::norm(theta) / 4);
+    out.pendulum_geometry_g = dc_gain * (-0.5 * std::real(F_[PA] * std::conj(theta)) - a[IA] * std::norm(theta) / 4);
+  out.loop_dc_gain = dc_gain;
+}
+
+FrequencyPrediction PreparedSineRectification::operator()(const Coefficients& coefficients) const {
+  FrequencyPrediction out = fixed_;
+  const double dc_gain = fixed_.loop_dc_gain;
+  // Terms of (1): each through the place where it acts.
+  for (int c = k0; c < kNumCoefficients; ++c) {
+    if (c == k0 || c == delta_OA || c == delta_PA || coefficients[c] == 0) continue;
+    Coefficients only;
+    only[K1] = 1;
+    only[c] = coefficients[c];
+    const bool ia_term = c <= k4;
+    const bool filtered = ia_term && location_[c] != Location::input;
+    const Eq3Terms t = sine_rectification(only, a_, filtered ? through_loop_ : felt_);
+    // What rectifies before the loop (input, torquer) reaches the output with the loop's DC gain.
+    const double gain = location_[c] == Location::output ? 1.0 : dc_gain;
+    for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
+  }
+  if (range_) out.terms.g[t_clipping] = clipping_sine(a_[IA], amp_i_, *range_);
+  if (readout_.empty()) return out;
   // A readout polynomial: the period average of R over the output's oscillation, by the
   // trapezoidal rule on 32 points (exact for a trigonometric polynomial of degree < 32).
   // U: the output's oscillation, the current plus the output-placed cross terms' linear part
@@ -169,18 +182,16 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
   Coefficients cross_out;
   cross_out[K1] = 1;
   for (int c = delta_OA; c < kNumCoefficients; ++c)
-    if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
-  const Vec3 slope = plant::output_gradient(cross_out, a) - Vec3::UnitX();
-  std::complex<double> U = current + slope[IA] * F[IA] + slope[PA] * F[PA] + slope[OA] * F[OA];
-  const double u0 = plant::output_g(config.coefficients, a);
-  for (const auto& e : config.effects) {
-    if (!e->readout_averaged_in_prediction()) continue;
+    if (location_[c] == Location::output) cross_out[c] = coefficients[c];
+  const Vec3 slope = plant::output_gradient(cross_out, a_) - Vec3::UnitX();
+  std::complex<double> U = current_ + slope[IA] * F_[IA] + slope[PA] * F_[PA] + slope[OA] * F_[OA];
+  const double u0 = plant::output_g(coefficients, a_);
+  for (const auto& e : readout_) {
     constexpr int kN = 32;
     double mean = 0;
     for (int k = 0; k < kN; ++k) mean += e->readout(u0 + std::real(U * std::polar(1.0, 2 * std::numbers::pi * k / kN)));
     out.readout_g += mean / kN - e->readout(u0);
   }
-  out.loop_dc_gain = dc_gain;
   return out;
 }
 
@@ -227,101 +238,120 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
 
 FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3& a, const PeriodicInput& in,
                                            const ResponseAt& response, bool allow_closed_form) {
+  return PreparedPeriodicRectification(config, a, in, response, allow_closed_form)(config.coefficients);
+}
+
+PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& config, const Vec3& a, const PeriodicInput& in,
+                                                             const ResponseAt& response, bool allow_closed_form)
+    : location_(config.location), a_(a), mean_g_(in.mean_g) {
   if (!(in.frequency_Hz > 0)) throw std::invalid_argument("periodic_rectification: frequency_Hz must be positive");
   if (allow_closed_form && in.single_tone()) {
     vibration::SineVibration v;
     v.frequency_Hz = in.frequency_Hz;
     const Eigen::Vector3cd& w = in.tones.front().second;
     for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(w[i]), v.phase_rad[i] = std::arg(w[i]);
-    return sine_rectification_at_frequency(config, a, v, std::nullopt, response(in.frequency_Hz));
+    closed_form_.emplace(config, a, v, std::nullopt, response(in.frequency_Hz));
+    return;
   }
   double p2 = 0.0;
   bool geometry = false;
   for (const auto& e : config.effects) {
     p2 += e->pickoff_p2_per_rad();
     geometry = geometry || e->vibropendulous();
+    if (e->readout_averaged_in_prediction()) readout_.push_back(e);
   }
-  // Per harmonic: what the pendulum's base feels F, the rebalance current I, the angle Theta,
-  // and the output's oscillation U (the current plus the output-placed cross terms' slope).
-  Coefficients cross_out;
-  cross_out[K1] = 1;
-  for (int c = delta_OA; c < kNumCoefficients; ++c)
-    if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
-  const Vec3 slope = plant::output_gradient(cross_out, a) - Vec3::UnitX();
-  struct Harmonic {
-    int h;
-    Eigen::Vector3cd F;
-    std::complex<double> I, Theta, U;
-  };
-  std::vector<Harmonic> hs;
+  // Per harmonic: what the pendulum's base feels F, the rebalance current I, the angle Theta
+  // (and, per coefficients, the output's oscillation U: the current plus the output-placed
+  // cross terms' slope).
   double dc_gain = 1.0;
   for (const auto& [h, W] : in.tones) {
     const LoopResponse r = response(h * in.frequency_Hz);
     dc_gain = r.dc_gain;
-    Harmonic x{h, Eigen::Vector3cd::Zero(), 0.0, 0.0, 0.0};
+    Harmonic x{h, Eigen::Vector3cd::Zero(), 0.0, 0.0};
     for (int j = 0; j < 3; ++j) {
       const auto sj = static_cast<std::size_t>(j);
       x.F[j] = r.mechanical[sj] * W[j];
       x.I += r.current[sj] * W[j];
       x.Theta += r.angle_rad[sj] * W[j];
     }
-    x.U = x.I + slope[IA] * x.F[IA] + slope[PA] * x.F[PA] + slope[OA] * x.F[OA];
-    hs.push_back(x);
+    hs_.push_back(x);
   }
-  FrequencyPrediction out;
+  FrequencyPrediction& out = fixed_;
   out.loop_dc_gain = dc_gain;
-  if (!hs.empty() && hs.front().h == 1) out.current_amplitude_g = hs.front().I, out.angle_amplitude_rad = hs.front().Theta;
+  if (!hs_.empty() && hs_.front().h == 1) out.current_amplitude_g = hs_.front().I, out.angle_amplitude_rad = hs_.front().Theta;
 
   // One period on kM points: the felt acceleration (about the static point moved by the
   // input's mean) and the current's oscillation; each coefficient's basis function averaged
-  // at its place, less its static value.
+  // at its place (less its static value, per coefficients).
   int h_max = 1;
-  for (const Harmonic& x : hs) h_max = std::max(h_max, x.h);
+  for (const Harmonic& x : hs_) h_max = std::max(h_max, x.h);
   const int kM = std::max(64, 6 * h_max + 1);  // exact for degree-6 trigonometric polynomials
+  points_ = kM;
   const Vec3 a_mean = a + in.mean_g;
-  std::array<double, kNumCoefficients> at_input{}, in_loop{};
-  const plant::Basis b0 = plant::basis(a);
-  double readout_mean = 0, u0 = plant::output_g(config.coefficients, a);
-  const double u_mean = u0 + in.mean_g[IA] + slope.dot(in.mean_g);
+  b0_ = plant::basis(a);
+  if (!readout_.empty()) phasors_.reserve(static_cast<std::size_t>(kM) * hs_.size());
   for (int k = 0; k < kM; ++k) {
     const double phi = 2 * std::numbers::pi * k / kM;
     Vec3 felt = a_mean;
-    double current = 0, u = u_mean;
-    for (const Harmonic& x : hs) {
+    double current = 0;
+    for (const Harmonic& x : hs_) {
       const std::complex<double> e = std::polar(1.0, x.h * phi);
       for (int i = 0; i < 3; ++i) felt[i] += std::imag(x.F[i] * e);
       current += std::imag(x.I * e);
-      u += std::imag(x.U * e);
+      if (!readout_.empty()) phasors_.push_back(e);
     }
     const plant::Basis bf = plant::basis(felt);
     Vec3 loop = felt;
     loop[IA] = a_mean[IA] + current;
     const plant::Basis bl = plant::basis(loop);
-    for (int c = 0; c < kNumCoefficients; ++c) at_input[c] += bf[c] / kM, in_loop[c] += bl[c] / kM;
-    for (const auto& e : config.effects)
-      if (e->readout_averaged_in_prediction()) readout_mean += (e->readout(u) - u) / kM;
+    for (int c = 0; c < kNumCoefficients; ++c) at_input_[c] += bf[c] / kM, in_loop_[c] += bl[c] / kM;
   }
-  for (int c = k1_asym; c < kNumCoefficients; ++c) {
-    if (config.coefficients[c] == 0) continue;
-    const bool filtered = c <= k4 && config.location[c] != Location::input;
-    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
-    const double g = gain * config.coefficients[c] * ((filtered ? in_loop[c] : at_input[c]) - b0[c]);
-    const int t = term_of_coefficient(c);  // -1: the misalignments, from the input's mean
-    if (t >= 0) out.terms.g[t] += g;
-    else out.input_mean_g += g;
-  }
-  out.input_mean_g += dc_gain * in.mean_g[IA];
-  for (const auto& e : config.effects)
-    if (e->readout_averaged_in_prediction()) readout_mean -= e->readout(u0) - u0;
-  out.readout_g = readout_mean;
+  out.input_mean_g = 0.0;
   // Effects beyond (1): quadratic in the angle, so harmonics add (their cross products
   // average out over a period).
   const Dynamics& d = config.dynamics;
   const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
   double theta2 = 0, pa_theta = 0;  // <theta^2>, <f_PA theta>
-  for (const Harmonic& x : hs) theta2 += std::norm(x.Theta) / 2, pa_theta += std::real(x.F[PA] * std::conj(x.Theta)) / 2;
+  for (const Harmonic& x : hs_) theta2 += std::norm(x.Theta) / 2, pa_theta += std::real(x.F[PA] * std::conj(x.Theta)) / 2;
   out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * theta2;
   if (geometry) out.pendulum_geometry_g = dc_gain * (-pa_theta - a_mean[IA] * theta2 / 2);
+}
+
+FrequencyPrediction PreparedPeriodicRectification::operator()(const Coefficients& coefficients) const {
+  if (closed_form_) return (*closed_form_)(coefficients);
+  FrequencyPrediction out = fixed_;
+  const double dc_gain = fixed_.loop_dc_gain;
+  for (int c = k1_asym; c < kNumCoefficients; ++c) {
+    if (coefficients[c] == 0) continue;
+    const bool filtered = c <= k4 && location_[c] != Location::input;
+    const double gain = location_[c] == Location::output ? 1.0 : dc_gain;
+    const double g = gain * coefficients[c] * ((filtered ? in_loop_[c] : at_input_[c]) - b0_[c]);
+    const int t = term_of_coefficient(c);  // -1: the misalignments, from the input's mean
+    if (t >= 0) out.terms.g[t] += g;
+    else out.input_mean_g += g;
+  }
+  out.input_mean_g += dc_gain * mean_g_[IA];
+  if (readout_.empty()) return out;
+  // The readout polynomials averaged over the output's oscillation u (the static output moved
+  // by the input's mean, plus each harmonic's U).
+  Coefficients cross_out;
+  cross_out[K1] = 1;
+  for (int c = delta_OA; c < kNumCoefficients; ++c)
+    if (location_[c] == Location::output) cross_out[c] = coefficients[c];
+  const Vec3 slope = plant::output_gradient(cross_out, a_) - Vec3::UnitX();
+  std::vector<std::complex<double>> U;
+  for (const Harmonic& x : hs_) U.push_back(x.I + slope[IA] * x.F[IA] + slope[PA] * x.F[PA] + slope[OA] * x.F[OA]);
+  const double u0 = plant::output_g(coefficients, a_);
+  const double u_mean = u0 + mean_g_[IA] + slope.dot(mean_g_);
+  const int kM = points_;
+  double readout_mean = 0;
+  for (int k = 0; k < kM; ++k) {
+    double u = u_mean;
+    for (std::size_t j = 0; j < hs_.size(); ++j) u += std::imag(U[j] * phasors_[static_cast<std::size_t>(k) * hs_.size() + j]);
+    for (const auto& e : readout_) readout_mean += (e->readout(u) - u) / kM;
+  }
+  for (const auto& e : readout_) readout_mean -= e->readout(u0) - u0;
+  out.readout_g = readout_mean;
   return out;
 }
 

@@ -24,6 +24,8 @@
 #include <array>
 #include <complex>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -112,5 +114,54 @@ using ResponseAt = std::function<LoopResponse(double frequency_Hz)>;
 FrequencyPrediction periodic_rectification(const plant::PlantConfig& plant, const Vec3& a_static_g,
                                            const PeriodicInput& input, const ResponseAt& response,
                                            bool allow_closed_form = true);
+
+// The same two predictions split in two (for a caller that varies the coefficients only, such
+// as a prediction's gradient in them): what does not depend on the coefficients (the vibration
+// through the loop's response; for a periodic input, the period's samples of the felt
+// acceleration and the current and the basis functions' averages) computed once, and what
+// does (the terms of (1), the readout) for any coefficients. prepared(c) equals the function
+// above for the plant with its coefficients replaced by c, bit for bit (the functions above
+// are these). The plant's effects, locations and dynamics are the constructor's.
+class PreparedSineRectification {
+ public:
+  PreparedSineRectification(const plant::PlantConfig& plant, const Vec3& a_static_g, const vibration::SineVibration& v,
+                            std::optional<double> range_limit_g, const LoopResponse& response);
+  FrequencyPrediction operator()(const plant::Coefficients& c) const;
+
+ private:
+  std::array<plant::Location, plant::kNumCoefficients> location_;
+  std::vector<std::shared_ptr<const plant::Effect>> readout_;  // the effects averaged on the readout
+  Vec3 a_;
+  std::optional<double> range_;
+  Eigen::Vector3cd F_;
+  vibration::SineVibration felt_, through_loop_;
+  std::complex<double> current_;
+  double amp_i_ = 0;
+  FrequencyPrediction fixed_;  // the parts independent of the coefficients
+};
+
+class PreparedPeriodicRectification {
+ public:
+  PreparedPeriodicRectification(const plant::PlantConfig& plant, const Vec3& a_static_g, const PeriodicInput& input,
+                                const ResponseAt& response, bool allow_closed_form = true);
+  FrequencyPrediction operator()(const plant::Coefficients& c) const;
+
+ private:
+  struct Harmonic {
+    int h;
+    Eigen::Vector3cd F;
+    std::complex<double> I, Theta;
+  };
+  std::optional<PreparedSineRectification> closed_form_;
+  std::array<plant::Location, plant::kNumCoefficients> location_;
+  std::vector<std::shared_ptr<const plant::Effect>> readout_;  // the effects averaged on the readout
+  Vec3 a_, mean_g_;
+  std::vector<Harmonic> hs_;
+  int points_ = 0;
+  std::vector<std::complex<double>> phasors_;  // e^{j h phi_k}, per point and harmonic (a readout only)
+  std::array<double, plant::kNumCoefficients> at_input_{}, in_loop_{};
+  plant::Basis b0_{};
+  FrequencyPrediction fixed_;  // the parts independent of the coefficients
+};
 
 }  // namespace vrelab::rectification

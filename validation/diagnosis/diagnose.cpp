@@ -201,11 +201,19 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       }
       return z;
     }();
+    // A periodic run: what does not depend on the coefficients (the motion through the loop,
+    // the period's averages) once for the gradient's 12 evaluations (the same numbers).
+    std::optional<rectification::PreparedPeriodicRectification> periodic;
+    if (!rr) periodic.emplace(cfg, r.orientation_g, input, h);
     const auto f = [&](const Coefficients& co) {
-      PlantConfig q = cfg;
-      for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
-      if (rr) return rectification::random_rectification_at_frequency(q, r.orientation_g, *rr, sine, sine_h).total_g();
-      return rectification::periodic_rectification(q, r.orientation_g, input, h).total_g();
+      if (rr) {
+        PlantConfig q = cfg;
+        for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
+        return rectification::random_rectification_at_frequency(q, r.orientation_g, *rr, sine, sine_h).total_g();
+      }
+      Coefficients q;
+      for (int i = 0; i < plant::kNumCoefficients; ++i) q[i] = co[i] + shift[i];
+      return (*periodic)(q).total_g();
     };
     const CoefArray g = prediction_gradient(f, nominal.coefficients);
     for (int i = 0; i < plant::kNumCoefficients; ++i) t.G(k, i) = g[i];
