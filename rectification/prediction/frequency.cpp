@@ -209,9 +209,46 @@ PeriodicInput periodic_input(const vibration::SineVibration& v) {
   return p;
 }
 
+namespace {
+
+constexpr int kInputPoints = 64, kInputMaxHarmonic = 16;
+
+// e^{-j 2 pi h k / N} for periodic_input's DFT (h = 1..16, k = 0..63), computed once by the
+// same expression as each call computed it (the same numbers).
+const std::vector<std::complex<double>>& input_twiddles() {
+  static const std::vector<std::complex<double>> table = [] {
+    constexpr int kN = kInputPoints;
+    std::vector<std::complex<double>> t;
+    for (int h = 1; h <= kInputMaxHarmonic; ++h)
+      for (int k = 0; k < kN; ++k) t.push_back(std::polar(1.0, -2 * std::numbers::pi * h * k / kN));
+    return t;
+  }();
+  return table;
+}
+
+// e^{j h phi_k}, phi_k = 2 pi k / 64, for periodic_rectification's 64 points (h = 1..10, where
+// it takes 64 points), by the same expression as the loop computes it.
+constexpr int kPeriodPoints = 64, kPeriodMaxHarmonic = 10;
+const std::vector<std::complex<double>>& period_phasors() {
+  static const std::vector<std::complex<double>> table = [] {
+    constexpr int kM = kPeriodPoints;
+    std::vector<std::complex<double>> t;
+    for (int h = 1; h <= kPeriodMaxHarmonic; ++h)
+      for (int k = 0; k < kM; ++k) {
+        const double phi = 2 * std::numbers::pi * k / kM;
+        t.push_back(std::polar(1.0, h * phi));
+      }
+    return t;
+  }();
+  return table;
+}
+
+}  // namespace
+
 PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz) {
   if (!(frequency_Hz > 0)) throw std::invalid_argument("periodic_input: frequency_Hz must be positive");
-  constexpr int kN = 64, kMaxHarmonic = 16;
+  constexpr int kN = kInputPoints, kMaxHarmonic = kInputMaxHarmonic;
+  const std::vector<std::complex<double>>& twiddle = input_twiddles();
   std::array<Vec3, kN> a;
   for (int k = 0; k < kN; ++k) a[static_cast<std::size_t>(k)] = e.acceleration_g(k / (kN * frequency_Hz));
   // Parts below the sampling's rounding (1e-12 of the largest sample) are noise, not motion.
@@ -225,8 +262,17 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
     if (std::abs(p.mean_g[i]) <= floor_g) p.mean_g[i] = 0.0;
   for (int h = 1; h <= kMaxHarmonic; ++h) {
     // X_h = sum_k a_k e^{-j 2 pi h k / N}; for a_k = Im(W e^{j 2 pi h k / N}), X_h = N W / (2j).
-    Eigen::Vector3cd x = Eigen::Vector3cd::Zero();
-    for (int k = 0; k < kN; ++k) x += a[static_cast<std::size_t>(k)].cast<std::complex<double>>() * std::polar(1.0, -2 * std::numbers::pi * h * k / kN);
+    // (In real arithmetic, as the complex product (a + 0j)(c + js) = (a c - 0 s) + j (a s + 0 c)
+    // computes it: the same numbers without the product's NaN checks.)
+    double xr[3] = {0, 0, 0}, xi[3] = {0, 0, 0};
+    const std::complex<double>* tw = twiddle.data() + static_cast<std::ptrdiff_t>(h - 1) * kN;
+    for (int k = 0; k < kN; ++k) {
+      const double c = tw[k].real(), sn = tw[k].imag();
+      const Vec3& ak = a[static_cast<std::size_t>(k)];
+      for (int i = 0; i < 3; ++i) xr[i] += ak[i] * c - 0.0 * sn, xi[i] += ak[i] * sn + 0.0 * c;
+    }
+    Eigen::Vector3cd x;
+    for (int i = 0; i < 3; ++i) x[i] = std::complex<double>(xr[i], xi[i]);
     Eigen::Vector3cd w = std::complex<double>(0, 2.0 / kN) * x;
     for (int i = 0; i < 3; ++i)
       if (std::abs(w[i]) <= floor_g) w[i] = 0.0;
@@ -290,12 +336,16 @@ PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& 
   const Vec3 a_mean = a + in.mean_g;
   b0_ = plant::basis(a);
   if (!readout_.empty()) phasors_.reserve(static_cast<std::size_t>(kM) * hs_.size());
+  const bool tabled = kM == kPeriodPoints && h_max <= kPeriodMaxHarmonic &&
+                      std::all_of(hs_.begin(), hs_.end(), [](const Harmonic& x) { return x.h >= 1; });
+  const std::vector<std::complex<double>>& table = period_phasors();
   for (int k = 0; k < kM; ++k) {
     const double phi = 2 * std::numbers::pi * k / kM;
     Vec3 felt = a_mean;
     double current = 0;
     for (const Harmonic& x : hs_) {
-      const std::complex<double> e = std::polar(1.0, x.h * phi);
+      const std::complex<double> e =
+          tabled ? table[static_cast<std::size_t>((x.h - 1) * kPeriodPoints + k)] : std::polar(1.0, x.h * phi);
       for (int i = 0; i < 3; ++i) felt[i] += std::imag(x.F[i] * e);
       current += std::imag(x.I * e);
       if (!readout_.empty()) phasors_.push_back(e);
