@@ -17,55 +17,70 @@ using namespace plant;
 
 LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
   if (!(frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+  return LoopResponder(config)(frequency_Hz);
+}
+
+LoopResponder::LoopResponder(const PlantConfig& config, bool dc_gain) {
   // The linear plant: the same dynamics, K1 and the linear cross terms, no nonlinear part.
   PlantConfig lin_cfg = config;
   for (int c : {k1_asym, k2, k3, k4, k_IP, k_IO, k_PO, k_PP, k_OO}) lin_cfg.coefficients[c] = 0.0;
   lin_cfg.torquer_c2_per_g = lin_cfg.torquer_c3_per_g2 = 0.0;
   lin_cfg.effects.clear();
-  LoopResponse out;
-  const double w_rad = 2 * std::numbers::pi * frequency_Hz;
   for (const auto& e : config.effects)
     if (e->kept_in_linearisation()) {  // linear (a mechanical mode): keep
       lin_cfg.effects.push_back(e);
-      for (int j = 0; j < 3; ++j) out.mechanical[static_cast<std::size_t>(j)] *= e->transmissibility(j, w_rad);
+      kept_.push_back(e);
     }
   // Linear: the response does not depend on the static orientation (IA up is as good as any).
   const Accelerometer plant(lin_cfg, Vec3(1, 0, 0));
   const Accelerometer::Linear lin = plant.linearise();
-  const int n = plant.size();
-  const double w = 2 * std::numbers::pi * frequency_Hz;
+  n_ = plant.size();
   // (s I - A) x = B solved in the plant's state scales (x = S y, S = diag(state_scale)): a
   // mechanical mode's states are ~1/w_m^2 g s^2, so unscaled A spans 1e-4 .. 1e11 and a full-pivot
   // LU's rank threshold (eps n max|pivot|) took real pivots for zero and returned a zero response
   // for a mode above the drive (issue 15: a mode at 2.5 kHz gave |I| = 0 at 800 Hz).
   const std::vector<double> scale = plant.state_scale();
-  Eigen::VectorXd sc(n);
-  for (int k = 0; k < n; ++k) sc[k] = scale[static_cast<std::size_t>(k)];
-  const Eigen::MatrixXcd a_scaled = (sc.cwiseInverse().asDiagonal() * lin.A * sc.asDiagonal()).cast<std::complex<double>>();
-  const Eigen::MatrixXcd b_scaled = (sc.cwiseInverse().asDiagonal() * lin.B).cast<std::complex<double>>();
-  const auto solve_at = [&](double w_solve, const Eigen::MatrixXcd& rhs) {
-    const Eigen::MatrixXcd m = std::complex<double>(0, w_solve) * Eigen::MatrixXcd::Identity(n, n) - a_scaled;
-    Eigen::MatrixXcd y = m.partialPivLu().solve(rhs);
-    return Eigen::MatrixXcd(sc.cast<std::complex<double>>().asDiagonal() * y);
-  };
-  const Eigen::MatrixXcd x = solve_at(w, b_scaled);  // n x 3: per unit input axis
+  sc_.resize(n_);
+  for (int k = 0; k < n_; ++k) sc_[k] = scale[static_cast<std::size_t>(k)];
+  a_scaled_ = (sc_.cwiseInverse().asDiagonal() * lin.A * sc_.asDiagonal()).cast<std::complex<double>>();
+  b_scaled_ = (sc_.cwiseInverse().asDiagonal() * lin.B).cast<std::complex<double>>();
   // The rebalance current of the linear plant: i = k G theta + (1 - k) q + w_i r, with
   // k = lead pole / lead zero (plant/accelerometer.cpp, the servo's realisation).
   const plant::Servo& sv = plant.servo();
-  const double lead_ratio = sv.lead_pole_rad_per_s / sv.lead_zero_rad_per_s;
-  out.frequency_Hz = frequency_Hz;
-  for (int j = 0; j < 3; ++j) {
-    out.current[j] = lead_ratio * sv.gain_g_per_rad * x(Accelerometer::kTheta, j) + (1 - lead_ratio) * x(Accelerometer::kLead, j) +
-                     sv.integrator_rad_per_s * x(Accelerometer::kIntegral, j);
-    out.angle_rad[j] = x(Accelerometer::kTheta, j);
-  }
+  lead_ratio_ = sv.lead_pole_rad_per_s / sv.lead_zero_rad_per_s;
+  gain_g_per_rad_ = sv.gain_g_per_rad;
+  integrator_rad_per_s_ = sv.integrator_rad_per_s;
+  if (!dc_gain) return;
   // DC gain of the loop from a disturbance entering before it (an input term, a torque) to
   // the current: exactly 1 with the integrator, L0 / (1 + L0) without (L0 = b G / w_p^2).
   // Evaluated at 0.01 Hz: within O((f / f_c)^2) ~ 1e-9 of DC, and clear of the pivot
   // threshold that the quadrature and inert states (zero poles) would hit at f = 0.
-  const Eigen::VectorXcd x_dc = solve_at(2 * std::numbers::pi * 0.01, b_scaled.col(IA)).col(0);
-  out.dc_gain = std::abs(lead_ratio * sv.gain_g_per_rad * x_dc[Accelerometer::kTheta] +
-                         (1 - lead_ratio) * x_dc[Accelerometer::kLead] + sv.integrator_rad_per_s * x_dc[Accelerometer::kIntegral]);
+  const Eigen::VectorXcd x_dc = solve_at(2 * std::numbers::pi * 0.01, b_scaled_.col(IA)).col(0);
+  dc_gain_ = std::abs(lead_ratio_ * gain_g_per_rad_ * x_dc[Accelerometer::kTheta] +
+                      (1 - lead_ratio_) * x_dc[Accelerometer::kLead] + integrator_rad_per_s_ * x_dc[Accelerometer::kIntegral]);
+}
+
+Eigen::MatrixXcd LoopResponder::solve_at(double w_solve, const Eigen::MatrixXcd& rhs) const {
+  const Eigen::MatrixXcd m = std::complex<double>(0, w_solve) * Eigen::MatrixXcd::Identity(n_, n_) - a_scaled_;
+  Eigen::MatrixXcd y = m.partialPivLu().solve(rhs);
+  return Eigen::MatrixXcd(sc_.cast<std::complex<double>>().asDiagonal() * y);
+}
+
+LoopResponse LoopResponder::operator()(double frequency_Hz) const {
+  if (!(frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+  LoopResponse out;
+  const double w_rad = 2 * std::numbers::pi * frequency_Hz;
+  for (const auto& e : kept_)
+    for (int j = 0; j < 3; ++j) out.mechanical[static_cast<std::size_t>(j)] *= e->transmissibility(j, w_rad);
+  const double w = 2 * std::numbers::pi * frequency_Hz;
+  const Eigen::MatrixXcd x = solve_at(w, b_scaled_);  // n x 3: per unit input axis
+  out.frequency_Hz = frequency_Hz;
+  for (int j = 0; j < 3; ++j) {
+    out.current[j] = lead_ratio_ * gain_g_per_rad_ * x(Accelerometer::kTheta, j) + (1 - lead_ratio_) * x(Accelerometer::kLead, j) +
+                     integrator_rad_per_s_ * x(Accelerometer::kIntegral, j);
+    out.angle_rad[j] = x(Accelerometer::kTheta, j);
+  }
+  out.dc_gain = dc_gain_;
   return out;
 }
 
@@ -94,7 +109,7 @@ PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::Sin
   double zeta = zeta0;
   for (int it = 0; it < 200; ++it) {
     out.dynamics.pendulum_damping_ratio = zeta;
-    const LoopResponse r = loop_response(out, v.frequency_Hz);
+    const LoopResponse r = LoopResponder(out, false)(v.frequency_Hz);  // (the angle only: no DC gain)
     const double theta = std::abs(r.angle_rad[0] * w[0] + r.angle_rad[1] * w[1] + r.angle_rad[2] * w[2]);
     const double updated = 0.5 * (zeta + zeta_at(theta));  // damped: the angle falls as the damping rises
     if (std::abs(updated - zeta) < 1e-10 * zeta) {

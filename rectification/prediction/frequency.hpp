@@ -79,6 +79,23 @@ struct LoopResponse {
   double dc_gain = 1;
 };
 LoopResponse loop_response(const plant::PlantConfig& plant, double frequency_Hz);
+// The same, the plant linearised once for any number of frequencies (and the DC gain, the
+// same at every frequency, solved once): responder(f) equals loop_response(plant, f) bit for
+// bit (loop_response is this). With dc_gain false, the responses' dc_gain is left at 1 (for a
+// caller that needs the current and the angle only).
+class LoopResponder {
+ public:
+  explicit LoopResponder(const plant::PlantConfig& plant, bool dc_gain = true);
+  LoopResponse operator()(double frequency_Hz) const;
+
+ private:
+  std::vector<std::shared_ptr<const plant::Effect>> kept_;  // the linear effects (their transmissibility)
+  Eigen::VectorXd sc_;
+  Eigen::MatrixXcd a_scaled_, b_scaled_;
+  int n_ = 0;
+  double lead_ratio_ = 0, gain_g_per_rad_ = 0, integrator_rad_per_s_ = 0, dc_gain_ = 1;
+  Eigen::MatrixXcd solve_at(double w_solve, const Eigen::MatrixXcd& rhs) const;
+};
 // The same prediction with the response given (its frequency must be v's).
 FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
                                                     const vibration::SineVibration& v, std::optional<double> range_limit_g,
