@@ -814,8 +814,16 @@ Coefficients settled_fit(const PlantConfig& plant, const std::vector<Position>& 
                          const FixedSet& fixed) {
   std::vector<Reading> readings;
   const double K1 = plant.coefficients[plant::K1];
-  for (std::size_t i = 0; i < positions.size(); ++i)
-    readings.push_back({static_cast<int>(i), K1 * plant::settled_output_g(plant, positions[i].nominal_g)});
+  // A position read more than once (a static test's repeats) is settled once: the same plant
+  // at the same orientation settles to the same number.
+  std::map<std::array<double, 3>, double> settled;
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const Vec3& g = positions[i].nominal_g;
+    const std::array<double, 3> at{g[0], g[1], g[2]};
+    auto it = settled.find(at);
+    if (it == settled.end()) it = settled.emplace(at, plant::settled_output_g(plant, g)).first;
+    readings.push_back({static_cast<int>(i), K1 * it->second});
+  }
   return least_squares(positions, readings, weights, fixed).estimate.value;
 }
 
