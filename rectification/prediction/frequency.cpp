@@ -17,55 +17,70 @@ using namespace plant;
 
 LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
   if (!(frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+  return LoopResponder(config)(frequency_Hz);
+}
+
+LoopResponder::LoopResponder(const PlantConfig& config, bool dc_gain) {
   // The linear plant: the same dynamics, K1 and the linear cross terms, no nonlinear part.
   PlantConfig lin_cfg = config;
   for (int c : {k1_asym, k2, k3, k4, k_IP, k_IO, k_PO, k_PP, k_OO}) lin_cfg.coefficients[c] = 0.0;
   lin_cfg.torquer_c2_per_g = lin_cfg.torquer_c3_per_g2 = 0.0;
   lin_cfg.effects.clear();
-  LoopResponse out;
-  const double w_rad = 2 * std::numbers::pi * frequency_Hz;
   for (const auto& e : config.effects)
     if (e->kept_in_linearisation()) {  // linear (a mechanical mode): keep
       lin_cfg.effects.push_back(e);
-      for (int j = 0; j < 3; ++j) out.mechanical[static_cast<std::size_t>(j)] *= e->transmissibility(j, w_rad);
+      kept_.push_back(e);
     }
   // Linear: the response does not depend on the static orientation (IA up is as good as any).
   const Accelerometer plant(lin_cfg, Vec3(1, 0, 0));
   const Accelerometer::Linear lin = plant.linearise();
-  const int n = plant.size();
-  const double w = 2 * std::numbers::pi * frequency_Hz;
+  n_ = plant.size();
   // (s I - A) x = B solved in the plant's state scales (x = S y, S = diag(state_scale)): a
   // mechanical mode's states are ~1/w_m^2 g s^2, so unscaled A spans 1e-4 .. 1e11 and a full-pivot
   // LU's rank threshold (eps n max|pivot|) took real pivots for zero and returned a zero response
   // for a mode above the drive (issue 15: a mode at 2.5 kHz gave |I| = 0 at 800 Hz).
   const std::vector<double> scale = plant.state_scale();
-  Eigen::VectorXd sc(n);
-  for (int k = 0; k < n; ++k) sc[k] = scale[static_cast<std::size_t>(k)];
-  const Eigen::MatrixXcd a_scaled = (sc.cwiseInverse().asDiagonal() * lin.A * sc.asDiagonal()).cast<std::complex<double>>();
-  const Eigen::MatrixXcd b_scaled = (sc.cwiseInverse().asDiagonal() * lin.B).cast<std::complex<double>>();
-  const auto solve_at = [&](double w_solve, const Eigen::MatrixXcd& rhs) {
-    const Eigen::MatrixXcd m = std::complex<double>(0, w_solve) * Eigen::MatrixXcd::Identity(n, n) - a_scaled;
-    Eigen::MatrixXcd y = m.partialPivLu().solve(rhs);
-    return Eigen::MatrixXcd(sc.cast<std::complex<double>>().asDiagonal() * y);
-  };
-  const Eigen::MatrixXcd x = solve_at(w, b_scaled);  // n x 3: per unit input axis
+  sc_.resize(n_);
+  for (int k = 0; k < n_; ++k) sc_[k] = scale[static_cast<std::size_t>(k)];
+  a_scaled_ = (sc_.cwiseInverse().asDiagonal() * lin.A * sc_.asDiagonal()).cast<std::complex<double>>();
+  b_scaled_ = (sc_.cwiseInverse().asDiagonal() * lin.B).cast<std::complex<double>>();
   // The rebalance current of the linear plant: i = k G theta + (1 - k) q + w_i r, with
   // k = lead pole / lead zero (plant/accelerometer.cpp, the servo's realisation).
   const plant::Servo& sv = plant.servo();
-  const double lead_ratio = sv.lead_pole_rad_per_s / sv.lead_zero_rad_per_s;
-  out.frequency_Hz = frequency_Hz;
-  for (int j = 0; j < 3; ++j) {
-    out.current[j] = lead_ratio * sv.gain_g_per_rad * x(Accelerometer::kTheta, j) + (1 - lead_ratio) * x(Accelerometer::kLead, j) +
-                     sv.integrator_rad_per_s * x(Accelerometer::kIntegral, j);
-    out.angle_rad[j] = x(Accelerometer::kTheta, j);
-  }
+  lead_ratio_ = sv.lead_pole_rad_per_s / sv.lead_zero_rad_per_s;
+  gain_g_per_rad_ = sv.gain_g_per_rad;
+  integrator_rad_per_s_ = sv.integrator_rad_per_s;
+  if (!dc_gain) return;
   // DC gain of the loop from a disturbance entering before it (an input term, a torque) to
   // the current: exactly 1 with the integrator, L0 / (1 + L0) without (L0 = b G / w_p^2).
   // Evaluated at 0.01 Hz: within O((f / f_c)^2) ~ 1e-9 of DC, and clear of the pivot
   // threshold that the quadrature and inert states (zero poles) would hit at f = 0.
-  const Eigen::VectorXcd x_dc = solve_at(2 * std::numbers::pi * 0.01, b_scaled.col(IA)).col(0);
-  out.dc_gain = std::abs(lead_ratio * sv.gain_g_per_rad * x_dc[Accelerometer::kTheta] +
-                         (1 - lead_ratio) * x_dc[Accelerometer::kLead] + sv.integrator_rad_per_s * x_dc[Accelerometer::kIntegral]);
+  const Eigen::VectorXcd x_dc = solve_at(2 * std::numbers::pi * 0.01, b_scaled_.col(IA)).col(0);
+  dc_gain_ = std::abs(lead_ratio_ * gain_g_per_rad_ * x_dc[Accelerometer::kTheta] +
+                      (1 - lead_ratio_) * x_dc[Accelerometer::kLead] + integrator_rad_per_s_ * x_dc[Accelerometer::kIntegral]);
+}
+
+Eigen::MatrixXcd LoopResponder::solve_at(double w_solve, const Eigen::MatrixXcd& rhs) const {
+  const Eigen::MatrixXcd m = std::complex<double>(0, w_solve) * Eigen::MatrixXcd::Identity(n_, n_) - a_scaled_;
+  Eigen::MatrixXcd y = m.partialPivLu().solve(rhs);
+  return Eigen::MatrixXcd(sc_.cast<std::complex<double>>().asDiagonal() * y);
+}
+
+LoopResponse LoopResponder::operator()(double frequency_Hz) const {
+  if (!(frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+  LoopResponse out;
+  const double w_rad = 2 * std::numbers::pi * frequency_Hz;
+  for (const auto& e : kept_)
+    for (int j = 0; j < 3; ++j) out.mechanical[static_cast<std::size_t>(j)] *= e->transmissibility(j, w_rad);
+  const double w = 2 * std::numbers::pi * frequency_Hz;
+  const Eigen::MatrixXcd x = solve_at(w, b_scaled_);  // n x 3: per unit input axis
+  out.frequency_Hz = frequency_Hz;
+  for (int j = 0; j < 3; ++j) {
+    out.current[j] = lead_ratio_ * gain_g_per_rad_ * x(Accelerometer::kTheta, j) + (1 - lead_ratio_) * x(Accelerometer::kLead, j) +
+                     integrator_rad_per_s_ * x(Accelerometer::kIntegral, j);
+    out.angle_rad[j] = x(Accelerometer::kTheta, j);
+  }
+  out.dc_gain = dc_gain_;
   return out;
 }
 
@@ -94,7 +109,7 @@ PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::Sin
   double zeta = zeta0;
   for (int it = 0; it < 200; ++it) {
     out.dynamics.pendulum_damping_ratio = zeta;
-    const LoopResponse r = loop_response(out, v.frequency_Hz);
+    const LoopResponse r = LoopResponder(out, false)(v.frequency_Hz);  // (the angle only: no DC gain)
     const double theta = std::abs(r.angle_rad[0] * w[0] + r.angle_rad[1] * w[1] + r.angle_rad[2] * w[2]);
     const double updated = 0.5 * (zeta + zeta_at(theta));  // damped: the angle falls as the damping rises
     if (std::abs(updated - zeta) < 1e-10 * zeta) {
@@ -116,6 +131,12 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
 
 FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
                                                     std::optional<double> range_g, const LoopResponse& h) {
+  return PreparedSineRectification(config, a, v, range_g, h)(config.coefficients);
+}
+
+PreparedSineRectification::PreparedSineRectification(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
+                                                     std::optional<double> range_g, const LoopResponse& h)
+    : location_(config.location), a_(a), range_(range_g) {
   if (std::abs(h.frequency_Hz - v.frequency_Hz) > 1e-9 * v.frequency_Hz)
     throw std::invalid_argument("sine_rectification_at_frequency: the loop response is for another frequency");
   double p2 = 0.0;
@@ -123,45 +144,52 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
   for (const auto& e : config.effects) {
     p2 += e->pickoff_p2_per_rad();
     geometry = geometry || e->vibropendulous();
+    if (e->readout_averaged_in_prediction()) readout_.push_back(e);
   }
-  Eigen::Vector3cd W, F;  // the case's vibration, and what the pendulum's base feels
-  vibration::SineVibration felt = v;
+  Eigen::Vector3cd W;  // the case's vibration; F_: what the pendulum's base feels
+  felt_ = v;
   for (int i = 0; i < 3; ++i) {
     W[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
-    F[i] = h.mechanical[static_cast<std::size_t>(i)] * W[i];
-    felt.amplitude_g[i] = std::abs(F[i]);
-    felt.phase_rad[i] = std::arg(F[i]);
+    F_[i] = h.mechanical[static_cast<std::size_t>(i)] * W[i];
+    felt_.amplitude_g[i] = std::abs(F_[i]);
+    felt_.phase_rad[i] = std::arg(F_[i]);
   }
-  const std::complex<double> current = h.current[0] * W[0] + h.current[1] * W[1] + h.current[2] * W[2];
+  current_ = h.current[0] * W[0] + h.current[1] * W[1] + h.current[2] * W[2];
   const double dc_gain = h.dc_gain;
-  FrequencyPrediction out;
-  out.current_amplitude_g = current;
+  FrequencyPrediction& out = fixed_;
+  out.current_amplitude_g = current_;
   out.angle_amplitude_rad = h.angle_rad[0] * W[0] + h.angle_rad[1] * W[1] + h.angle_rad[2] * W[2];
-
-  // Terms of (1): each through the place where it acts.
-  const double amp_i = std::abs(current);
-  vibration::SineVibration through_loop = felt;
-  through_loop.amplitude_g[IA] = amp_i;
-  for (int c = k0; c < kNumCoefficients; ++c) {
-    if (c == k0 || c == delta_OA || c == delta_PA || config.coefficients[c] == 0) continue;
-    Coefficients only;
-    only[K1] = 1;
-    only[c] = config.coefficients[c];
-    const bool ia_term = c <= k4;
-    const bool filtered = ia_term && config.location[c] != Location::input;
-    const Eq3Terms t = sine_rectification(only, a, filtered ? through_loop : felt);
-    // What rectifies before the loop (input, torquer) reaches the output with the loop's DC gain.
-    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
-    for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
-  }
-  if (range_g) out.terms.g[t_clipping] = clipping_sine(a[IA], amp_i, *range_g);
+  amp_i_ = std::abs(current_);
+  through_loop_ = felt_;
+  through_loop_.amplitude_g[IA] = amp_i_;
   // Effects beyond (1), from the averaged torque balance.
   const Dynamics& d = config.dynamics;
   const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
   const std::complex<double> theta = out.angle_amplitude_rad;
   out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * std::norm(theta) / 2;
   if (geometry)
-    out.pendulum_geometry_g = dc_gain * (-0.5 * std::real(F[PA] * std::conj(theta)) - a[IA] * std::norm(theta) / 4);
+    out.pendulum_geometry_g = dc_gain * (-0.5 * std::real(F_[PA] * std::conj(theta)) - a[IA] * std::norm(theta) / 4);
+  out.loop_dc_gain = dc_gain;
+}
+
+FrequencyPrediction PreparedSineRectification::operator()(const Coefficients& coefficients) const {
+  FrequencyPrediction out = fixed_;
+  const double dc_gain = fixed_.loop_dc_gain;
+  // Terms of (1): each through the place where it acts.
+  for (int c = k0; c < kNumCoefficients; ++c) {
+    if (c == k0 || c == delta_OA || c == delta_PA || coefficients[c] == 0) continue;
+    Coefficients only;
+    only[K1] = 1;
+    only[c] = coefficients[c];
+    const bool ia_term = c <= k4;
+    const bool filtered = ia_term && location_[c] != Location::input;
+    const Eq3Terms t = sine_rectification(only, a_, filtered ? through_loop_ : felt_);
+    // What rectifies before the loop (input, torquer) reaches the output with the loop's DC gain.
+    const double gain = location_[c] == Location::output ? 1.0 : dc_gain;
+    for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
+  }
+  if (range_) out.terms.g[t_clipping] = clipping_sine(a_[IA], amp_i_, *range_);
+  if (readout_.empty()) return out;
   // A readout polynomial: the period average of R over the output's oscillation, by the
   // trapezoidal rule on 32 points (exact for a trigonometric polynomial of degree < 32).
   // U: the output's oscillation, the current plus the output-placed cross terms' linear part
@@ -169,18 +197,16 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
   Coefficients cross_out;
   cross_out[K1] = 1;
   for (int c = delta_OA; c < kNumCoefficients; ++c)
-    if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
-  const Vec3 slope = plant::output_gradient(cross_out, a) - Vec3::UnitX();
-  std::complex<double> U = current + slope[IA] * F[IA] + slope[PA] * F[PA] + slope[OA] * F[OA];
-  const double u0 = plant::output_g(config.coefficients, a);
-  for (const auto& e : config.effects) {
-    if (!e->readout_averaged_in_prediction()) continue;
+    if (location_[c] == Location::output) cross_out[c] = coefficients[c];
+  const Vec3 slope = plant::output_gradient(cross_out, a_) - Vec3::UnitX();
+  std::complex<double> U = current_ + slope[IA] * F_[IA] + slope[PA] * F_[PA] + slope[OA] * F_[OA];
+  const double u0 = plant::output_g(coefficients, a_);
+  for (const auto& e : readout_) {
     constexpr int kN = 32;
     double mean = 0;
     for (int k = 0; k < kN; ++k) mean += e->readout(u0 + std::real(U * std::polar(1.0, 2 * std::numbers::pi * k / kN)));
     out.readout_g += mean / kN - e->readout(u0);
   }
-  out.loop_dc_gain = dc_gain;
   return out;
 }
 
@@ -198,9 +224,46 @@ PeriodicInput periodic_input(const vibration::SineVibration& v) {
   return p;
 }
 
+namespace {
+
+constexpr int kInputPoints = 64, kInputMaxHarmonic = 16;
+
+// e^{-j 2 pi h k / N} for periodic_input's DFT (h = 1..16, k = 0..63), computed once by the
+// same expression as each call computed it (the same numbers).
+const std::vector<std::complex<double>>& input_twiddles() {
+  static const std::vector<std::complex<double>> table = [] {
+    constexpr int kN = kInputPoints;
+    std::vector<std::complex<double>> t;
+    for (int h = 1; h <= kInputMaxHarmonic; ++h)
+      for (int k = 0; k < kN; ++k) t.push_back(std::polar(1.0, -2 * std::numbers::pi * h * k / kN));
+    return t;
+  }();
+  return table;
+}
+
+// e^{j h phi_k}, phi_k = 2 pi k / 64, for periodic_rectification's 64 points (h = 1..10, where
+// it takes 64 points), by the same expression as the loop computes it.
+constexpr int kPeriodPoints = 64, kPeriodMaxHarmonic = 10;
+const std::vector<std::complex<double>>& period_phasors() {
+  static const std::vector<std::complex<double>> table = [] {
+    constexpr int kM = kPeriodPoints;
+    std::vector<std::complex<double>> t;
+    for (int h = 1; h <= kPeriodMaxHarmonic; ++h)
+      for (int k = 0; k < kM; ++k) {
+        const double phi = 2 * std::numbers::pi * k / kM;
+        t.push_back(std::polar(1.0, h * phi));
+      }
+    return t;
+  }();
+  return table;
+}
+
+}  // namespace
+
 PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz) {
   if (!(frequency_Hz > 0)) throw std::invalid_argument("periodic_input: frequency_Hz must be positive");
-  constexpr int kN = 64, kMaxHarmonic = 16;
+  constexpr int kN = kInputPoints, kMaxHarmonic = kInputMaxHarmonic;
+  const std::vector<std::complex<double>>& twiddle = input_twiddles();
   std::array<Vec3, kN> a;
   for (int k = 0; k < kN; ++k) a[static_cast<std::size_t>(k)] = e.acceleration_g(k / (kN * frequency_Hz));
   // Parts below the sampling's rounding (1e-12 of the largest sample) are noise, not motion.
@@ -214,8 +277,17 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
     if (std::abs(p.mean_g[i]) <= floor_g) p.mean_g[i] = 0.0;
   for (int h = 1; h <= kMaxHarmonic; ++h) {
     // X_h = sum_k a_k e^{-j 2 pi h k / N}; for a_k = Im(W e^{j 2 pi h k / N}), X_h = N W / (2j).
-    Eigen::Vector3cd x = Eigen::Vector3cd::Zero();
-    for (int k = 0; k < kN; ++k) x += a[static_cast<std::size_t>(k)].cast<std::complex<double>>() * std::polar(1.0, -2 * std::numbers::pi * h * k / kN);
+    // (In real arithmetic, as the complex product (a + 0j)(c + js) = (a c - 0 s) + j (a s + 0 c)
+    // computes it: the same numbers without the product's NaN checks.)
+    double xr[3] = {0, 0, 0}, xi[3] = {0, 0, 0};
+    const std::complex<double>* tw = twiddle.data() + static_cast<std::ptrdiff_t>(h - 1) * kN;
+    for (int k = 0; k < kN; ++k) {
+      const double c = tw[k].real(), sn = tw[k].imag();
+      const Vec3& ak = a[static_cast<std::size_t>(k)];
+      for (int i = 0; i < 3; ++i) xr[i] += ak[i] * c - 0.0 * sn, xi[i] += ak[i] * sn + 0.0 * c;
+    }
+    Eigen::Vector3cd x;
+    for (int i = 0; i < 3; ++i) x[i] = std::complex<double>(xr[i], xi[i]);
     Eigen::Vector3cd w = std::complex<double>(0, 2.0 / kN) * x;
     for (int i = 0; i < 3; ++i)
       if (std::abs(w[i]) <= floor_g) w[i] = 0.0;
@@ -227,101 +299,124 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
 
 FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3& a, const PeriodicInput& in,
                                            const ResponseAt& response, bool allow_closed_form) {
+  return PreparedPeriodicRectification(config, a, in, response, allow_closed_form)(config.coefficients);
+}
+
+PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& config, const Vec3& a, const PeriodicInput& in,
+                                                             const ResponseAt& response, bool allow_closed_form)
+    : location_(config.location), a_(a), mean_g_(in.mean_g) {
   if (!(in.frequency_Hz > 0)) throw std::invalid_argument("periodic_rectification: frequency_Hz must be positive");
   if (allow_closed_form && in.single_tone()) {
     vibration::SineVibration v;
     v.frequency_Hz = in.frequency_Hz;
     const Eigen::Vector3cd& w = in.tones.front().second;
     for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(w[i]), v.phase_rad[i] = std::arg(w[i]);
-    return sine_rectification_at_frequency(config, a, v, std::nullopt, response(in.frequency_Hz));
+    closed_form_.emplace(config, a, v, std::nullopt, response(in.frequency_Hz));
+    return;
   }
   double p2 = 0.0;
   bool geometry = false;
   for (const auto& e : config.effects) {
     p2 += e->pickoff_p2_per_rad();
     geometry = geometry || e->vibropendulous();
+    if (e->readout_averaged_in_prediction()) readout_.push_back(e);
   }
-  // Per harmonic: what the pendulum's base feels F, the rebalance current I, the angle Theta,
-  // and the output's oscillation U (the current plus the output-placed cross terms' slope).
-  Coefficients cross_out;
-  cross_out[K1] = 1;
-  for (int c = delta_OA; c < kNumCoefficients; ++c)
-    if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
-  const Vec3 slope = plant::output_gradient(cross_out, a) - Vec3::UnitX();
-  struct Harmonic {
-    int h;
-    Eigen::Vector3cd F;
-    std::complex<double> I, Theta, U;
-  };
-  std::vector<Harmonic> hs;
+  // Per harmonic: what the pendulum's base feels F, the rebalance current I, the angle Theta
+  // (and, per coefficients, the output's oscillation U: the current plus the output-placed
+  // cross terms' slope).
   double dc_gain = 1.0;
   for (const auto& [h, W] : in.tones) {
     const LoopResponse r = response(h * in.frequency_Hz);
     dc_gain = r.dc_gain;
-    Harmonic x{h, Eigen::Vector3cd::Zero(), 0.0, 0.0, 0.0};
+    Harmonic x{h, Eigen::Vector3cd::Zero(), 0.0, 0.0};
     for (int j = 0; j < 3; ++j) {
       const auto sj = static_cast<std::size_t>(j);
       x.F[j] = r.mechanical[sj] * W[j];
       x.I += r.current[sj] * W[j];
       x.Theta += r.angle_rad[sj] * W[j];
     }
-    x.U = x.I + slope[IA] * x.F[IA] + slope[PA] * x.F[PA] + slope[OA] * x.F[OA];
-    hs.push_back(x);
+    hs_.push_back(x);
   }
-  FrequencyPrediction out;
+  FrequencyPrediction& out = fixed_;
   out.loop_dc_gain = dc_gain;
-  if (!hs.empty() && hs.front().h == 1) out.current_amplitude_g = hs.front().I, out.angle_amplitude_rad = hs.front().Theta;
+  if (!hs_.empty() && hs_.front().h == 1) out.current_amplitude_g = hs_.front().I, out.angle_amplitude_rad = hs_.front().Theta;
 
   // One period on kM points: the felt acceleration (about the static point moved by the
   // input's mean) and the current's oscillation; each coefficient's basis function averaged
-  // at its place, less its static value.
+  // at its place (less its static value, per coefficients).
   int h_max = 1;
-  for (const Harmonic& x : hs) h_max = std::max(h_max, x.h);
+  for (const Harmonic& x : hs_) h_max = std::max(h_max, x.h);
   const int kM = std::max(64, 6 * h_max + 1);  // exact for degree-6 trigonometric polynomials
+  points_ = kM;
   const Vec3 a_mean = a + in.mean_g;
-  std::array<double, kNumCoefficients> at_input{}, in_loop{};
-  const plant::Basis b0 = plant::basis(a);
-  double readout_mean = 0, u0 = plant::output_g(config.coefficients, a);
-  const double u_mean = u0 + in.mean_g[IA] + slope.dot(in.mean_g);
+  b0_ = plant::basis(a);
+  if (!readout_.empty()) phasors_.reserve(static_cast<std::size_t>(kM) * hs_.size());
+  const bool tabled = kM == kPeriodPoints && h_max <= kPeriodMaxHarmonic &&
+                      std::all_of(hs_.begin(), hs_.end(), [](const Harmonic& x) { return x.h >= 1; });
+  const std::vector<std::complex<double>>& table = period_phasors();
   for (int k = 0; k < kM; ++k) {
     const double phi = 2 * std::numbers::pi * k / kM;
     Vec3 felt = a_mean;
-    double current = 0, u = u_mean;
-    for (const Harmonic& x : hs) {
-      const std::complex<double> e = std::polar(1.0, x.h * phi);
+    double current = 0;
+    for (const Harmonic& x : hs_) {
+      const std::complex<double> e =
+          tabled ? table[static_cast<std::size_t>((x.h - 1) * kPeriodPoints + k)] : std::polar(1.0, x.h * phi);
       for (int i = 0; i < 3; ++i) felt[i] += std::imag(x.F[i] * e);
       current += std::imag(x.I * e);
-      u += std::imag(x.U * e);
+      if (!readout_.empty()) phasors_.push_back(e);
     }
     const plant::Basis bf = plant::basis(felt);
     Vec3 loop = felt;
     loop[IA] = a_mean[IA] + current;
     const plant::Basis bl = plant::basis(loop);
-    for (int c = 0; c < kNumCoefficients; ++c) at_input[c] += bf[c] / kM, in_loop[c] += bl[c] / kM;
-    for (const auto& e : config.effects)
-      if (e->readout_averaged_in_prediction()) readout_mean += (e->readout(u) - u) / kM;
+    for (int c = 0; c < kNumCoefficients; ++c) at_input_[c] += bf[c] / kM, in_loop_[c] += bl[c] / kM;
   }
-  for (int c = k1_asym; c < kNumCoefficients; ++c) {
-    if (config.coefficients[c] == 0) continue;
-    const bool filtered = c <= k4 && config.location[c] != Location::input;
-    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
-    const double g = gain * config.coefficients[c] * ((filtered ? in_loop[c] : at_input[c]) - b0[c]);
-    const int t = term_of_coefficient(c);  // -1: the misalignments, from the input's mean
-    if (t >= 0) out.terms.g[t] += g;
-    else out.input_mean_g += g;
-  }
-  out.input_mean_g += dc_gain * in.mean_g[IA];
-  for (const auto& e : config.effects)
-    if (e->readout_averaged_in_prediction()) readout_mean -= e->readout(u0) - u0;
-  out.readout_g = readout_mean;
+  out.input_mean_g = 0.0;
   // Effects beyond (1): quadratic in the angle, so harmonics add (their cross products
   // average out over a period).
   const Dynamics& d = config.dynamics;
   const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
   double theta2 = 0, pa_theta = 0;  // <theta^2>, <f_PA theta>
-  for (const Harmonic& x : hs) theta2 += std::norm(x.Theta) / 2, pa_theta += std::real(x.F[PA] * std::conj(x.Theta)) / 2;
+  for (const Harmonic& x : hs_) theta2 += std::norm(x.Theta) / 2, pa_theta += std::real(x.F[PA] * std::conj(x.Theta)) / 2;
   out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * theta2;
   if (geometry) out.pendulum_geometry_g = dc_gain * (-pa_theta - a_mean[IA] * theta2 / 2);
+}
+
+FrequencyPrediction PreparedPeriodicRectification::operator()(const Coefficients& coefficients) const {
+  if (closed_form_) return (*closed_form_)(coefficients);
+  FrequencyPrediction out = fixed_;
+  const double dc_gain = fixed_.loop_dc_gain;
+  for (int c = k1_asym; c < kNumCoefficients; ++c) {
+    if (coefficients[c] == 0) continue;
+    const bool filtered = c <= k4 && location_[c] != Location::input;
+    const double gain = location_[c] == Location::output ? 1.0 : dc_gain;
+    const double g = gain * coefficients[c] * ((filtered ? in_loop_[c] : at_input_[c]) - b0_[c]);
+    const int t = term_of_coefficient(c);  // -1: the misalignments, from the input's mean
+    if (t >= 0) out.terms.g[t] += g;
+    else out.input_mean_g += g;
+  }
+  out.input_mean_g += dc_gain * mean_g_[IA];
+  if (readout_.empty()) return out;
+  // The readout polynomials averaged over the output's oscillation u (the static output moved
+  // by the input's mean, plus each harmonic's U).
+  Coefficients cross_out;
+  cross_out[K1] = 1;
+  for (int c = delta_OA; c < kNumCoefficients; ++c)
+    if (location_[c] == Location::output) cross_out[c] = coefficients[c];
+  const Vec3 slope = plant::output_gradient(cross_out, a_) - Vec3::UnitX();
+  std::vector<std::complex<double>> U;
+  for (const Harmonic& x : hs_) U.push_back(x.I + slope[IA] * x.F[IA] + slope[PA] * x.F[PA] + slope[OA] * x.F[OA]);
+  const double u0 = plant::output_g(coefficients, a_);
+  const double u_mean = u0 + mean_g_[IA] + slope.dot(mean_g_);
+  const int kM = points_;
+  double readout_mean = 0;
+  for (int k = 0; k < kM; ++k) {
+    double u = u_mean;
+    for (std::size_t j = 0; j < hs_.size(); ++j) u += std::imag(U[j] * phasors_[static_cast<std::size_t>(k) * hs_.size() + j]);
+    for (const auto& e : readout_) readout_mean += (e->readout(u) - u) / kM;
+  }
+  for (const auto& e : readout_) readout_mean -= e->readout(u0) - u0;
+  out.readout_g = readout_mean;
   return out;
 }
 

@@ -24,6 +24,8 @@
 #include <array>
 #include <complex>
 #include <functional>
+#include <memory>
+#include <optional>
 #include <utility>
 #include <vector>
 
@@ -77,6 +79,23 @@ struct LoopResponse {
   double dc_gain = 1;
 };
 LoopResponse loop_response(const plant::PlantConfig& plant, double frequency_Hz);
+// The same, the plant linearised once for any number of frequencies (and the DC gain, the
+// same at every frequency, solved once): responder(f) equals loop_response(plant, f) bit for
+// bit (loop_response is this). With dc_gain false, the responses' dc_gain is left at 1 (for a
+// caller that needs the current and the angle only).
+class LoopResponder {
+ public:
+  explicit LoopResponder(const plant::PlantConfig& plant, bool dc_gain = true);
+  LoopResponse operator()(double frequency_Hz) const;
+
+ private:
+  std::vector<std::shared_ptr<const plant::Effect>> kept_;  // the linear effects (their transmissibility)
+  Eigen::VectorXd sc_;
+  Eigen::MatrixXcd a_scaled_, b_scaled_;
+  int n_ = 0;
+  double lead_ratio_ = 0, gain_g_per_rad_ = 0, integrator_rad_per_s_ = 0, dc_gain_ = 1;
+  Eigen::MatrixXcd solve_at(double w_solve, const Eigen::MatrixXcd& rhs) const;
+};
 // The same prediction with the response given (its frequency must be v's).
 FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
                                                     const vibration::SineVibration& v, std::optional<double> range_limit_g,
@@ -112,5 +131,54 @@ using ResponseAt = std::function<LoopResponse(double frequency_Hz)>;
 FrequencyPrediction periodic_rectification(const plant::PlantConfig& plant, const Vec3& a_static_g,
                                            const PeriodicInput& input, const ResponseAt& response,
                                            bool allow_closed_form = true);
+
+// The same two predictions split in two (for a caller that varies the coefficients only, such
+// as a prediction's gradient in them): what does not depend on the coefficients (the vibration
+// through the loop's response; for a periodic input, the period's samples of the felt
+// acceleration and the current and the basis functions' averages) computed once, and what
+// does (the terms of (1), the readout) for any coefficients. prepared(c) equals the function
+// above for the plant with its coefficients replaced by c, bit for bit (the functions above
+// are these). The plant's effects, locations and dynamics are the constructor's.
+class PreparedSineRectification {
+ public:
+  PreparedSineRectification(const plant::PlantConfig& plant, const Vec3& a_static_g, const vibration::SineVibration& v,
+                            std::optional<double> range_limit_g, const LoopResponse& response);
+  FrequencyPrediction operator()(const plant::Coefficients& c) const;
+
+ private:
+  std::array<plant::Location, plant::kNumCoefficients> location_;
+  std::vector<std::shared_ptr<const plant::Effect>> readout_;  // the effects averaged on the readout
+  Vec3 a_;
+  std::optional<double> range_;
+  Eigen::Vector3cd F_;
+  vibration::SineVibration felt_, through_loop_;
+  std::complex<double> current_;
+  double amp_i_ = 0;
+  FrequencyPrediction fixed_;  // the parts independent of the coefficients
+};
+
+class PreparedPeriodicRectification {
+ public:
+  PreparedPeriodicRectification(const plant::PlantConfig& plant, const Vec3& a_static_g, const PeriodicInput& input,
+                                const ResponseAt& response, bool allow_closed_form = true);
+  FrequencyPrediction operator()(const plant::Coefficients& c) const;
+
+ private:
+  struct Harmonic {
+    int h;
+    Eigen::Vector3cd F;
+    std::complex<double> I, Theta;
+  };
+  std::optional<PreparedSineRectification> closed_form_;
+  std::array<plant::Location, plant::kNumCoefficients> location_;
+  std::vector<std::shared_ptr<const plant::Effect>> readout_;  // the effects averaged on the readout
+  Vec3 a_, mean_g_;
+  std::vector<Harmonic> hs_;
+  int points_ = 0;
+  std::vector<std::complex<double>> phasors_;  // e^{j h phi_k}, per point and harmonic (a readout only)
+  std::array<double, plant::kNumCoefficients> at_input_{}, in_loop_{};
+  plant::Basis b0_{};
+  FrequencyPrediction fixed_;  // the parts independent of the coefficients
+};
 
 }  // namespace vrelab::rectification

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <complex>
 #include <cstdio>
 #include <numbers>
 #include <cmath>
@@ -95,21 +96,25 @@ class ResponseCache {
     const bool same = bound_ && plant.coefficients.v == plant_.coefficients.v && key(plant.dynamics) == key(plant_.dynamics);
     if (same) return;
     plant_ = plant, bound_ = true;
-    tables_.clear(), absorbed_.clear(), cache_.clear();
+    tables_.clear(), absorbed_.clear(), cache_.clear(), responders_.clear();
   }
   std::map<std::string, std::shared_ptr<const Table>> tables_;
   std::map<std::string, plant::Coefficients> absorbed_;
 
+  // (A response is computed for the first plant that asks for its key and frequency, as
+  // loop_response would compute it; the plant is linearised once for every frequency asked of
+  // a linear part alike (rectification::LoopResponder: the same numbers).)
   const rectification::LoopResponse& get(const PlantConfig& cfg, const std::string& key, double f) {
     auto k = std::make_pair(key, f);
     auto it = cache_.find(k);
     if (it == cache_.end()) {
+      if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
       if (cfg.servo) {
-        it = cache_.emplace(k, rectification::loop_response(cfg, f)).first;
+        it = cache_.emplace(k, responder(cfg, key)(f)).first;
       } else {
         PlantConfig with_servo = cfg;
         with_servo.servo = servo(cfg.dynamics);
-        it = cache_.emplace(k, rectification::loop_response(with_servo, f)).first;
+        it = cache_.emplace(k, responder(with_servo, key)(f)).first;
       }
     }
     return it->second;
@@ -128,7 +133,35 @@ class ResponseCache {
     if (it == servos_.end()) it = servos_.emplace(k, plant::design_servo(d)).first;
     return it->second;
   }
+  // What loop_response reads of a plant (with its servo): the coefficients its linear plant
+  // keeps, the locations, the dynamics, the servo, and the linear effects (their
+  // transmissibility at a probe frequency; the key names the effect and its values).
+  static std::vector<double> linear_part(const PlantConfig& cfg) {
+    std::vector<double> v;
+    for (int c : {plant::K1, plant::k0, plant::delta_OA, plant::delta_PA}) v.push_back(cfg.coefficients[c]);
+    for (const plant::Location l : cfg.location) v.push_back(static_cast<double>(l));
+    const DynamicsKey d = key(cfg.dynamics);
+    std::apply([&](auto... x) { (v.push_back(static_cast<double>(x)), ...); }, d);
+    v.push_back(cfg.torquer_c2_per_g), v.push_back(cfg.torquer_c3_per_g2);
+    const plant::Servo& sv = *cfg.servo;
+    for (double x : {sv.gain_g_per_rad, sv.lead_zero_rad_per_s, sv.lead_pole_rad_per_s, sv.integrator_rad_per_s}) v.push_back(x);
+    for (const auto& e : cfg.effects)
+      if (e->kept_in_linearisation()) {
+        for (int j = 0; j < 3; ++j) {
+          const std::complex<double> t = e->transmissibility(j, 2 * std::numbers::pi * 1234.5);
+          v.push_back(t.real()), v.push_back(t.imag());
+        }
+      }
+    return v;
+  }
+  const rectification::LoopResponder& responder(const PlantConfig& cfg, const std::string& key) {
+    auto k = std::make_pair(key, linear_part(cfg));
+    auto it = responders_.find(k);
+    if (it == responders_.end()) it = responders_.emplace(k, std::make_unique<rectification::LoopResponder>(cfg)).first;
+    return *it->second;
+  }
   std::map<std::pair<std::string, double>, rectification::LoopResponse> cache_;
+  std::map<std::pair<std::string, std::vector<double>>, std::unique_ptr<rectification::LoopResponder>> responders_;
   std::map<DynamicsKey, plant::Servo> servos_;
   PlantConfig plant_;
   bool bound_ = false;
@@ -201,11 +234,19 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       }
       return z;
     }();
+    // A periodic run: what does not depend on the coefficients (the motion through the loop,
+    // the period's averages) once for the gradient's 12 evaluations (the same numbers).
+    std::optional<rectification::PreparedPeriodicRectification> periodic;
+    if (!rr) periodic.emplace(cfg, r.orientation_g, input, h);
     const auto f = [&](const Coefficients& co) {
-      PlantConfig q = cfg;
-      for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
-      if (rr) return rectification::random_rectification_at_frequency(q, r.orientation_g, *rr, sine, sine_h).total_g();
-      return rectification::periodic_rectification(q, r.orientation_g, input, h).total_g();
+      if (rr) {
+        PlantConfig q = cfg;
+        for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
+        return rectification::random_rectification_at_frequency(q, r.orientation_g, *rr, sine, sine_h).total_g();
+      }
+      Coefficients q;
+      for (int i = 0; i < plant::kNumCoefficients; ++i) q[i] = co[i] + shift[i];
+      return (*periodic)(q).total_g();
     };
     const CoefArray g = prediction_gradient(f, nominal.coefficients);
     for (int i = 0; i < plant::kNumCoefficients; ++i) t.G(k, i) = g[i];
@@ -773,8 +814,16 @@ Coefficients settled_fit(const PlantConfig& plant, const std::vector<Position>& 
                          const FixedSet& fixed) {
   std::vector<Reading> readings;
   const double K1 = plant.coefficients[plant::K1];
-  for (std::size_t i = 0; i < positions.size(); ++i)
-    readings.push_back({static_cast<int>(i), K1 * plant::settled_output_g(plant, positions[i].nominal_g)});
+  // A position read more than once (a static test's repeats) is settled once: the same plant
+  // at the same orientation settles to the same number.
+  std::map<std::array<double, 3>, double> settled;
+  for (std::size_t i = 0; i < positions.size(); ++i) {
+    const Vec3& g = positions[i].nominal_g;
+    const std::array<double, 3> at{g[0], g[1], g[2]};
+    auto it = settled.find(at);
+    if (it == settled.end()) it = settled.emplace(at, plant::settled_output_g(plant, g)).first;
+    readings.push_back({static_cast<int>(i), K1 * it->second});
+  }
   return least_squares(positions, readings, weights, fixed).estimate.value;
 }
 
