@@ -171,6 +171,10 @@ Accelerometer::Accelerometer(PlantConfig config, const Vec3& a_static_g, Input i
   }
   for (int c : kCrossTerms)
     if (config_.coefficients[c] != 0) has_cross_[static_cast<std::size_t>(config_.location[c])] = true;
+  for (int c : kIaTerms)
+    if (config_.coefficients[c] != 0 && config_.location[c] != Location::output)
+      newton_terms_[static_cast<std::size_t>(n_newton_terms_++)] = {c, config_.coefficients[c], config_.location[c] == Location::input};
+  for (int t = 0; t < n_newton_terms_; ++t) has_kink_ |= newton_terms_[static_cast<std::size_t>(t)].c == k1_asym;
   n_ = kCoreStates;
   for (const auto& e : config_.effects) {
     effect_offset_.push_back(n_);
@@ -204,28 +208,47 @@ double Accelerometer::cross(Location l, const Vec3& a) const {
 double Accelerometer::solve_z(double i) const {
   if (!has_in_ia_ && !has_loop_) return i;
   // m_il(z) = z + F_input(z) + F_loop(z) = i: monotone, a small perturbation of z = i.
-  double z = i - f_ia(Location::input, i) - f_ia(Location::loop, i);
-  for (int it = 0; it < 30; ++it) {
-    // f_ia and f_ia_slope at the input and in the loop in one pass over the terms (the same
-    // sums in the same order: bit-identical to four calls).
-    double f_in = 0, f_loop = 0, s_in = 0, s_loop = 0;
-    for (int c : kIaTerms) {
-      const Location l = config_.location[c];
-      const double k = config_.coefficients[c];
-      if (l == Location::output || k == 0) continue;  // adds +-0 to sums that start at +0
-      const double f = k * ia_basis(c, z), sl = k * ia_basis_slope(c, z);
-      if (l == Location::input) {
-        f_in += f;
-        s_in += sl;
+  // Sums over the IA terms with a coefficient at the input or in the loop (newton_terms_),
+  // in the order of f_ia: the same sums (f_ia's zero terms add +-0 to sums that start at +0).
+  const auto sums = [this](double z, double* f_in, double* f_loop, double* s_in, double* s_loop, double* curvature) {
+    *f_in = *f_loop = *s_in = *s_loop = 0;
+    double c = 0;  // |F''|: bounds Newton's next error
+    for (int t = 0; t < n_newton_terms_; ++t) {
+      const NewtonTerm& term = newton_terms_[static_cast<std::size_t>(t)];
+      double f, sl;
+      switch (term.c) {
+        case k0: f = term.k * 1.0, sl = term.k * 0.0; break;
+        case k1_asym: f = term.k * (0.5 * std::abs(z)), sl = term.k * (0.5 * ((z > 0) - (z < 0))); break;
+        case k2: f = term.k * (z * z), sl = term.k * (2 * z), c += std::abs(2 * term.k); break;
+        case k3: f = term.k * (z * z * z), sl = term.k * (3 * z * z), c += std::abs(6 * term.k * z); break;
+        default: f = term.k * (z * z * z * z), sl = term.k * (4 * z * z * z), c += std::abs(12 * term.k * z * z); break;
+      }
+      if (term.input) {
+        *f_in += f;
+        *s_in += sl;
       } else {
-        f_loop += f;
-        s_loop += sl;
+        *f_loop += f;
+        *s_loop += sl;
       }
     }
+    *curvature = c;
+  };
+  double f_in, f_loop, s_in, s_loop, curvature;
+  sums(i, &f_in, &f_loop, &s_in, &s_loop, &curvature);
+  double z = i - f_in - f_loop;
+  for (int it = 0; it < 30; ++it) {
+    sums(z, &f_in, &f_loop, &s_in, &s_loop, &curvature);
     const double g = z + f_in + f_loop - i;
-    const double dz = g / (1 + s_in + s_loop);
+    const double slope = 1 + s_in + s_loop;
+    const double dz = g / slope;
+    const double z_before = z;
     z -= dz;
-    if (std::abs(dz) <= 1e-16 * (1 + std::abs(z))) break;
+    const double tolerance = 1e-16 * (1 + std::abs(z));
+    if (std::abs(dz) <= tolerance) break;
+    // Newton's next step would be about |F''| dz^2 / (2 m'): below the tolerance it would
+    // change z by at most an ulp, so the iteration stops a step early (not across the kink
+    // of the k1_asym term, where F'' does not bound it).
+    if (curvature * dz * dz <= 0.1 * tolerance * std::abs(slope) && ((z > 0) == (z_before > 0) || !has_kink_)) break;
   }
   return z;
 }

@@ -71,11 +71,14 @@ struct Kernel {
   }
   // g <- f - B a (f in g on entry); N = g - A sigma; dN = N - N_prev (0 at the start);
   // returns C P2 dN (the output's correction from sigma to the corrected state).
+  // Also gathers f (the plant's derivative, all states) into g first, and sets *linear to the
+  // companion's linear output.
   static double correct(const StepData& d, bool first) {
     const int n = d.n;
     const MapM a(d.a, n, n);
     MapV g(d.g, n), nprev(d.n_prev, n), dn(d.dn, n);
     const MapCV sigma(d.sigma, n), cp2(d.c_p2, n);
+    for (int i = 0; i < n; ++i) d.g[i] = d.f[d.act[i]];
     for (int i = 0; i < d.k_axes; ++i) g -= Eigen::Map<const Eigen::Matrix<double, N, 1>>(d.b + i * n, n) * d.a_k[i];
     Eigen::Matrix<double, N, 1> nnow(n);
     nnow = g;
@@ -85,6 +88,10 @@ struct Kernel {
     else
       dn = nnow - nprev;
     nprev = nnow;
+    double lin = MapCV(d.q_row, n).dot(MapCV(d.z, n));
+    double lin_input = 0;
+    for (int i = 0; i < d.k_axes; ++i) lin_input += d.q_input[i] * d.a_k[i];
+    *d.linear = lin + lin_input;
     return cp2.dot(dn);
   }
 };
@@ -309,6 +316,11 @@ StepData DiscretisedRandomPlant::step_data() {
   d.n_prev = n_prev_.data();
   d.dn = dn_.data();
   d.a_k = a_k_.data();
+  d.f = f_.data();
+  d.act = act_.data();
+  d.q_row = q_row_.data();
+  d.q_input = q_input_.data();
+  d.linear = &linear_;
   return d;
 }
 
@@ -341,12 +353,10 @@ void DiscretisedRandomPlant::evaluate_at_grid_point() {
   }
   out_ = plant_.rhs_output(a_, x_.data(), f_.data());
   ++evaluations_;
-  for (int i = 0; i < na_; ++i) g_[i] = f_[static_cast<std::size_t>(act_[static_cast<std::size_t>(i)])];
   for (int i : inert_)
     if (f_[static_cast<std::size_t>(i)] != 0.0)
       throw std::logic_error("DiscretisedRandomPlant: a state the linearisation holds still moved");
-  out_ += correct_(data_, m_ == 0);
-  linear_ = q_row_.dot(z_) + q_input_.dot(a_k_);
+  out_ += correct_(data_, m_ == 0);  // also the linear output
 }
 
 }  // namespace vrelab::rectification

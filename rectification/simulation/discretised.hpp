@@ -46,8 +46,9 @@ namespace vrelab::rectification {
 struct StepData {
   int n = 0, w = 0, k_axes = 0;
   const double *e = nullptr, *p1 = nullptr, *ep2 = nullptr, *a = nullptr, *b = nullptr, *k = nullptr,
-               *c_p2 = nullptr, *window = nullptr, *a_k = nullptr;
-  double *z = nullptr, *sigma = nullptr, *g = nullptr, *n_prev = nullptr, *dn = nullptr;
+               *c_p2 = nullptr, *window = nullptr, *a_k = nullptr, *f = nullptr, *q_row = nullptr, *q_input = nullptr;
+  const int* act = nullptr;
+  double *z = nullptr, *sigma = nullptr, *g = nullptr, *n_prev = nullptr, *dn = nullptr, *linear = nullptr;
 };
 
 class DiscretisedRandomPlant {
