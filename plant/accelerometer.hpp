@@ -141,7 +141,6 @@ class Accelerometer final : public OdeSystem {
   };
   std::array<NewtonTerm, 5> newton_terms_{};
   int n_newton_terms_ = 0;
-  bool has_kink_ = false;  // a k1_asym term among them
 };
 
 // The plant run statically: from rest with every state zero (the instrument switched on in

@@ -76,10 +76,13 @@ struct Kernel {
   static double correct(const StepData& d, bool first) {
     const int n = d.n;
     const MapM a(d.a, n, n);
-    MapV g(d.g, n), nprev(d.n_prev, n), dn(d.dn, n);
+    MapV g_out(d.g, n), nprev(d.n_prev, n), dn(d.dn, n);
     const MapCV sigma(d.sigma, n), cp2(d.c_p2, n);
-    for (int i = 0; i < n; ++i) d.g[i] = d.f[d.act[i]];
+    // Gathered into a local (scalar stores read back as pairs would stall the store forwarding).
+    Eigen::Matrix<double, N, 1> g(n);
+    for (int i = 0; i < n; ++i) g[i] = d.f[d.act[i]];
     for (int i = 0; i < d.k_axes; ++i) g -= Eigen::Map<const Eigen::Matrix<double, N, 1>>(d.b + i * n, n) * d.a_k[i];
+    g_out = g;
     Eigen::Matrix<double, N, 1> nnow(n);
     nnow = g;
     nnow.noalias() -= a * sigma;
