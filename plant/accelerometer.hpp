@@ -133,6 +133,14 @@ class Accelerometer final : public OdeSystem {
   double q_ref_ = 0.0;
   bool has_in_ia_ = false, has_loop_ = false, has_out_ia_ = false;
   std::array<bool, 3> has_cross_{};  // a cross term with a non-zero coefficient at each Location
+  // The IA terms solve_z's Newton iteration sums: non-zero, at the input or in the loop.
+  struct NewtonTerm {
+    int c = 0;
+    double k = 0;
+    bool input = false;
+  };
+  std::array<NewtonTerm, 5> newton_terms_{};
+  int n_newton_terms_ = 0;
 };
 
 // The plant run statically: from rest with every state zero (the instrument switched on in

@@ -2,10 +2,14 @@
 
 #include "vibration/detail.hpp"
 
+#include <fftw3.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <numbers>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -160,10 +164,114 @@ std::string SampledExcitation::describe() const {
 
 // ---------------------------------------------------------------- RandomExcitation
 
+namespace {
+
+// random_phase_block(profile, M, fs, seed, j) for a RandomExcitation's blocks, bit for bit,
+// with what does not depend on j made once: the amplitude of every bin (the PSD's log-log
+// interpolation, a pow and a log per bin), the FFTW plan (FFTW_ESTIMATE, as random_phase_block
+// plans it; an FFTW plan gives the same numbers for the same size and flags) and its aligned
+// buffers. The phases are drawn and turned into the spectrum exactly as random_phase_block
+// does (test RandomExcitation.BlocksEqualRandomPhaseBlock checks the equality).
+class BlockSynthesiser {
+ public:
+  BlockSynthesiser(const RandomProfile& p, double fs, std::uint64_t seed, std::size_t m)
+      : profile_(p), seed_(seed), m_(m), kmax_((m - 1) / 2) {
+    for (int a = 0; a < 3; ++a) {
+      if (!p.psd[a]) continue;
+      const ResolvedPsd psd = resolve(*p.psd[a]);
+      for (std::size_t k = 1; k <= kmax_; ++k) {
+        const double g = psd_g2_per_Hz(psd, static_cast<double>(k) * fs / static_cast<double>(m));
+        if (g == 0.0) continue;
+        bins_[a].push_back(k);
+        amp_[a].push_back(std::sqrt(g * fs / (2.0 * static_cast<double>(m))));
+      }
+    }
+    spec_ = static_cast<fftw_complex*>(fftw_malloc(sizeof(fftw_complex) * (m / 2 + 1)));
+    sig_ = static_cast<double*>(fftw_malloc(sizeof(double) * m));
+    if (spec_ == nullptr || sig_ == nullptr) {
+      release();
+      throw std::bad_alloc();
+    }
+    std::lock_guard lock(fftw_planner_mutex());
+    plan_ = fftw_plan_dft_c2r_1d(static_cast<int>(m), spec_, sig_, FFTW_ESTIMATE);
+    if (plan_ == nullptr) {
+      release();
+      throw std::runtime_error("fftw_plan_dft_c2r_1d failed for n = " + std::to_string(m));
+    }
+  }
+  ~BlockSynthesiser() { release(); }
+  BlockSynthesiser(const BlockSynthesiser&) = delete;
+  BlockSynthesiser& operator=(const BlockSynthesiser&) = delete;
+
+  SampledSignal block(double fs, std::int64_t block_index) {
+    const auto b = static_cast<std::uint64_t>(block_index);
+    std::seed_seq seq{static_cast<std::uint32_t>(seed_), static_cast<std::uint32_t>(seed_ >> 32),
+                      static_cast<std::uint32_t>(b), static_cast<std::uint32_t>(b >> 32)};
+    std::mt19937_64 engine(seq);
+    std::array<std::vector<double>, 3> phase;
+    for (int a = 0; a < 3; ++a) {
+      if (a > 0 && profile_.coupling == AxisCoupling::common) {
+        phase[a] = phase[0];
+        continue;
+      }
+      phase[a].resize(kmax_ + 1);
+      // Uniform in [0, 1) from the top 53 bits (random.cpp's unit_uniform).
+      for (std::size_t k = 1; k <= kmax_; ++k)
+        phase[a][k] = 2 * std::numbers::pi * (static_cast<double>(engine() >> 11) * 0x1p-53);
+    }
+    SampledSignal out;
+    out.sample_rate_Hz = fs;
+    const std::size_t nbins = m_ / 2 + 1;
+    for (int a = 0; a < 3; ++a) {
+      out.samples_g[a].assign(m_, 0.0);
+      if (!profile_.psd[a]) continue;
+      for (std::size_t k = 0; k < nbins; ++k) spec_[k][0] = spec_[k][1] = 0.0;
+      for (std::size_t i = 0; i < bins_[a].size(); ++i) {
+        const std::size_t k = bins_[a][i];
+        spec_[k][0] = amp_[a][i] * std::cos(phase[a][k]);
+        spec_[k][1] = amp_[a][i] * std::sin(phase[a][k]);
+      }
+      fftw_execute_dft_c2r(plan_, spec_, sig_);
+      std::copy(sig_, sig_ + m_, out.samples_g[a].begin());
+    }
+    return out;
+  }
+  std::size_t bytes() const {
+    std::size_t n = sizeof(fftw_complex) * (m_ / 2 + 1) + sizeof(double) * m_;
+    for (int a = 0; a < 3; ++a) n += bins_[a].size() * (sizeof(std::size_t) + sizeof(double));
+    return n;
+  }
+
+ private:
+  void release() {
+    if (plan_ != nullptr) {
+      std::lock_guard lock(fftw_planner_mutex());
+      fftw_destroy_plan(plan_);
+    }
+    fftw_free(spec_);
+    fftw_free(sig_);
+    plan_ = nullptr, spec_ = nullptr, sig_ = nullptr;
+  }
+  const RandomProfile& profile_;
+  std::uint64_t seed_;
+  std::size_t m_, kmax_;
+  std::array<std::vector<std::size_t>, 3> bins_;  // bins with power, per axis
+  std::array<std::vector<double>, 3> amp_;        // their amplitudes
+  fftw_complex* spec_ = nullptr;
+  double* sig_ = nullptr;
+  fftw_plan plan_ = nullptr;
+};
+
+}  // namespace
+
 struct RandomExcitation::Cache {
   std::mutex mutex;
   Lru<SampledSignal> blocks{4};
   Lru<Coefficients3> stretches{3};
+  // Made on first use (a RandomExcitation that is only described costs nothing).
+  std::unique_ptr<BlockSynthesiser> synthesiser;
+  // The overlap-add weights cos(pi r / M), sin(pi r / M), r = 0 .. M/2 - 1.
+  std::vector<double> w0, w1;
 };
 
 RandomExcitation::RandomExcitation(const RandomProfile& profile, double fs, std::uint64_t seed, std::size_t m)
@@ -193,27 +301,47 @@ std::size_t RandomExcitation::memory_bytes() const {
          cache_->stretches.capacity() * 3 * (m_ / 2) * sizeof(double);
 }
 
+std::size_t RandomExcitation::synthesis_bytes() const {
+  std::lock_guard lock(cache_->mutex);
+  return (cache_->synthesiser ? cache_->synthesiser->bytes() : 0) + (cache_->w0.size() + cache_->w1.size()) * sizeof(double);
+}
+
 namespace {
 
 // Stream samples [first, first + count) into out (count per axis); the cache's lock is held.
 void stream_samples(const RandomProfile& profile, double fs, std::uint64_t seed, std::size_t m,
-                    Lru<SampledSignal>& blocks, std::int64_t first, std::size_t count, Coefficients3& out) {
+                    RandomExcitation::Cache& cache, std::int64_t first, std::size_t count, Coefficients3& out) {
   const auto h = static_cast<std::int64_t>(m / 2);
+  if (!cache.synthesiser) {
+    cache.synthesiser = std::make_unique<BlockSynthesiser>(profile, fs, seed, m);
+    cache.w0.resize(static_cast<std::size_t>(h));
+    cache.w1.resize(static_cast<std::size_t>(h));
+    for (std::int64_t r = 0; r < h; ++r) {
+      const double theta = std::numbers::pi * static_cast<double>(r) / static_cast<double>(m);
+      cache.w0[static_cast<std::size_t>(r)] = std::cos(theta);
+      cache.w1[static_cast<std::size_t>(r)] = std::sin(theta);
+    }
+  }
+  BlockSynthesiser& synth = *cache.synthesiser;
   for (auto& v : out) v.assign(count, 0.0);
   std::size_t i = 0;
   while (i < count) {
     const std::int64_t c = floor_div(first + static_cast<std::int64_t>(i), h);  // [cH, (c+1)H): blocks c, c+1
-    const auto b0 = blocks.get(c, [&] { return random_phase_block(profile, m, fs, seed, c); });
-    const auto b1 = blocks.get(c + 1, [&] { return random_phase_block(profile, m, fs, seed, c + 1); });
-    for (; i < count && first + static_cast<std::int64_t>(i) < (c + 1) * h; ++i) {
-      const std::int64_t r = first + static_cast<std::int64_t>(i) - c * h;  // 0 .. H-1
-      // Block c+1 at m = r has weight sin(pi r / M); block c at m = r + H has sin(pi r / M + pi/2).
-      const double theta = std::numbers::pi * static_cast<double>(r) / static_cast<double>(m);
-      const double w0 = std::cos(theta), w1 = std::sin(theta);
-      for (int a = 0; a < 3; ++a)
-        out[a][i] =
-            w0 * b0->samples_g[a][static_cast<std::size_t>(r + h)] + w1 * b1->samples_g[a][static_cast<std::size_t>(r)];
+    const auto b0 = cache.blocks.get(c, [&] { return synth.block(fs, c); });
+    const auto b1 = cache.blocks.get(c + 1, [&] { return synth.block(fs, c + 1); });
+    // Block c+1 at m = r has weight sin(pi r / M); block c at m = r + H has sin(pi r / M + pi/2).
+    const std::int64_t r0 = first + static_cast<std::int64_t>(i) - c * h;  // 0 .. H-1
+    const std::size_t n = std::min(count - i, static_cast<std::size_t>(h - r0));
+    for (int a = 0; a < 3; ++a) {
+      if (!profile.psd[a]) continue;  // the blocks' samples are +0 (assigned above)
+      const double* x0 = b0->samples_g[a].data() + r0 + h;
+      const double* x1 = b1->samples_g[a].data() + r0;
+      const double* w0 = cache.w0.data() + r0;
+      const double* w1 = cache.w1.data() + r0;
+      double* o = out[a].data() + i;
+      for (std::size_t q = 0; q < n; ++q) o[q] = w0[q] * x0[q] + w1[q] * x1[q];
     }
+    i += n;
   }
 }
 
@@ -223,7 +351,7 @@ SampledSignal RandomExcitation::samples(std::int64_t first, std::size_t count) c
   SampledSignal out;
   out.sample_rate_Hz = fs_;
   std::lock_guard lock(cache_->mutex);
-  stream_samples(profile_, fs_, seed_, m_, cache_->blocks, first, count, out.samples_g);
+  stream_samples(profile_, fs_, seed_, m_, *cache_, first, count, out.samples_g);
   return out;
 }
 
@@ -239,7 +367,7 @@ Vec3 RandomExcitation::acceleration_g(double t) const {
   auto stretch = [&](std::int64_t c) {
     return cache_->stretches.get(c, [&] {
       Coefficients3 x;
-      stream_samples(profile_, fs_, seed_, m_, cache_->blocks, c * h - kMargin,
+      stream_samples(profile_, fs_, seed_, m_, *cache_, c * h - kMargin,
                      static_cast<std::size_t>(h + 2 * kMargin), x);
       for (auto& v : x) {
         prefilter(v);

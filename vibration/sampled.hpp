@@ -75,6 +75,7 @@ class SampledExcitation final : public Excitation {
 
 class RandomExcitation final : public Excitation {
  public:
+  struct Cache;
   // block_length M: even, >= 1024, and fine enough that fs/M is at most a quarter of the
   // narrowest table segment (otherwise std::invalid_argument naming block_length).
   RandomExcitation(const RandomProfile& profile, double sample_rate_Hz, std::uint64_t seed,
@@ -88,11 +89,14 @@ class RandomExcitation final : public Excitation {
   // at t = n / fs), per axis.
   SampledSignal samples(std::int64_t first, std::size_t count) const;
   std::size_t memory_bytes() const;
+  // Beside the caches, fixed for the object's life once it has synthesised: the amplitude of
+  // every bin with power, the FFT's buffers and plan, the blocks' overlap weights (~1.2 MB
+  // at M = 32768 with one axis; 0 before the first sample).
+  std::size_t synthesis_bytes() const;
   double sample_rate_Hz() const { return fs_; }
   std::size_t block_length() const { return m_; }
 
  private:
-  struct Cache;
   RandomProfile profile_;
   double fs_;
   std::uint64_t seed_;

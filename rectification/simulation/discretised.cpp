@@ -71,12 +71,18 @@ struct Kernel {
   }
   // g <- f - B a (f in g on entry); N = g - A sigma; dN = N - N_prev (0 at the start);
   // returns C P2 dN (the output's correction from sigma to the corrected state).
+  // Also gathers f (the plant's derivative, all states) into g first, and sets *linear to the
+  // companion's linear output.
   static double correct(const StepData& d, bool first) {
     const int n = d.n;
     const MapM a(d.a, n, n);
-    MapV g(d.g, n), nprev(d.n_prev, n), dn(d.dn, n);
+    MapV g_out(d.g, n), nprev(d.n_prev, n), dn(d.dn, n);
     const MapCV sigma(d.sigma, n), cp2(d.c_p2, n);
+    // Gathered into a local (scalar stores read back as pairs would stall the store forwarding).
+    Eigen::Matrix<double, N, 1> g(n);
+    for (int i = 0; i < n; ++i) g[i] = d.f[d.act[i]];
     for (int i = 0; i < d.k_axes; ++i) g -= Eigen::Map<const Eigen::Matrix<double, N, 1>>(d.b + i * n, n) * d.a_k[i];
+    g_out = g;
     Eigen::Matrix<double, N, 1> nnow(n);
     nnow = g;
     nnow.noalias() -= a * sigma;
@@ -85,6 +91,10 @@ struct Kernel {
     else
       dn = nnow - nprev;
     nprev = nnow;
+    double lin = MapCV(d.q_row, n).dot(MapCV(d.z, n));
+    double lin_input = 0;
+    for (int i = 0; i < d.k_axes; ++i) lin_input += d.q_input[i] * d.a_k[i];
+    *d.linear = lin + lin_input;
     return cp2.dot(dn);
   }
 };
@@ -92,13 +102,15 @@ struct Kernel {
 }  // namespace
 
 // The excitation's spline coefficients, streamed: a window of kLength coefficients refilled
-// from RandomExcitation::samples (bounded memory for any run length).
+// from RandomExcitation::samples (bounded memory for any run length), the excited axes
+// interleaved (coefficient i of axis slot a at (i - first) k + a: the 7 k coefficients of a
+// step are contiguous, in the order of the step matrices' columns).
 struct DiscretisedRandomPlant::Coefficients {
   static constexpr std::int64_t kLength = 8192;
   const vibration::RandomExcitation& ex;
   std::vector<int> axes;
   std::int64_t first = std::numeric_limits<std::int64_t>::min();
-  std::vector<std::vector<double>> c;  // per excited axis
+  std::vector<double> c;
 
   // Coefficients [lo, hi] available.
   void ensure(std::int64_t lo, std::int64_t hi) {
@@ -106,18 +118,21 @@ struct DiscretisedRandomPlant::Coefficients {
     core::throw_if_cancelled();  // a caller's cancel flag (core/cancel.hpp), every 8192 knots
     first = lo;
     const vibration::SampledSignal s = ex.samples(first - kMargin, static_cast<std::size_t>(kLength + 2 * kMargin));
-    c.resize(axes.size());
-    for (std::size_t a = 0; a < axes.size(); ++a) {
+    const std::size_t k = axes.size();
+    c.assign(static_cast<std::size_t>(kLength) * k, 0.0);
+    for (std::size_t a = 0; a < k; ++a) {
       std::vector<double> v = s.samples_g[static_cast<std::size_t>(axes[a])];
       vibration::quintic_prefilter(v);
-      c[a].assign(v.begin() + kMargin, v.end() - kMargin);
+      for (std::int64_t i = 0; i < kLength; ++i)
+        c[static_cast<std::size_t>(i) * k + a] = v[static_cast<std::size_t>(i + kMargin)];
     }
     for (int axis = 0; axis < 3; ++axis)
       if (std::find(axes.begin(), axes.end(), axis) == axes.end())
         for (double v : s.samples_g[static_cast<std::size_t>(axis)])
           if (v != 0.0) throw std::logic_error("DiscretisedRandomPlant: an axis at rest moved");
   }
-  double at(std::size_t a, std::int64_t i) const { return c[a][static_cast<std::size_t>(i - first)]; }
+  // The coefficients from i on (ensure first).
+  const double* from(std::int64_t i) const { return c.data() + static_cast<std::size_t>(i - first) * axes.size(); }
 };
 
 std::string DiscretisedRandomPlant::unsupported(const plant::PlantConfig& config, const vibration::RandomExcitation& ex,
@@ -140,7 +155,7 @@ std::string DiscretisedRandomPlant::unsupported(const plant::PlantConfig& config
 
 DiscretisedRandomPlant::DiscretisedRandomPlant(const Accelerometer& plant, const Accelerometer::Linear& lin,
                                                const std::vector<double>& x_eq, const vibration::RandomExcitation& ex,
-                                               double rate)
+                                               double rate, bool quadrature)
     : plant_(plant), x_eq_(x_eq), rate_(rate), n_(plant.size()) {
   const std::string why = unsupported(plant.config(), ex, rate);
   if (!why.empty()) throw std::invalid_argument("discretised random path: " + why);
@@ -213,11 +228,22 @@ DiscretisedRandomPlant::DiscretisedRandomPlant(const Accelerometer& plant, const
   const Eigen::MatrixXd phi = etd.exp();
   // Restricted to the states that move: the inert ones (zero row and column of A, zero row
   // of B: the anti-alias filter when off) stay at rest, their blocks of every matrix being 0.
+  // The quadrature feeds nothing back (its column of A is 0): stepped last, and only when
+  // residual_quadrature is wanted.
   std::vector<int> inert;
   for (int i = 0; i < n_; ++i) {
     const bool still = lin.A.row(i).cwiseAbs().maxCoeff() == 0 && lin.A.col(i).cwiseAbs().maxCoeff() == 0 &&
                        lin.B.row(i).cwiseAbs().maxCoeff() == 0;
-    (still ? inert : act_).push_back(i);
+    if (still)
+      inert.push_back(i);
+    else if (i != Accelerometer::kQuadrature)
+      act_.push_back(i);
+  }
+  if (lin.A.col(Accelerometer::kQuadrature).cwiseAbs().maxCoeff() != 0)
+    throw std::logic_error("DiscretisedRandomPlant: the quadrature feeds back");
+  if (quadrature) {
+    q_index_ = static_cast<int>(act_.size());
+    act_.push_back(Accelerometer::kQuadrature);
   }
   inert_ = inert;
   na_ = static_cast<int>(act_.size());
@@ -241,21 +267,24 @@ DiscretisedRandomPlant::DiscretisedRandomPlant(const Accelerometer& plant, const
   for (Eigen::Index i = 0; i < na; ++i) {
     c_act[i] = lin.C[act_[static_cast<std::size_t>(i)]];
     q_row[i] = lin.A(Accelerometer::kQuadrature, act_[static_cast<std::size_t>(i)]);
-    if (act_[static_cast<std::size_t>(i)] == Accelerometer::kQuadrature) q_index_ = static_cast<int>(i);
   }
   c_p2_ = (c_act * p2).transpose();
-  p2_q_ = p2.row(q_index_).transpose();
+  if (q_index_ >= 0) p2_q_ = p2.row(q_index_).transpose();
   q_row_ = q_row.transpose();
   q_input_.resize(k);
   for (Eigen::Index a = 0; a < k; ++a) q_input_[a] = lin.B(Accelerometer::kQuadrature, axes_[static_cast<std::size_t>(a)]);
 
   z_ = sigma_ = g_ = n_prev_ = dn_ = Eigen::VectorXd::Zero(na);
-  window_ = Eigen::VectorXd::Zero(7 * k);
   a_k_ = Eigen::VectorXd::Zero(k);
-  x_.assign(static_cast<std::size_t>(n), 0.0);
+  x_ = x_eq_;  // the states not stepped stay at the equilibrium
   f_.assign(static_cast<std::size_t>(n), 0.0);
   propagate_ = &Kernel<Eigen::Dynamic, Eigen::Dynamic>::propagate;
   correct_ = &Kernel<Eigen::Dynamic, Eigen::Dynamic>::correct;
+  if (na == 4) {  // a sampled record (the quadrature not stepped)
+    if (k == 1) propagate_ = &Kernel<4, 7>::propagate, correct_ = &Kernel<4, 7>::correct;
+    if (k == 2) propagate_ = &Kernel<4, 14>::propagate, correct_ = &Kernel<4, 14>::correct;
+    if (k == 3) propagate_ = &Kernel<4, 21>::propagate, correct_ = &Kernel<4, 21>::correct;
+  }
   if (na == 5) {
     if (k == 1) propagate_ = &Kernel<5, 7>::propagate, correct_ = &Kernel<5, 7>::correct;
     if (k == 2) propagate_ = &Kernel<5, 14>::propagate, correct_ = &Kernel<5, 14>::correct;
@@ -268,6 +297,7 @@ DiscretisedRandomPlant::DiscretisedRandomPlant(const Accelerometer& plant, const
 DiscretisedRandomPlant::~DiscretisedRandomPlant() = default;
 
 double DiscretisedRandomPlant::residual_quadrature() const {
+  if (q_index_ < 0) throw std::logic_error("DiscretisedRandomPlant: built without the quadrature");
   // y_Q = Q - z_Q at the corrected state sigma + P2 dN.
   return sigma_[q_index_] - z_[q_index_] + p2_q_.dot(dn_);
 }
@@ -283,48 +313,53 @@ StepData DiscretisedRandomPlant::step_data() {
   d.a = a_mat_.data();
   d.b = b_mat_.data();
   d.c_p2 = c_p2_.data();
-  d.window = window_.data();
   d.z = z_.data();
   d.sigma = sigma_.data();
   d.g = g_.data();
   d.n_prev = n_prev_.data();
   d.dn = dn_.data();
   d.a_k = a_k_.data();
+  d.f = f_.data();
+  d.act = act_.data();
+  d.q_row = q_row_.data();
+  d.q_input = q_input_.data();
+  d.linear = &linear_;
   return d;
 }
 
 void DiscretisedRandomPlant::advance() {
-  const std::int64_t pos = m_ * p_, n0 = pos / q_, j = pos % q_;
-  coef_->ensure(n0 - 2, n0 + 4);
-  for (int w = 0; w < 7; ++w)
-    for (int a = 0; a < k_; ++a) window_[w * k_ + a] = coef_->at(static_cast<std::size_t>(a), n0 - 2 + w);
-  data_.k = k_step_[static_cast<std::size_t>(j)].data();
+  // The step from m to m + 1 starts in knot interval knot_ at phase_ / q.
+  coef_->ensure(knot_ - 2, knot_ + 4);
+  data_.window = coef_->from(knot_ - 2);
+  data_.k = k_step_[static_cast<std::size_t>(phase_)].data();
   propagate_(data_);
   ++m_;
+  phase_ += p_;
+  while (phase_ >= q_) phase_ -= q_, ++knot_;
   evaluate_at_grid_point();
 }
 
 void DiscretisedRandomPlant::evaluate_at_grid_point() {
-  const std::int64_t pos = m_ * p_, n0 = pos / q_, j = pos % q_;
-  coef_->ensure(n0 - 2, n0 + 4);
-  const std::vector<double>& w = weights_[static_cast<std::size_t>(j)];
+  coef_->ensure(knot_ - 2, knot_ + 4);
+  const double* w = weights_[static_cast<std::size_t>(phase_)].data();
+  const double* c = coef_->from(knot_ - 2);
   a_.setZero();
   for (int a = 0; a < k_; ++a) {
     double s = 0;
-    for (int i = 0; i < 6; ++i) s += w[static_cast<std::size_t>(i)] * coef_->at(static_cast<std::size_t>(a), n0 - 2 + i);
+    for (int i = 0; i < 6; ++i) s += w[i] * c[i * k_ + a];
     a_[axes_[static_cast<std::size_t>(a)]] = s;
     a_k_[a] = s;
   }
-  for (int i = 0; i < n_; ++i) x_[static_cast<std::size_t>(i)] = x_eq_[static_cast<std::size_t>(i)];
-  for (int i = 0; i < na_; ++i) x_[static_cast<std::size_t>(act_[static_cast<std::size_t>(i)])] += sigma_[i];
+  for (int i = 0; i < na_; ++i) {
+    const std::size_t k = static_cast<std::size_t>(act_[static_cast<std::size_t>(i)]);
+    x_[k] = x_eq_[k] + sigma_[i];
+  }
   out_ = plant_.rhs_output(a_, x_.data(), f_.data());
   ++evaluations_;
-  for (int i = 0; i < na_; ++i) g_[i] = f_[static_cast<std::size_t>(act_[static_cast<std::size_t>(i)])];
   for (int i : inert_)
     if (f_[static_cast<std::size_t>(i)] != 0.0)
       throw std::logic_error("DiscretisedRandomPlant: a state the linearisation holds still moved");
-  out_ += correct_(data_, m_ == 0);
-  linear_ = q_row_.dot(z_) + q_input_.dot(a_k_);
+  out_ += correct_(data_, m_ == 0);  // also the linear output
 }
 
 }  // namespace vrelab::rectification

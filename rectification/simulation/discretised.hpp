@@ -46,8 +46,9 @@ namespace vrelab::rectification {
 struct StepData {
   int n = 0, w = 0, k_axes = 0;
   const double *e = nullptr, *p1 = nullptr, *ep2 = nullptr, *a = nullptr, *b = nullptr, *k = nullptr,
-               *c_p2 = nullptr, *window = nullptr, *a_k = nullptr;
-  double *z = nullptr, *sigma = nullptr, *g = nullptr, *n_prev = nullptr, *dn = nullptr;
+               *c_p2 = nullptr, *window = nullptr, *a_k = nullptr, *f = nullptr, *q_row = nullptr, *q_input = nullptr;
+  const int* act = nullptr;
+  double *z = nullptr, *sigma = nullptr, *g = nullptr, *n_prev = nullptr, *dn = nullptr, *linear = nullptr;
 };
 
 class DiscretisedRandomPlant {
@@ -56,8 +57,12 @@ class DiscretisedRandomPlant {
   static std::string unsupported(const plant::PlantConfig& config, const vibration::RandomExcitation& ex,
                                  double grid_rate_Hz);
 
+  // quadrature = false: residual_quadrature() is not wanted (a sampled record reads the
+  // output and the linear output only), and the quadrature state is not stepped (it feeds
+  // nothing back: one state fewer in every per-step product).
   DiscretisedRandomPlant(const plant::Accelerometer& plant, const plant::Accelerometer::Linear& lin,
-                         const std::vector<double>& x_eq, const vibration::RandomExcitation& ex, double grid_rate_Hz);
+                         const std::vector<double>& x_eq, const vibration::RandomExcitation& ex, double grid_rate_Hz,
+                         bool quadrature = true);
   ~DiscretisedRandomPlant();
 
   // From grid point m to m + 1 (the object starts at m = 0, t = 0, at rest).
@@ -67,7 +72,7 @@ class DiscretisedRandomPlant {
   double output_g() const { return out_; }
   double linear_output_g() const { return linear_; }
   const Vec3& input_g() const { return a_; }
-  double residual_quadrature() const;  // y_Q = Q - z_Q
+  double residual_quadrature() const;  // y_Q = Q - z_Q (needs quadrature = true)
   long plant_evaluations() const { return evaluations_; }
 
  private:
@@ -79,21 +84,22 @@ class DiscretisedRandomPlant {
   const std::vector<double>& x_eq_;
   double rate_;
   int n_;                       // plant states
-  std::vector<int> act_, inert_;  // states that move / that the linearisation holds still
-  int na_ = 0, q_index_ = 0;    // act_'s size, the quadrature's place in it
+  std::vector<int> act_, inert_;  // states stepped (the loop's, then the quadrature if kept) / held still
+  int na_ = 0, q_index_ = -1;   // act_'s size, the quadrature's place in it (-1: not stepped)
   std::vector<int> axes_;       // excited axes
   int k_ = 0;                   // their number
   std::int64_t p_ = 1, q_ = 1;  // grid step = p/q knot intervals
-  std::int64_t m_ = 0;
+  std::int64_t m_ = 0;          // grid point
+  std::int64_t knot_ = 0, phase_ = 0;  // m p = knot_ q + phase_ (no division per step)
   // Per phase j (grid point m at knot position floor + j/q): input weights (6) and the input
   // contribution over the step (na x 7k).
   std::vector<std::vector<double>> weights_;
   std::vector<Eigen::MatrixXd> k_step_;
-  // On the moving states: e^{Ah}, h phi1(Ah), e^{Ah} h phi2(Ah), A, B (excited axes).
+  // On the stepped states: e^{Ah}, h phi1(Ah), e^{Ah} h phi2(Ah), A, B (excited axes).
   Eigen::MatrixXd e_, p1_, ep2_, a_mat_, b_mat_;
   // z: the companion; sigma: the deviation x - x_eq where the plant is evaluated (the ETD2
   // prediction; the corrected state is sigma + P2 dN); g = f - B a; N_prev; dN.
-  Eigen::VectorXd z_, sigma_, g_, n_prev_, dn_, window_, a_k_, c_p2_, p2_q_, q_row_, q_input_;
+  Eigen::VectorXd z_, sigma_, g_, n_prev_, dn_, a_k_, c_p2_, p2_q_, q_row_, q_input_;
   std::vector<double> x_, f_;  // full plant state and derivative
   StepData data_;
   void (*propagate_)(const StepData&) = nullptr;

@@ -69,12 +69,14 @@ class SampledRecorder {
       : ro_(ro), k1_(k1), baseline_(baseline_g), block_n_(block_n), dt_(dt), sink_(sink), rng_(ro.seed),
         rest_(static_cast<std::size_t>(blocks), 0.0), vib_(rest_) {
     const long rest_n = blocks * block_n;
-    for (long m = 0; m < rest_n; ++m) {
-      if (m % 65536 == 0) core::throw_if_cancelled();  // a long record at rest (Ctrl-C from Python)
-      const double u = acquire(baseline_g);
-      rest_[static_cast<std::size_t>(m / block_n)] += u / k1;
-      if (sink_) sink_(static_cast<double>(m - rest_n) * dt, Vec3::Zero(), u);
-    }
+    long m = 0;
+    for (std::size_t b = 0; b < rest_.size(); ++b)
+      for (long i = 0; i < block_n; ++i, ++m) {
+        if (m % 65536 == 0) core::throw_if_cancelled();  // a long record at rest (Ctrl-C from Python)
+        const double u = acquire(baseline_g);
+        rest_[b] += u / k1;
+        if (sink_) sink_(static_cast<double>(m - rest_n) * dt, Vec3::Zero(), u);
+      }
     samples_ = rest_n;
   }
   // One sample of the vibration record at t; `measured_index` >= 0 counts the samples of the
@@ -85,7 +87,14 @@ class SampledRecorder {
     ++samples_;
     if (measured_index < 0) return;
     const double x = u / k1_ - linear_g;
-    vib_[static_cast<std::size_t>(measured_index / block_n_)] += x;
+    // The block of measured_index: counted along (the samples come in order), no division.
+    if (measured_index != next_index_) {
+      block_ = measured_index / block_n_;
+      in_block_ = measured_index % block_n_;
+    }
+    vib_[static_cast<std::size_t>(block_)] += x;
+    next_index_ = measured_index + 1;
+    if (++in_block_ == block_n_) in_block_ = 0, ++block_;
     integral_ += (x - baseline_) * dt_;
     const double tm = static_cast<double>(measured_index + 1) * dt_;
     st_ += tm, stt_ += tm * tm, si_ += integral_, sti_ += tm * integral_;
@@ -125,6 +134,7 @@ class SampledRecorder {
   std::vector<double> rest_, vib_;
   double integral_ = 0, st_ = 0, stt_ = 0, si_ = 0, sti_ = 0;
   long n_fit_ = 0, samples_ = 0;
+  long next_index_ = 0, block_ = 0, in_block_ = 0;  // the next measured sample expected, its block
 };
 
 
@@ -498,7 +508,7 @@ ShakeResult shake_excitation(const plant::PlantConfig& config, const Vec3& a_sta
     const double rate = ro.active() ? ro.sample_rate_Hz : sampled ? 8 * f_top : random->sample_rate_Hz();
     cvode_reason = DiscretisedRandomPlant::unsupported(config, *random, rate);
     if (cvode_reason.empty()) {
-      DiscretisedRandomPlant plant(shaken, lin, x_eq, *random, rate);
+      DiscretisedRandomPlant plant(shaken, lin, x_eq, *random, rate, !sampled);
       r.path = "exponential integrator";
       const double dt = 1 / rate;
       const long settle_n = static_cast<long>(std::ceil(r.settle_s * rate));
