@@ -101,15 +101,26 @@ json pairs_json(const validation::Diagnosis& d) {
 
 json campaign_row(const validation::BlindCampaign& k) {
   json h = json::array();
-  for (const auto& x : k.hidden) h.push_back({{"name", x.name}, {"parameter", x.parameter}});
+  for (const auto& x : k.hidden) {
+    h.push_back({{"name", x.name}, {"parameter", x.parameter}});
+    if (!x.form.empty()) h.back()["form"] = x.form;  // the natural form's further parameters
+  }
   json row = {{"index", k.index}, {"seed", k.seed},           {"category", k.category}, {"hidden", h},
               {"called", k.called}, {"simulate_s", k.simulate_s}, {"wall_s", k.wall_s}};
-  if (k.category == "single") row["effect_max_sigma"] = k.effect_max_sigma;
+  if (k.category == "single" || k.category == "natural") row["effect_max_sigma"] = k.effect_max_sigma;
   if (k.category == "sigma_understated") row["noise_scale"] = k.noise_scale;
   if (k.category == "drift") row["drift_ug_per_h"] = k.drift_g_per_h * 1e6;
+  if (k.category == "dynamics_off")
+    row["manifest_dynamics_off"] = {{"crossover_ratio", k.manifest_crossover_ratio},
+                                    {"pendulum_frequency_ratio", k.manifest_pendulum_ratio},
+                                    {"phase_margin_offset_deg", k.manifest_margin_offset_deg}};
   if (k.error.empty()) {
     row["top"] = k.top;
     row["top_parameter"] = k.diagnosis.effects.front().value;
+    json tp = json::array();
+    for (const auto& q : k.diagnosis.effects.front().parameters)
+      tp.push_back({{"name", q.name}, {"value", q.value}, {"sigma", std::isfinite(q.sigma) ? json(q.sigma) : json()}, {"status", q.status}});
+    row["top_parameters"] = tp;
     row["rms_before_g"] = k.diagnosis.rms_before_g, row["rms_after_g"] = k.diagnosis.rms_after_g;
     row["where"] = k.diagnosis.where;
     row["verdict"] = k.diagnosis.verdict;
@@ -126,7 +137,7 @@ json families_json(const validation::BlindScores& s) {
   for (const auto& [name, f] : s.families)
     j[name] = {{"n", f.n},         {"right", f.right},         {"right_physics", f.family}, {"unexplained", f.unexplained},
                {"no_gap", f.no_gap}, {"confidently_wrong", f.wrong}, {"ambiguous", f.ambiguous},   {"ambiguous_right_among", f.right_among},
-               {"error", f.error}};
+               {"error", f.error}, {"right_effect_parameters_off", f.parameters_off}};
   return j;
 }
 
@@ -416,12 +427,13 @@ std::string blind_html(const validation::BlindResult& r) {
                    "another physics); ambiguous (the truth among them).</p>\n",
                    r.settings.n, r.settings.seed, r.wall_s, r.threads);
   h += "<h2>Per family</h2>\n<table><tr><th class=\"l\">family</th><th>n</th><th>right</th><th>right physics</th>"
-       "<th>unexplained</th><th>no gap</th><th>confidently wrong</th><th>ambiguous</th><th>(right among)</th><th>error</th></tr>\n";
+       "<th>unexplained</th><th>no gap</th><th>confidently wrong</th><th>ambiguous</th><th>(right among)</th><th>error</th>"
+       "<th>right effect, a parameter beyond 3&sigma;</th></tr>\n";
   for (const auto& [name, f] : r.scores.families)
     h += fmt::format("<tr><td class=\"l\">{}</td><td>{}</td><td class=\"ok\">{}</td><td>{}</td><td>{}</td><td>{}</td>"
-                     "<td class=\"{}\">{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                     "<td class=\"{}\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
                      html_escape(name), f.n, f.right, f.family, f.unexplained, f.no_gap, f.wrong ? "bad" : "", f.wrong,
-                     f.ambiguous, f.right_among, f.error);
+                     f.ambiguous, f.right_among, f.error, f.parameters_off);
   h += "</table>\n<h2>Confusion matrix</h2>\n<p>Rows: the hidden truth; columns: what diagnose called it (without the key).</p>\n";
   std::vector<std::string> called;
   for (const auto& [t, row] : r.confusion)

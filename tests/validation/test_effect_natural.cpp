@@ -133,3 +133,39 @@ TEST(NaturalForm, ACleanCampaignIsNotExplainedByTheRicherEffects) {
                   e.parameters[j].value, e.evidence);
   }
 }
+
+// Transverse motion in its natural form: 6.6 % at 1 kHz in phase and 4.5 % in quadrature (8 %
+// at 0.6 rad), growing as f^2, on the other transverse axis (IA -> OA, PA -> IA, OA -> PA; the
+// default form: in phase, as f, IA -> PA). Along IA it meets k_IO, along PA k_IP: runs along
+// IA, PA and OA over a decade and a half pin the in-phase ratio, the power and the axis; the
+// quadrature part reaches the output only through the quadratic terms (k2 from PA runs, at
+// (r A)^2), which may leave it held: then the in-phase ratio is what the cross terms measure.
+// Seed 6010 (the dev range of session 6).
+TEST(NaturalForm, TransverseMotionOutOfPhaseOnTheOtherAxisIsFoundWithItsLaw) {
+  const std::vector<double> v = {0.08 * std::cos(0.6), 0.08 * std::sin(0.6), 2, 1};
+  const Campaign c = simulate_campaign(truth(), {HiddenEffect("shaker_transverse_motion", v[0], {v[1], v[2], v[3]})},
+                                       design({10, 100, 400, 800, 1500}, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}), 6010, 2);
+  const Diagnosis d = diagnose(c);
+  ASSERT_TRUE(d.gap_significant) << d.where;
+  EXPECT_TRUE(d.explained) << d.verdict;
+  ASSERT_EQ(d.effects.front().name, "shaker_transverse_motion") << d.verdict;
+  EXPECT_EQ(parameter(d.effects.front(), "axis_cycle").status, "chosen");
+  EXPECT_EQ(parameter(d.effects.front(), "frequency_power").status, "fitted");
+  expect_within_3_sigma(d.effects.front(), v);
+}
+
+// A fixture rocking about PA (the default form: about OA), 2 urad/g, the sensor 30 mm out
+// along OA: along IA the table's motion turned by the rocking puts -alpha a_IA on OA and
+// gravity's OA part on IA, along OA alpha a_OA on IA (a first-order mean, as about OA with
+// PA). Seed 6011.
+TEST(NaturalForm, RockingAboutPaIsFoundWithItsAxis) {
+  const std::vector<double> v = {2e-6, 1};
+  const Campaign c = simulate_campaign(truth(), {HiddenEffect("fixture_rocking", v[0], {v[1]})},
+                                       design({10, 100, 400, 1000}, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}), 6011, 2);
+  const Diagnosis d = diagnose(c);
+  ASSERT_TRUE(d.gap_significant) << d.where;
+  EXPECT_TRUE(d.explained) << d.verdict;
+  ASSERT_EQ(d.effects.front().name, "fixture_rocking") << d.verdict;
+  EXPECT_EQ(parameter(d.effects.front(), "axis").status, "chosen");
+  expect_within_3_sigma(d.effects.front(), v);
+}

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numbers>
 #include <random>
 #include <stdexcept>
 
@@ -27,17 +28,49 @@ HiddenEffect draw_effect(const std::string& name, std::mt19937_64& rng) {
   return draw_hidden(*e, rng);
 }
 
-// Campaign i's key: its category and hidden effects, from its own seed.
+// The library's effects with a natural form (Effect::draw_form), in the library's order.
+std::vector<std::string> natural_form_effects() {
+  std::vector<std::string> v;
+  for (const Effect& e : effect_library())
+    if (e.draw_form) v.push_back(e.name);
+  return v;
+}
+
+// The out-of-library effects blind hides (the registry's, in its order: physically different
+// from every library effect, each realised by a plant module or a shaker decorator).
+std::vector<std::string> out_of_library_effects() {
+  std::vector<std::string> v;
+  for (const Effect& e : effect_registry())
+    if (!e.in_library && e.draw) v.push_back(e.name);
+  return v;
+}
+
+// Campaign i's key: its category and hidden effects, from its own seed. The mix, per 12:
+// 2 clean, 2 out of library (1 in odd twelves, which have 1 dynamics_off instead), 1 pair,
+// 1 sigma understated, 1 drift, 2 natural forms, 3 single.
 BlindCampaign draw_campaign(int i, std::uint64_t seed, const std::vector<std::string>& library) {
   BlindCampaign k;
   k.index = i, k.seed = seed * 1000003u + static_cast<std::uint64_t>(i);
   std::mt19937_64 rng(k.seed);
-  const int slot = i % 12;  // 2 clean, 1 out of library, 1 pair, 1 sigma understated, 1 drift, 6 single in 12
+  const int slot = i % 12;
   if (slot < 2) {
     k.category = "clean";
-  } else if (slot == 2) {
+  } else if (slot == 8 && (i / 12) % 2 == 1) {
+    // The manifest's nominal dynamics off the truth's by a few % (every other twelve, in the
+    // second out-of-library slot): crossover and pendulum frequency 2-5 % either way, the
+    // phase margin 1-4 deg either way; no effect hidden.
+    k.category = "dynamics_off";
+    const auto off = [&rng](double lo, double hi) {
+      const double s = std::bernoulli_distribution(0.5)(rng) ? 1 : -1;
+      return s * std::uniform_real_distribution<double>(lo, hi)(rng);
+    };
+    k.manifest_crossover_ratio = 1 + off(0.02, 0.05);
+    k.manifest_pendulum_ratio = 1 + off(0.02, 0.05);
+    k.manifest_margin_offset_deg = off(1, 4);
+  } else if (slot == 2 || slot == 8) {
     k.category = "out_of_library";
-    k.hidden.push_back(draw_effect("readout_clipping", rng));
+    const std::vector<std::string> ool = out_of_library_effects();
+    k.hidden.push_back(draw_effect(ool[std::uniform_int_distribution<std::size_t>(0, ool.size() - 1)(rng)], rng));
   } else if (slot == 4) {
     k.category = "sigma_understated";
     k.noise_scale = std::uniform_real_distribution<double>(1.8, 3.0)(rng);
@@ -50,6 +83,13 @@ BlindCampaign draw_campaign(int i, std::uint64_t seed, const std::vector<std::st
     std::vector<std::string> pick = library;
     std::shuffle(pick.begin(), pick.end(), rng);
     k.hidden = {draw_effect(pick[0], rng), draw_effect(pick[1], rng)};
+  } else if (slot == 6 || slot == 7) {
+    // A library effect in its natural form: its size as `draw`, its further parameters away
+    // from the library's defaults (`draw_form`: damping, axis, phase, a second angle).
+    k.category = "natural";
+    const std::vector<std::string> nat = natural_form_effects();
+    const Effect* e = find_effect(nat[std::uniform_int_distribution<std::size_t>(0, nat.size() - 1)(rng)]);
+    k.hidden.push_back(draw_hidden_natural(*e, rng));
   } else {
     k.category = "single";
     k.hidden.push_back(draw_effect(library[std::uniform_int_distribution<std::size_t>(0, library.size() - 1)(rng)], rng));
@@ -80,12 +120,17 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
     const plant::PlantConfig truth = blind_truth(rng);
     Campaign camp = simulate_campaign(truth, k.hidden, default_design(), k.seed, 1);
     apply_lab_log(camp, k);
+    // The manifest states the lab's estimate of the dynamics, not the truth's.
+    camp.dynamics.loop_bandwidth_Hz *= k.manifest_crossover_ratio;
+    camp.dynamics.pendulum_frequency_Hz *= k.manifest_pendulum_ratio;
+    camp.dynamics.phase_margin_deg += k.manifest_margin_offset_deg;
     k.simulate_s = seconds_since(t0);
     k.diagnosis = diagnose(camp, settings);  // the key (k.hidden) is not passed
-    if (k.category == "single") {
-      const Effect* e = find_effect(k.hidden[0].name);
+    if (k.category == "single" || k.category == "natural") {
+      const Effect& e = *find_effect(k.hidden[0].name);
+      const std::vector<double> values = k.hidden[0].values(e);
       for (const RunRecord& r : camp.runs) {
-        const double size = predict_run_g(truth, r, e, k.hidden[0].parameter) - predict_run_g(truth, r);
+        const double size = predict_run_g(truth, r, e, values) - predict_run_g(truth, r);
         k.effect_max_sigma = std::max(k.effect_max_sigma, std::abs(size) / r.sigma_g);
       }
     }
@@ -113,10 +158,54 @@ std::string physics_of(const std::string& name) {
   return e ? to_string(e->acts_on) : "";
 }
 
+// Whether the diagnosis' top effect (the one called) has every fitted parameter within 3 sigma
+// of the hidden truth's (a phase's difference wrapped to [-pi, pi)) and every discrete one
+// (chosen, or held at its nominal: either is a claim) equal to it; a held continuous parameter
+// (the data do not pin it: reported at its nominal) is not judged. `off` says which parameter failed, or lists the held ones.
+bool match_parameters(const HiddenEffect& h, const Diagnosis& d, std::string* off) {
+  const Effect* e = find_effect(h.name);
+  if (!e || d.effects.empty() || d.effects.front().name != h.name) {
+    *off = "no parameters reported";
+    return false;
+  }
+  const std::vector<double> truth = h.values(*e);
+  const std::vector<FittedParameter>& fit = d.effects.front().parameters;
+  if (fit.size() != truth.size()) {
+    *off = fmt::format("{} parameters reported for {}", fit.size(), truth.size());
+    return false;
+  }
+  std::string held;
+  for (std::size_t i = 0; i < fit.size(); ++i) {
+    const FittedParameter& q = fit[i];
+    double diff = q.value - truth[i];
+    if (e->parameters[i].periodic) diff = std::remainder(diff, 2 * std::numbers::pi);
+    if (e->parameters[i].discrete) {  // held at its nominal or chosen, it is a claim (the mode's axis)
+      if (diff != 0) {
+        *off = fmt::format("{} {} {:.4g}, truth {:.4g}", q.name, q.status, q.value, truth[i]);
+        return false;
+      }
+    } else if (q.status == "held") {
+      held += fmt::format("{}{} held at {:.4g} (truth {:.4g})", held.empty() ? "" : ", ", q.name, q.value, truth[i]);
+    } else if (q.status == "chosen") {
+      if (diff != 0) {
+        *off = fmt::format("{} chosen {:.4g}, truth {:.4g}", q.name, q.value, truth[i]);
+        return false;
+      }
+    } else if (!(std::abs(diff) <= 3 * q.sigma)) {
+      *off = fmt::format("{} = {:.4g} +- {:.2g}, truth {:.4g}: {:.1f} sigma", q.name, q.value, q.sigma, truth[i],
+                         std::abs(diff) / q.sigma);
+      return false;
+    }
+  }
+  *off = held;
+  return true;
+}
+
 // Campaign k's outcome in its family (FamilyScore), and why when not right.
 void score_family(const BlindCampaign& k, BlindResult& r) {
   // Single effects below 5 sigma in every run are a family apart (the issue scores >= 5 sigma).
-  FamilyScore& f = r.scores.families[k.category == "single" && k.error.empty() && k.effect_max_sigma < 5 ? "single_below_5_sigma" : k.category];
+  const bool small = (k.category == "single" || k.category == "natural") && k.error.empty() && k.effect_max_sigma < 5;
+  FamilyScore& f = r.scores.families[small ? k.category + "_below_5_sigma" : k.category];
   ++f.n;
   if (!k.error.empty()) {
     ++f.error;
@@ -128,8 +217,14 @@ void score_family(const BlindCampaign& k, BlindResult& r) {
   for (const auto& h : k.hidden) truth.push_back(h.name);
   const auto is_truth = [&](const std::string& n) { return std::find(truth.begin(), truth.end(), n) != truth.end(); };
   std::string key = k.category;
-  for (const auto& h : k.hidden) key += fmt::format(" {} = {:.4g}", h.name, h.parameter);
+  for (const auto& h : k.hidden) {
+    key += fmt::format(" {} = {:.4g}", h.name, h.parameter);
+    for (double x : h.form) key += fmt::format(", {:.4g}", x);
+  }
   if (k.category == "sigma_understated") key += fmt::format(" (scatter x{:.2f})", k.noise_scale);
+  if (k.category == "dynamics_off")
+    key += fmt::format(" (manifest: crossover x{:.3f}, pendulum x{:.3f}, margin {:+.1f} deg)", k.manifest_crossover_ratio,
+                       k.manifest_pendulum_ratio, k.manifest_margin_offset_deg);
   if (k.category == "drift") key += fmt::format(" ({:.3g} ug/h)", k.drift_g_per_h * 1e6);
   const std::string why = fmt::format("[{}] campaign {} (seed {}): {}; called \"{}\" (top {})", k.category, k.index, k.seed, key,
                                       d.verdict, k.top);
@@ -159,14 +254,25 @@ void score_family(const BlindCampaign& k, BlindResult& r) {
   else if (k.category == "drift")
     right = !d.explained && drift_flagged &&
             std::abs(drift->value - k.drift_g_per_h * 1e6) < 3 * drift->sigma + 0.1 * std::abs(k.drift_g_per_h * 1e6);
+  else if (k.category == "dynamics_off")  // the loop's dynamics found off the manifest (either servo effect, or both)
+    right = !called.empty() && std::all_of(called.begin(), called.end(), [](const std::string& c) {
+      return c == "servo_dynamics" || c == "servo_phase_margin";
+    });
   else if (k.category == "two") {
     right = called.size() == 2 && is_truth(called[0]) && is_truth(called[1]);
     family = !right && std::any_of(called.begin(), called.end(), is_truth);
-  } else {  // single
+  } else {  // single, natural
     right = called.size() == 1 && is_truth(called[0]);
     family = !right && !called.empty() && std::all_of(called.begin(), called.end(), [&](const std::string& c) {
       return physics_of(c) == physics_of(truth.front());
     });
+  }
+  // A natural form is right when its fitted parameters are within 3 sigma of the truth too.
+  std::string off;
+  if (right && k.category == "natural" && !match_parameters(k.hidden.front(), d, &off)) {
+    ++f.parameters_off;
+    r.wrong.push_back(why + " (the right effect, " + off + ")");
+    return;
   }
   if (right) {
     ++f.right;
@@ -190,11 +296,17 @@ void score(const BlindCampaign& k, BlindResult& r, std::vector<double>& shrink, 
   const Diagnosis& d = k.diagnosis;
   const std::string& called = k.called;
   score_family(k, r);
-  if (k.category == "sigma_understated" || k.category == "drift") {
+  if (k.category == "sigma_understated" || k.category == "drift" || k.category == "dynamics_off") {
     ++r.confusion[k.category][called];
     return;
   }
-  ++r.confusion[k.category == "single" ? k.hidden[0].name : k.category][called];
+  if (k.category == "natural") {  // scored in its family only (parameters within 3 sigma)
+    ++r.confusion[k.hidden[0].name + " (natural form)"][called];
+    return;
+  }
+  ++r.confusion[k.category == "single"           ? k.hidden[0].name
+                : k.category == "out_of_library" ? k.hidden[0].name + " (out of library)"
+                                                 : k.category][called];
   if (k.category == "single" && k.error.empty() && k.effect_max_sigma < 5) {
     ++s.small;  // below the issue's "gap >= 5 sigma somewhere": reported, not scored
     s.small_right += called == k.hidden[0].name;
@@ -229,6 +341,19 @@ void score(const BlindCampaign& k, BlindResult& r, std::vector<double>& shrink, 
 }
 
 }  // namespace
+
+bool parameters_match(const HiddenEffect& truth, const Diagnosis& d, std::string* why) {
+  std::string w;
+  const bool ok = match_parameters(truth, d, &w);
+  if (why) *why = w;
+  return ok;
+}
+
+BlindCampaign blind_key(int index, std::uint64_t seed) {
+  std::vector<std::string> library;
+  for (const auto& e : effect_library()) library.push_back(e.name);
+  return draw_campaign(index, seed, library);
+}
 
 plant::PlantConfig blind_truth(std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0.7, 1.3);
@@ -278,7 +403,9 @@ std::string unescaped(const std::string& s) {
 // effects (their count, then each), the nuisances (their count, then 8 fields each): what the
 // scoring reads. (Before, the verdict, the nuisances and the ambiguity were not sent, so a
 // nuisance campaign scored "no gap" whatever its diagnosis said.)
-constexpr std::size_t kFixedResultFields = 17, kNuisanceFields = 8;
+// Last, the top effect's parameters (their count, then 6 fields each: name, unit, value,
+// sigma, status, at_bound).
+constexpr std::size_t kFixedResultFields = 17, kNuisanceFields = 8, kParameterFields = 6;
 
 std::string campaign_result_text(const BlindCampaign& k) {
   const Diagnosis& d = k.diagnosis;
@@ -298,6 +425,12 @@ std::string campaign_result_text(const BlindCampaign& k) {
   for (const Nuisance& x : d.nuisances)
     t.append(fmt::format("\t{}\t{}\t{:.17g}\t{:.17g}\t{:d}\t{:d}\t{:d}\t{}", escaped(x.name), escaped(x.unit), x.value, x.sigma,
                          x.estimated ? 1 : 0, x.applied ? 1 : 0, x.significant ? 1 : 0, escaped(x.note)));
+  const std::vector<FittedParameter> none;
+  const std::vector<FittedParameter>& ps = has_top ? d.effects.front().parameters : none;
+  t.append(fmt::format("\t{}", ps.size()));
+  for (const FittedParameter& q : ps)
+    t.append(fmt::format("\t{}\t{}\t{:.17g}\t{:.17g}\t{}\t{:d}", escaped(q.name), escaped(q.unit), q.value, q.sigma, escaped(q.status),
+                         q.at_bound ? 1 : 0));
   return t;
 }
 
@@ -350,7 +483,7 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
   d.ambiguous_with.clear();
   for (std::size_t i = 0; i < n_ambiguous; ++i) d.ambiguous_with.push_back(unescaped(f[at++]));
   const std::size_t n_nuisances = count(at++);
-  if (f.size() != at + kNuisanceFields * n_nuisances) throw bad(fmt::format("{} nuisances of {} fields expected", n_nuisances, kNuisanceFields));
+  if (f.size() < at + kNuisanceFields * n_nuisances + 1) throw bad(fmt::format("{} nuisances of {} fields expected", n_nuisances, kNuisanceFields));
   d.nuisances.clear();
   for (std::size_t i = 0; i < n_nuisances; ++i) {
     Nuisance x;
@@ -360,6 +493,18 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
     x.note = unescaped(f[at + 7]);
     d.nuisances.push_back(x);
     at += kNuisanceFields;
+  }
+  // The top effect's parameters (the natural forms' scoring reads them).
+  const std::size_t n_parameters = count(at++);
+  if (f.size() != at + kParameterFields * n_parameters)
+    throw bad(fmt::format("{} parameters of {} fields expected", n_parameters, kParameterFields));
+  if (n_parameters > 0 && d.effects.empty()) throw bad("parameters without a top effect");
+  for (std::size_t i = 0; i < n_parameters; ++i) {
+    FittedParameter q;
+    q.name = unescaped(f[at]), q.unit = unescaped(f[at + 1]);
+    q.value = num(at + 2), q.sigma = num(at + 3), q.status = unescaped(f[at + 4]), q.at_bound = f[at + 5] == "1";
+    d.effects.front().parameters.push_back(q);
+    at += kParameterFields;
   }
 }
 
@@ -430,16 +575,16 @@ std::string BlindResult::BriefReport() const {
 }
 
 std::string BlindResult::FamilyTable() const {
-  std::string t = fmt::format("  {:<22}{:>4}{:>7}{:>8}{:>8}{:>8}{:>8}{:>8}{:>11}{:>7}\n", "family", "n", "right", "family", "unexpl",
-                              "no gap", "WRONG", "ambig", "(right in)", "error");
-  static const std::vector<std::string> order = {"single", "single_below_5_sigma", "two", "out_of_library", "sigma_understated",
-                                                 "drift", "clean"};
+  std::string t = fmt::format("  {:<22}{:>4}{:>7}{:>8}{:>8}{:>8}{:>8}{:>8}{:>11}{:>7}{:>8}\n", "family", "n", "right", "family", "unexpl",
+                              "no gap", "WRONG", "ambig", "(right in)", "error", "par>3s");
+  static const std::vector<std::string> order = {"single", "single_below_5_sigma", "natural", "natural_below_5_sigma", "two",
+                                                 "out_of_library", "dynamics_off", "sigma_understated", "drift", "clean"};
   for (const auto& name : order) {
     const auto it = scores.families.find(name);
     if (it == scores.families.end()) continue;
     const FamilyScore& f = it->second;
-    t += fmt::format("  {:<22}{:>4}{:>7}{:>8}{:>8}{:>8}{:>8}{:>8}{:>11}{:>7}\n", name, f.n, f.right, f.family, f.unexplained, f.no_gap,
-                     f.wrong, f.ambiguous, f.right_among, f.error);
+    t += fmt::format("  {:<22}{:>4}{:>7}{:>8}{:>8}{:>8}{:>8}{:>8}{:>11}{:>7}{:>8}\n", name, f.n, f.right, f.family, f.unexplained, f.no_gap,
+                     f.wrong, f.ambiguous, f.right_among, f.error, f.parameters_off);
   }
   return t;
 }

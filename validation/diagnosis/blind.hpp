@@ -49,6 +49,9 @@ struct BlindCampaign {
   std::vector<HiddenEffect> hidden;
   double noise_scale = 1;     // the runs' scatter over their stated sigma (sigma_understated)
   double drift_g_per_h = 0;   // the bias drift (drift)
+  // dynamics_off: the manifest's nominal dynamics against the truth's (a lab's estimate): its
+  // crossover and pendulum frequency as ratios to the truth's, its phase margin's offset (deg).
+  double manifest_crossover_ratio = 1, manifest_pendulum_ratio = 1, manifest_margin_offset_deg = 0;
   Diagnosis diagnosis;
   std::string error;     // the simulation or diagnosis failed: why ("" otherwise)
   std::string called;    // clean, <effect>, "<A> + <B>", unexplained, or error
@@ -70,8 +73,11 @@ struct BlindCampaign {
 //  unexplained, no_gap: those verdicts where they are not right;
 //  wrong: explained by an effect of another physics (confidently wrong);
 //  ambiguous: "ambiguous between" verdicts, counted apart (right_among: the truth among them).
+//  parameters_off (natural forms): the right effect, but a fitted parameter beyond 3 sigma of
+//         the truth (or a discrete one, the mode's axis, not the truth's).
 struct FamilyScore {
   int n = 0, right = 0, family = 0, unexplained = 0, no_gap = 0, wrong = 0, ambiguous = 0, right_among = 0, error = 0;
+  int parameters_off = 0;
 };
 
 struct BlindScores {
@@ -109,6 +115,17 @@ struct BlindResult {
 plant::PlantConfig blind_truth(std::mt19937_64& rng);
 
 using BlindProgress = std::function<void(std::size_t done, std::size_t total)>;
+
+// Campaign `index`'s key in a blind draw of `seed` (category, hidden effects with their natural
+// form, the nuisances' sizes): what run_blind simulates, without running it.
+BlindCampaign blind_key(int index, std::uint64_t seed);
+
+// A natural form's scoring: the diagnosis' top effect is the hidden one and each of its
+// parameters the data pinned is within 3 sigma of the truth (a phase's difference wrapped to
+// [-pi, pi); a discrete one, the mode's axis, equal, chosen or held); a held continuous
+// parameter (reported at its nominal, the data do not pin it) is not judged. `why` names the parameter that failed, or
+// lists the held ones.
+bool parameters_match(const HiddenEffect& truth, const Diagnosis& d, std::string* why);
 
 // Invalid settings throw std::invalid_argument naming the key. A campaign whose simulation or
 // diagnosis fails is kept with its error (called "error").

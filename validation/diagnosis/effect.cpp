@@ -35,10 +35,10 @@ std::shared_ptr<const vibration::Excitation> TableMotion::excitation() const {
     // Gravity and the table's motion turn with the fixture; the lever arm adds a tangential
     // acceleration along PA (~ f^2) and a centripetal one along -IA (~ f^2 alpha^2).
     vibration::RockingSpec rs;
-    rs.axis = Vec3::UnitZ();
+    rs.axis = Vec3::Unit(rocking_axis);
     rs.amplitude_rad = std::abs(rocking_rad_per_g) * commanded_amplitude_g;
     rs.phase_rad = rocking_rad_per_g < 0 ? std::numbers::pi : 0.0;
-    rs.lever_arm_m = Vec3(kRockingLeverArm_m, 0, 0);
+    rs.lever_arm_m = kRockingLeverArm_m * Vec3::Unit((rocking_axis + 1) % 3);
     shaker.rocking = rs;
   }
   return sine_motion(sine, shaker, static_gravity_g, 9.80665);

@@ -38,8 +38,11 @@ struct TableMotion {
   vibration::SineVibration sine;
   std::vector<vibration::Harmonic> harmonics;  // vibration/decorators.hpp's HarmonicDistortion
   // Rocking of the fixture about OA, rad per g of commanded amplitude, in phase with the
-  // table (negative: in antiphase); the sensor 30 mm from the axis along IA.
+  // table (negative: in antiphase); the sensor 30 mm from the axis along IA. The natural
+  // form: about another axis (rocking_axis: 0 IA, 1 PA, 2 OA), the sensor 30 mm from it along
+  // the next axis (IA -> PA -> OA -> IA).
   double rocking_rad_per_g = 0;
+  int rocking_axis = 2;
   double commanded_amplitude_g = 0;
   Vec3 static_gravity_g = Vec3::Zero();  // what the rocking turns
   static constexpr double kRockingLeverArm_m = 0.03;
