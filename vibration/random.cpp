@@ -98,22 +98,22 @@ Eigen::Matrix3cd CrossSpectralMatrix::at(double f) const {
 void validate(const CrossSpectralMatrix& m) {
   if (m.frequency_Hz.empty()) throw std::invalid_argument("measured cross-spectral matrix: no bins");
   if (m.s_g2_per_Hz.size() != m.frequency_Hz.size())
-    throw std::invalid_argument("measured cross-spectral matrix: " + std::to_string(m.s_g2_per_Hz.size()) + " matrices for " +
+    throw std::invalid_argument(std::string("measured cross-spectral matrix: ") + std::to_string(m.s_g2_per_Hz.size()) + " matrices for " +
                                 std::to_string(m.frequency_Hz.size()) + " bins");
   if (!(m.resolution_Hz > 0) || !std::isfinite(m.resolution_Hz))
     throw std::invalid_argument("measured cross-spectral matrix: resolution_Hz = " + num(m.resolution_Hz) + " must be > 0");
   if (!(m.from_Hz() >= 0)) throw std::invalid_argument("measured cross-spectral matrix: the first bin reaches below 0 Hz");
   for (std::size_t k = 0; k < m.frequency_Hz.size(); ++k) {
     if (k > 0 && std::abs(m.frequency_Hz[k] - m.frequency_Hz[k - 1] - m.resolution_Hz) > 1e-6 * m.resolution_Hz)
-      throw std::invalid_argument("measured cross-spectral matrix: bin " + std::to_string(k) + " at " + num(m.frequency_Hz[k]) +
+      throw std::invalid_argument(std::string("measured cross-spectral matrix: bin ") + std::to_string(k) + " at " + num(m.frequency_Hz[k]) +
                                   " Hz is not one resolution above the previous");
     const Eigen::Matrix3cd& s = m.s_g2_per_Hz[k];
     const double scale = s.cwiseAbs().maxCoeff();
     if (!std::isfinite(scale) || (s - s.adjoint()).cwiseAbs().maxCoeff() > 1e-9 * scale)
-      throw std::invalid_argument("measured cross-spectral matrix: bin " + std::to_string(k) + " is not finite and Hermitian");
+      throw std::invalid_argument(std::string("measured cross-spectral matrix: bin ") + std::to_string(k) + " is not finite and Hermitian");
     for (int i = 0; i < 3; ++i)
       if (s(i, i).real() < 0)
-        throw std::invalid_argument("measured cross-spectral matrix: bin " + std::to_string(k) + " has a negative PSD");
+        throw std::invalid_argument(std::string("measured cross-spectral matrix: bin ") + std::to_string(k) + " has a negative PSD");
   }
 }
 

@@ -23,8 +23,11 @@
 #include <memory>
 #include <numbers>
 #include <random>
+#include <regex>
+#include <sstream>
 
 #include <fmt/format.h>
+#include <hdf5.h>
 
 #include "io/lab_data.hpp"
 #include "plant/effects/pendulum_geometry.hpp"
@@ -211,4 +214,78 @@ TEST(LabReferenceCross, SineOnRandomRunIsPredictedFromItsMeasuredSineAndSpectra)
   const double tol = std::max(3 * ode.sigma_g, 0.01 * std::abs(ode.measured_g));
   EXPECT_NEAR(from_reference, ode.measured_g, tol);
   EXPECT_GT(std::abs(from_command - ode.measured_g), 10 * ode.sigma_g);
+}
+
+namespace {
+
+// A record as HDF5 datasets (float64, contiguous), each of its own length.
+void write_h5(const std::string& path, const std::vector<std::pair<std::string, std::vector<double>>>& datasets) {
+  const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  for (const auto& [name, x] : datasets) {
+    const hsize_t n = x.size();
+    const hid_t space = H5Screate_simple(1, &n, nullptr);
+    const hid_t d = H5Dcreate2(file, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, x.data());
+    H5Dclose(d), H5Sclose(space);
+  }
+  H5Fclose(file);
+}
+
+}  // namespace
+
+// Issue 16's bad input: a reference channel at another rate. In CSV it shares the time column,
+// so another rate is a cell missing on some rows (file:line:column, "missing value": the test
+// in tests/cli/test_lab_reference.cpp, and by hand `diagnose` exits 2 on it); in HDF5 it is a
+// dataset of another length (here every other sample: half the rate), which skips the run
+// naming the file and the dataset. The same record at full rate reads (the converter is right).
+TEST(LabReferenceCross, Hdf5ReferenceAtAnotherRateSkipsTheRunNamingFileAndDataset) {
+  test::TempDir tmp;
+  const fs::path dir = tmp.path / "lab";
+  fs::copy(fs::path(VRELAB_CASES_DIR) / "lab-reference", dir, fs::copy_options::recursive);
+  std::array<std::vector<double>, 5> col;  // time, output, ref IA, PA, OA
+  {
+    std::ifstream in(dir / "records" / "random-ia-plus.csv");
+    std::string line;
+    while (std::getline(in, line)) {
+      if (line.empty() || line[0] == '#' || line[0] == 't') continue;
+      std::size_t p = 0;
+      for (auto& c : col) {
+        c.push_back(std::stod(line.substr(p)));
+        p = line.find(',', p) + 1;
+      }
+    }
+  }
+  ASSERT_GT(col[0].size(), 1000u);
+  std::string runs;
+  {
+    std::ifstream in(dir / "runs.csv");
+    std::stringstream s;
+    s << in.rdbuf();
+    runs = s.str();
+    const std::size_t at = runs.find("records/random-ia-plus.csv");
+    ASSERT_NE(at, std::string::npos);
+    runs.replace(at, std::string("records/random-ia-plus.csv").size(), "records/random-ia-plus.h5");
+    std::ofstream(dir / "runs.csv") << runs;
+  }
+  const std::string rec = (dir / "records" / "random-ia-plus.h5").string();
+  const auto datasets = [&](bool half_rate_ia) {
+    std::vector<double> ia = col[2];
+    if (half_rate_ia) {
+      ia.clear();
+      for (std::size_t i = 0; i < col[2].size(); i += 2) ia.push_back(col[2][i]);
+    }
+    return std::vector<std::pair<std::string, std::vector<double>>>{
+        {"time_s", col[0]}, {"output_mA", col[1]}, {"ref_IA_g", ia}, {"ref_PA_g", col[3]}, {"ref_OA_g", col[4]}};
+  };
+  write_h5(rec, datasets(false));
+  validation::Campaign c = io::read_campaign(dir.string());
+  EXPECT_TRUE(c.skipped.empty()) << c.skipped.front();
+  EXPECT_EQ(c.runs.size(), 18u);
+  write_h5(rec, datasets(true));
+  c = io::read_campaign(dir.string());
+  EXPECT_EQ(c.runs.size(), 17u);
+  ASSERT_EQ(c.skipped.size(), 1u);
+  EXPECT_TRUE(std::regex_search(c.skipped[0], std::regex(R"(runs\.csv:\d+ \(run 'random-ia-plus'\): .*random-ia-plus\.h5: dataset ref_IA_g has \d+ samples, time_s has \d+)")))
+      << c.skipped[0];
 }
