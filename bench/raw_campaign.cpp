@@ -11,6 +11,7 @@
 // (420 s: 1.0 GB); about 2.5 times that as CSV.
 #include <array>
 #include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -88,8 +89,14 @@ int main(int argc, char** argv) {
     bool raw = false;
     for (const auto& r : ids) raw = raw || r == id;
     if (!raw) continue;
-    const double f = id.find("400Hz") != std::string::npos ? 400.0 : 100.0, a = id.find("4g") != std::string::npos ? 4.0 : 2.0;
-    const double measured_ug = std::stod(line.substr(line.rfind(',', line.rfind(',') - 1) + 1));
+    // The run's row: id, frequency_Hz, amplitude_g, d_IA, d_PA, d_OA, ..., measured_ug, sigma_ug.
+    std::vector<double> cell;
+    for (std::size_t p = line.find(','); p != std::string::npos; p = line.find(',', p + 1)) cell.push_back(std::atof(line.c_str() + p + 1));
+    const double f = cell.at(0), a = cell.at(1), measured_ug = cell.at(cell.size() - 2);
+    // The reference channels carry the commanded motion, a d sin(w t) on each axis (before,
+    // 2 g on IA alone for the diagonal run diag-100Hz-2g: a table 41 % off the command on IA
+    // and still on PA, which the diagnosis, taking the motion as measured, could not explain).
+    const std::array<double, 3> d{cell.at(2), cell.at(3), cell.at(4)};
     std::unique_ptr<vrelab::io::Hdf5SeriesWriter> h5;
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> csv(nullptr, std::fclose);
     for (const auto& [dir, hdf5] : kinds) {
@@ -107,7 +114,8 @@ int main(int argc, char** argv) {
       const bool on = t >= 0;
       const double s = std::sin(2 * std::numbers::pi * f * t);
       const double u = 0.88 + 1e-5 * rng.next() + (on ? s + K1 * measured_ug * 1e-6 : 0.0);
-      const std::array<double, 3> g{on ? a * s + 1e-3 * rng.next() : 1e-3 * rng.next(), 1e-3 * rng.next(), 1e-3 * rng.next()};
+      std::array<double, 3> g{};
+      for (std::size_t k = 0; k < 3; ++k) g[k] = (on ? a * d[k] * s : 0.0) + 1e-3 * rng.next();
       if (h5) h5->add(t, u, g);
       if (csv) fmt::print(csv.get(), "{},{},{},{},{}\n", t, u, g[0], g[1], g[2]);
     }

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <sstream>
 
@@ -235,9 +236,9 @@ std::string raw_record_csv(const std::string& id, const validation::RawRecord& r
 }
 
 // A run's measured motion from its reference channels (docs/data-format.md, "Reference
-// channels"): a sine run's tones (axes without a channel: the commanded), a random run's
-// Welch PSD over the commanded band (axes without a channel: the commanded table); a sine
-// on random run's is reported (its sine's tones) but not used by the prediction.
+// channels"): a sine run's tones, a random run's Welch cross-spectral matrix over the
+// commanded band, a sine on random run's fundamental and the Welch matrix of the rest; used
+// by the prediction only with all three axes (else the departure is reported).
 rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, const rectification::ReferenceAnalysis& a) {
   rectification::MeasuredMotion mm;
   mm.present = a.present;
@@ -259,12 +260,18 @@ rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, co
           if (!a.present[i]) W[static_cast<int>(i)] = h == 1 ? std::complex<double>(signed_g[static_cast<int>(i)], 0) : 0.0;
         mm.tones.emplace_back(h, W);
       }
-    return mm;
+    if (!r.random || !all_axes) return mm;
+    // Sine on random: the sine's measured fundamental (transverse parts and phases included;
+    // the prediction takes one sine), the random part below from the spectra with that
+    // fundamental taken off (reference.hpp; the 2nd and 3rd harmonics stay in the spectra,
+    // where their second moments are carried).
+    mm.tones.emplace_back(1, a.harmonic_g[1]);
+  } else {
+    const Eigen::Matrix3d C = vibration::gaussian_equivalent(*r.random).covariance_g2();
+    mm.departure = rectification::random_departure(a, C);
+    if (!all_axes) return mm;
   }
   const vibration::RandomProfile& cmd = *r.random;
-  const Eigen::Matrix3d C = vibration::gaussian_equivalent(cmd).covariance_g2();
-  mm.departure = rectification::random_departure(a, C);
-  if (!all_axes) return mm;
   double lo = INFINITY, hi = 0;
   for (const auto& t : cmd.psd)
     if (t) lo = std::min(lo, t->rows.front().frequency_Hz), hi = std::max(hi, t->rows.back().frequency_Hz);
@@ -287,6 +294,10 @@ rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, co
                                               a.resolution_Hz, lo, hi));
     p.psd[i] = t;
   }
+  // The full measured cross-spectral matrix: the transverse motion's coherence and phase with
+  // the drive as measured, not the run's `coupling` (a transverse part partly coherent with
+  // IA, or delayed, rectifies through the cross terms by Re(H S H^H), not sqrt(G_i G_j)).
+  p.measured = std::make_shared<const vibration::CrossSpectralMatrix>(rectification::welch_matrix(a, lo, hi));
   mm.random = p;
   return mm;
 }
@@ -550,6 +561,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
         rectification::ReferenceWindow rwin;
         rwin.from_s = win.on_from_s, rwin.to_s = rectification::used_on_to_s(win);
         rwin.frequency_Hz = r.random ? (r.sine_part ? r.frequency_Hz : 0.0) : r.frequency_Hz;
+        rwin.sine_on_random = r.random && r.sine_part;
         std::optional<rectification::ReferenceAnalyzer> refan;
         const ReferenceSink reference = [&](double t_s, const std::array<double, 3>& ref_g, const std::array<bool, 3>& present) {
           if (!refan) refan.emplace(rwin);

@@ -523,10 +523,17 @@ PYBIND11_MODULE(_core, m) {
       });
   m.def(
       "_campaign",
-      [](const std::string& case_path, const std::string& out_dir, const std::string& key_path, std::optional<std::uint64_t> seed) {
-        return interruptible([&] { return io::write_virtual_campaign({case_path, out_dir, key_path, seed, false}); });
+      [](const std::string& case_path, const std::string& out_dir, const std::string& key_path, std::optional<std::uint64_t> seed,
+         const std::string& raw_format) {
+        if (raw_format != "csv" && raw_format != "hdf5")
+          throw io::InputError("campaign: raw_format must be 'csv' or 'hdf5', got '" + raw_format + "'");
+        return interruptible([&] {
+          return io::write_virtual_campaign(
+              {case_path, out_dir, key_path, seed, false, raw_format == "hdf5" ? io::RawFormat::hdf5 : io::RawFormat::csv});
+        });
       },
-      py::arg("case_path"), py::arg("out_dir"), py::arg("key_path") = "", py::arg("seed") = py::none());
+      py::arg("case_path"), py::arg("out_dir"), py::arg("key_path") = "", py::arg("seed") = py::none(),
+      py::arg("raw_format") = "csv");
 
   py::class_<io::FolderDiagnosis>(m, "Diagnosis", "The diagnosis of a campaign folder: where the gap lies and what explains it.")
       .def_readwrite("dir", &io::FolderDiagnosis::dir, "The campaign folder (diagnose_data: the name given).")

@@ -4,6 +4,7 @@
 
 #include <fftw3.h>
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <memory>
@@ -85,7 +86,39 @@ double unit_uniform(std::mt19937_64& e) { return static_cast<double>(e() >> 11) 
 
 }  // namespace
 
+Eigen::Matrix3cd CrossSpectralMatrix::at(double f) const {
+  if (frequency_Hz.empty() || !(resolution_Hz > 0)) return Eigen::Matrix3cd::Zero();
+  // Bin k covers [f_k - res/2, f_k + res/2]: k = ceil((f - f_0) / res - 1/2), the lower at an edge.
+  const double u = (f - frequency_Hz.front()) / resolution_Hz;
+  if (u < -0.5 || u > static_cast<double>(frequency_Hz.size()) - 0.5) return Eigen::Matrix3cd::Zero();
+  const auto k = static_cast<std::size_t>(std::max(0.0, std::ceil(u - 0.5)));
+  return s_g2_per_Hz[std::min(k, s_g2_per_Hz.size() - 1)];
+}
+
+void validate(const CrossSpectralMatrix& m) {
+  if (m.frequency_Hz.empty()) throw std::invalid_argument("measured cross-spectral matrix: no bins");
+  if (m.s_g2_per_Hz.size() != m.frequency_Hz.size())
+    throw std::invalid_argument(std::string("measured cross-spectral matrix: ") + std::to_string(m.s_g2_per_Hz.size()) + " matrices for " +
+                                std::to_string(m.frequency_Hz.size()) + " bins");
+  if (!(m.resolution_Hz > 0) || !std::isfinite(m.resolution_Hz))
+    throw std::invalid_argument("measured cross-spectral matrix: resolution_Hz = " + num(m.resolution_Hz) + " must be > 0");
+  if (!(m.from_Hz() >= 0)) throw std::invalid_argument("measured cross-spectral matrix: the first bin reaches below 0 Hz");
+  for (std::size_t k = 0; k < m.frequency_Hz.size(); ++k) {
+    if (k > 0 && std::abs(m.frequency_Hz[k] - m.frequency_Hz[k - 1] - m.resolution_Hz) > 1e-6 * m.resolution_Hz)
+      throw std::invalid_argument(std::string("measured cross-spectral matrix: bin ") + std::to_string(k) + " at " + num(m.frequency_Hz[k]) +
+                                  " Hz is not one resolution above the previous");
+    const Eigen::Matrix3cd& s = m.s_g2_per_Hz[k];
+    const double scale = s.cwiseAbs().maxCoeff();
+    if (!std::isfinite(scale) || (s - s.adjoint()).cwiseAbs().maxCoeff() > 1e-9 * scale)
+      throw std::invalid_argument(std::string("measured cross-spectral matrix: bin ") + std::to_string(k) + " is not finite and Hermitian");
+    for (int i = 0; i < 3; ++i)
+      if (s(i, i).real() < 0)
+        throw std::invalid_argument(std::string("measured cross-spectral matrix: bin ") + std::to_string(k) + " has a negative PSD");
+  }
+}
+
 void validate(const RandomProfile& p) {
+  if (p.measured) validate(*p.measured);
   bool any = false;
   for (int i = 0; i < 3; ++i) {
     if (!p.psd[i]) continue;
@@ -109,7 +142,8 @@ double max_frequency_Hz(const RandomProfile& p) {
 
 std::string describe(const RandomProfile& p) {
   validate(p);
-  std::string s = p.coupling == AxisCoupling::common ? "random (common phases)" : "random (independent axes)";
+  std::string s = p.measured ? "random (measured cross-spectra)"
+                 : p.coupling == AxisCoupling::common ? "random (common phases)" : "random (independent axes)";
   for (int i = 0; i < 3; ++i)
     if (p.psd[i]) s += std::string("; ") + kAxis[i] + ": " + describe(*p.psd[i]);
   return s;
@@ -227,6 +261,15 @@ RandomVibration gaussian_equivalent(const RandomProfile& p) {
       r[static_cast<std::size_t>(i)] = resolve(*p.psd[static_cast<std::size_t>(i)]);
       g.rms_g[i] = rms_g(*p.psd[static_cast<std::size_t>(i)]);
     }
+  if (p.measured) {
+    Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
+    for (const Eigen::Matrix3cd& s : p.measured->s_g2_per_Hz) c += s.real() * p.measured->resolution_Hz;
+    for (int i = 0; i < 3; ++i) g.rms_g[i] = std::sqrt(std::max(0.0, c(i, i)));
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (i != j && g.rms_g[i] > 0 && g.rms_g[j] > 0) g.correlation(i, j) = std::clamp(c(i, j) / (g.rms_g[i] * g.rms_g[j]), -1.0, 1.0);
+    return g;
+  }
   if (p.coupling == AxisCoupling::common) {
     // Cross integrals on a fine log grid (trapezoid in log f): the integrand is a power law
     // between merged breakpoints, so 20000 points give ~1e-8 relative.

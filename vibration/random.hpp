@@ -28,12 +28,16 @@
 // axis), plus 16 (N/2 + 1) bytes of FFT buffer per axis while transforming. For long runs
 // use RandomExcitation (vibration/sampled.hpp), which synthesises in blocks.
 #include <array>
-#include <mutex>
+#include <complex>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <optional>
 #include <span>
 #include <string>
 #include <vector>
+
+#include <Eigen/Dense>
 
 #include "vibration/profile.hpp"
 #include "vibration/psd.hpp"
@@ -47,9 +51,37 @@ std::mutex& fftw_planner_mutex();
 
 enum class AxisCoupling { independent, common };
 
+// A measured cross-spectral matrix, one-sided, g^2/Hz: S_ij = 2 <X_i conj(X_j)> / (fs sum w^2)
+// as Welch estimates it (rectification/measurement/reference.hpp), Hermitian and positive
+// semi-definite, its diagonal the axes' PSDs. Bins of width resolution_Hz centred on
+// frequency_Hz (evenly spaced, increasing), each a step over its width; 0 outside the bins.
+// Complex: a transverse motion that lags the drive by a delay or a resonance has a cross-
+// spectrum whose phase turns with frequency; the rectification of real signals takes
+// Re(H_y S H_z^H) (rectification/prediction/random.hpp), which needs S whole, not |S| or Re S
+// alone.
+struct CrossSpectralMatrix {
+  std::vector<double> frequency_Hz;
+  double resolution_Hz = 0;
+  std::vector<Eigen::Matrix3cd> s_g2_per_Hz;  // one per bin
+  // S(f): the bin whose step holds f (|f - f_k| <= resolution / 2; the lower bin at an
+  // edge), else 0.
+  Eigen::Matrix3cd at(double frequency_Hz) const;
+  double from_Hz() const { return frequency_Hz.front() - resolution_Hz / 2; }
+  double to_Hz() const { return frequency_Hz.back() + resolution_Hz / 2; }
+};
+// Throws std::invalid_argument for no bins, a size mismatch, bins not evenly spaced by
+// resolution_Hz from above 0, a matrix not finite or not Hermitian, a negative diagonal.
+void validate(const CrossSpectralMatrix& m);
+
 struct RandomProfile {
   std::array<std::optional<PsdTable>, 3> psd;  // per axis [IA, PA, OA]; empty: axis at rest
   AxisCoupling coupling = AxisCoupling::common;
+  // A measured motion (the reference channels of a random run, io/lab_data.cpp): when set,
+  // the prediction takes S(f) from it, diagonal and cross terms, and `coupling` is not used
+  // (the psd tables then hold its diagonal, as steps over the same bins, for the rms, the
+  // band and the description). The synthesis (synthesize_random, RandomExcitation) does not
+  // use it. Shared: a profile is copied with its run.
+  std::shared_ptr<const CrossSpectralMatrix> measured;
 };
 
 // Throws std::invalid_argument if no axis has a table, or a table is invalid (the message
@@ -61,7 +93,8 @@ std::string describe(const RandomProfile& p);
 
 // The Gaussian description of a profile for the analytic prediction: rms per axis (the
 // spec's) and the correlation, 0 between independent axes and, for common phases,
-// rho_ij = integral sqrt(G_i G_j) df / (sigma_i sigma_j) (1 for proportional tables).
+// rho_ij = integral sqrt(G_i G_j) df / (sigma_i sigma_j) (1 for proportional tables); with a
+// measured matrix, rms and correlation from its bins (sum of Re S_ij x resolution).
 RandomVibration gaussian_equivalent(const RandomProfile& p);
 
 struct SampledSignal {

@@ -172,17 +172,22 @@ def sweep(case, out=None, restart=False, threads=-1, progress=False):
     return SweepResult(run, _read_csv_columns(os.fspath(out)))
 
 
-def campaign(case, out_dir, key=None, seed=None):
-    """campaign(case_path, out_dir, key=None, seed=None) -> CampaignWritten
+def campaign(case, out_dir, key=None, seed=None, raw_format="csv"):
+    """campaign(case_path, out_dir, key=None, seed=None, raw_format='csv') -> CampaignWritten
 
     The virtual lab: a whole campaign (static test, shaker runs) simulated from the case's
     truth with its hidden effects ([campaign]) and written to out_dir in the lab data format;
     the answer key apart (key, default <out_dir>.key.json). Same as `vrelab campaign CASE
-    --out DIR [--key FILE]`. Takes a case file path (the folder records it). Releases the GIL.
+    --out DIR [--key FILE] [--raw-format csv|hdf5]`. raw_format: the raw records (a case with
+    [campaign] raw_series = true) as records/<id>.csv or records/<id>.h5 (docs/data-format.md,
+    "Raw records in HDF5"); 'hdf5' for a case that writes summaries raises InputError, as the
+    CLI exits 2. Takes a case file path (the folder records it). Releases the GIL.
     """
     if not isinstance(case, (str, os.PathLike)):
         raise TypeError("campaign takes a case file path (the campaign's manifest records it)")
-    return _core._campaign(os.fspath(case), os.fspath(out_dir), os.fspath(key) if key else "", seed)
+    if raw_format not in ("csv", "hdf5"):
+        raise ValueError("campaign: raw_format must be 'csv' or 'hdf5', got %r" % (raw_format,))
+    return _core._campaign(os.fspath(case), os.fspath(out_dir), os.fspath(key) if key else "", seed, raw_format)
 
 
 def diagnose(dir, **settings):

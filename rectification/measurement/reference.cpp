@@ -95,12 +95,13 @@ void ReferenceAnalyzer::add(double t, const std::array<double, 3>& x, const std:
       for (int i = 0; i < 3; ++i)
         if (a_.present[static_cast<std::size_t>(i)]) sumh_[static_cast<std::size_t>(h)][i] += x[static_cast<std::size_t>(i)] * e;
     }
-    return;
+    if (!w_.sine_on_random) return;
   }
   // Welch: the segment length once the rate is known (the second sample in the window).
   if (L_ == 0) {
     if (dt_ == 0) {  // the first sample: held until the rate is known
       for (std::size_t i = 0; i < 3; ++i) buf_[i].push_back(x[i]);
+      tbuf_.push_back(t);
       return;
     }
     if (w_.segment_samples > 0) {
@@ -112,17 +113,24 @@ void ReferenceAnalyzer::add(double t, const std::array<double, 3>& x, const std:
     }
     window_.resize(static_cast<std::size_t>(L_));
     for (int k = 0; k < L_; ++k) window_[static_cast<std::size_t>(k)] = 0.5 - 0.5 * std::cos(2 * std::numbers::pi * k / L_);
+    const std::size_t nb = static_cast<std::size_t>(L_ / 2 + 1);
     for (std::size_t i = 0; i < 3; ++i) {
-      pxx_[i].assign(static_cast<std::size_t>(L_ / 2 + 1), 0.0);
-      pxy_[i].assign(static_cast<std::size_t>(L_ / 2 + 1), 0.0);
+      pxx_[i].assign(nb, 0.0);
+      pxy_[i].assign(nb, 0.0);
       buf_[i].reserve(static_cast<std::size_t>(L_));
+      if (w_.sine_on_random)
+        for (auto& v : pxb_[i]) v.assign(nb, 0.0);
     }
+    if (w_.sine_on_random)
+      for (auto& v : pbb_) v.assign(nb, 0.0);
     fft_ = new Fft(L_);
   }
   for (std::size_t i = 0; i < 3; ++i) buf_[i].push_back(x[i]);
+  tbuf_.push_back(t);
   if (static_cast<int>(buf_[0].size()) == L_) {
     segment();
     for (std::size_t i = 0; i < 3; ++i) buf_[i].erase(buf_[i].begin(), buf_[i].begin() + L_ / 2);
+    tbuf_.erase(tbuf_.begin(), tbuf_.begin() + L_ / 2);
   }
 }
 
@@ -145,6 +153,29 @@ void ReferenceAnalyzer::segment() {
     const auto [i, j] = pairs[p];
     if (!a_.present[i] || !a_.present[j]) continue;
     for (std::size_t k = 0; k < nb; ++k) pxy_[p][k] += X[i][k] * std::conj(X[j][k]);
+  }
+  if (w_.sine_on_random) {
+    // The fundamental's basis over this segment's own sample times, processed as the samples
+    // are (mean removed, Hann window, FFT): the fitted sine's spectrum in this segment is
+    // Re(W_1) B_0 + Im(W_1) B_1 (a = Im(W e^{jwt}) = Re W sin wt + Im W cos wt).
+    std::array<std::vector<std::complex<double>>, 2> B;
+    const double w = 2 * std::numbers::pi * w_.frequency_Hz;
+    for (std::size_t m = 0; m < 2; ++m) {
+      double mean = 0;
+      for (std::size_t k = 0; k < static_cast<std::size_t>(L_); ++k)
+        fft_->in[k] = m == 0 ? std::sin(w * tbuf_[k]) : std::cos(w * tbuf_[k]), mean += fft_->in[k];
+      mean /= L_;
+      for (std::size_t k = 0; k < static_cast<std::size_t>(L_); ++k) fft_->in[k] = (fft_->in[k] - mean) * window_[k];
+      fftw_execute(fft_->plan);
+      B[m].resize(nb);
+      for (std::size_t k = 0; k < nb; ++k) B[m][k] = {fft_->out[k][0], fft_->out[k][1]};
+    }
+    for (std::size_t i = 0; i < 3; ++i)
+      if (a_.present[i])
+        for (std::size_t m = 0; m < 2; ++m)
+          for (std::size_t k = 0; k < nb; ++k) pxb_[i][m][k] += X[i][k] * std::conj(B[m][k]);
+    for (std::size_t mn = 0; mn < 4; ++mn)
+      for (std::size_t k = 0; k < nb; ++k) pbb_[mn][k] += B[mn / 2][k] * std::conj(B[mn % 2][k]);
   }
   ++a_.segments;
 }
@@ -175,12 +206,35 @@ ReferenceAnalysis ReferenceAnalyzer::finish() {
       a.residual_rms_g[i] = std::sqrt(std::max(0.0, a.rms_g[i] * a.rms_g[i] - tones));
       a.amplitude_sigma_g[i] = a.residual_rms_g[i] * std::sqrt(2.0 / N);
     }
-    return a;
+    if (!w_.sine_on_random) return a;
   }
   if (a.segments < 2)
     throw std::invalid_argument(fmt::format("reference channels: the vibration window holds {} samples; Welch's PSD needs "
                                             "at least two segments of {} (50 % overlap: {} samples)",
                                             n_, std::max(L_, 64), 3 * std::max(L_, 64) / 2));
+  if (w_.sine_on_random) {
+    // Take the fitted fundamental off the sums (reference.hpp): with q_i = (Re W_1i, Im W_1i),
+    // sum_s (X_i - q_i.B)(X_j - q_j.B)^* = P_ij - q_j.XB_i - conj(q_i.XB_j) + q_i^T BB q_j.
+    a.sine_removed = true;
+    const std::size_t nb = static_cast<std::size_t>(L_ / 2 + 1);
+    std::array<std::array<double, 2>, 3> q{};
+    for (std::size_t i = 0; i < 3; ++i) q[i] = {a.harmonic_g[1][static_cast<int>(i)].real(), a.harmonic_g[1][static_cast<int>(i)].imag()};
+    const auto residual = [&](std::size_t i, std::size_t j, std::size_t k) {
+      std::complex<double> v = 0;
+      for (std::size_t m = 0; m < 2; ++m) {
+        v -= q[j][m] * pxb_[i][m][k] + q[i][m] * std::conj(pxb_[j][m][k]);
+        for (std::size_t n = 0; n < 2; ++n) v += q[i][m] * q[j][n] * pbb_[2 * m + n][k];
+      }
+      return v;
+    };
+    static constexpr std::array<std::pair<std::size_t, std::size_t>, 3> pairs{{{0, 1}, {0, 2}, {1, 2}}};
+    for (std::size_t k = 0; k < nb; ++k) {
+      for (std::size_t i = 0; i < 3; ++i)
+        if (a.present[i]) pxx_[i][k] = std::max(0.0, pxx_[i][k] + residual(i, i, k).real());
+      for (std::size_t p = 0; p < 3; ++p)
+        if (a.present[pairs[p].first] && a.present[pairs[p].second]) pxy_[p][k] += residual(pairs[p].first, pairs[p].second, k);
+    }
+  }
   const double fs = a.sample_rate_Hz;
   double sw2 = 0;
   for (double v : window_) sw2 += v * v;
@@ -195,12 +249,17 @@ ReferenceAnalysis ReferenceAnalyzer::finish() {
   // k2 rectifies is the record's own mean square, known far better from the samples than from
   // the sum of Welch's bins (relative sigma ~ sqrt(2 / (dof x bins / 2)), 4 % for 1.2 s at
   // 7.8 Hz bins); Welch gives how it is spread over frequency.
+  // A sine on random run: the random part's mean square, the window's less the fundamental's
+  // |W_1|^2 / 2 (exact over whole periods; over a window of n periods and a fraction, the
+  // fit's leakage is ~1 / (4 pi n) of W_1).
   std::array<double, 3> norm{1, 1, 1};
   for (std::size_t i = 0; i < 3; ++i) {
     if (!a.present[i]) continue;
     double sum = 0;
     for (int k = 1; k < L_ / 2; ++k) sum += pxx_[i][static_cast<std::size_t>(k)] * scale * a.resolution_Hz;
-    if (sum > 0) norm[i] = a.rms_g[static_cast<int>(i)] * a.rms_g[static_cast<int>(i)] / sum;
+    const int ii = static_cast<int>(i);
+    const double ms = a.rms_g[ii] * a.rms_g[ii] - (a.sine_removed ? std::norm(a.harmonic_g[1][ii]) / 2 : 0.0);
+    if (sum > 0) norm[i] = std::max(0.0, ms) / sum;
   }
   static constexpr std::array<std::pair<std::size_t, std::size_t>, 3> pairs{{{0, 1}, {0, 2}, {1, 2}}};
   for (std::size_t i = 0; i < 3; ++i) {
@@ -336,6 +395,30 @@ vibration::PsdTable welch_table(const ReferenceAnalysis& a, int axis, double fro
       t.rows.push_back(vibration::PsdRow::level(a.bin_Hz[k] + half, level));
     }
   return t;
+}
+
+vibration::CrossSpectralMatrix welch_matrix(const ReferenceAnalysis& a, double from_Hz, double to_Hz) {
+  if (!(a.present[0] && a.present[1] && a.present[2]))
+    throw std::invalid_argument("reference channels: the cross-spectral matrix needs all three axes");
+  static constexpr std::array<std::pair<int, int>, 3> pairs{{{0, 1}, {0, 2}, {1, 2}}};
+  vibration::CrossSpectralMatrix m;
+  m.resolution_Hz = a.resolution_Hz;
+  for (std::size_t k = 0; k < a.bin_Hz.size(); ++k) {
+    if (a.bin_Hz[k] < from_Hz || a.bin_Hz[k] > to_Hz) continue;
+    Eigen::Matrix3cd s = Eigen::Matrix3cd::Zero();
+    for (int i = 0; i < 3; ++i) s(i, i) = a.psd_g2_per_Hz[static_cast<std::size_t>(i)][k];
+    for (std::size_t p = 0; p < 3; ++p) {
+      const auto [i, j] = pairs[p];
+      const std::complex<double> v = a.csd_g2_per_Hz[p].empty() ? 0.0 : a.csd_g2_per_Hz[p][k];
+      s(i, j) = v, s(j, i) = std::conj(v);
+    }
+    m.frequency_Hz.push_back(a.bin_Hz[k]);
+    m.s_g2_per_Hz.push_back(s);
+  }
+  if (m.frequency_Hz.empty())
+    throw std::invalid_argument(fmt::format("reference channels: no Welch bin ({:g} Hz bins) in {:g} - {:g} Hz", a.resolution_Hz,
+                                            from_Hz, to_Hz));
+  return m;
 }
 
 }  // namespace vrelab::rectification

@@ -39,6 +39,10 @@ namespace vrelab::rectification {
 struct ReferenceWindow {
   double from_s = 0, to_s = 0;  // half-open [from, to)
   double frequency_Hz = 0;      // > 0: a sine run (harmonics 1, 2, 3); 0: a random run (Welch)
+  // A sine on random run (frequency_Hz > 0): the harmonics and the random part's Welch
+  // spectra with the fitted fundamental taken off every segment (the 2nd and 3rd harmonics
+  // stay in the spectra: the prediction takes one sine).
+  bool sine_on_random = false;
   int segment_samples = 0;      // random: Welch segment length (even, >= 16); 0: the largest
                                 // power of two <= samples / 8, within [64, 4096]
 };
@@ -61,6 +65,10 @@ struct ReferenceAnalysis {
   std::array<std::vector<std::complex<double>>, 3> csd_g2_per_Hz;
   int segment_samples = 0, segments = 0;
   double resolution_Hz = 0, dof = 0;  // Welch's chi^2 degrees of freedom per bin
+  // Sine on random: the spectra above are of the motion less the fundamental W_1 (each
+  // segment's windowed FFT less the fitted sine's, exactly: the sums are kept per bin and the
+  // fit, known at the window's end, taken off them then), scaled to the mean square less |W_1|^2/2.
+  bool sine_removed = false;
   // The covariance of the motion over [from_Hz, to_Hz] from the spectra (Re of the
   // integrated cross-spectra), g^2; the whole band when from = to = 0.
   Eigen::Matrix3d band_covariance_g2(double from_Hz = 0, double to_Hz = 0) const;
@@ -95,6 +103,12 @@ class ReferenceAnalyzer {
   std::array<std::vector<double>, 3> buf_;
   std::array<std::vector<double>, 3> pxx_;
   std::array<std::vector<std::complex<double>>, 3> pxy_;
+  // Sine on random: the segment's sample times, and per bin the sums of X_i conj(B_m) and
+  // B_m conj(B_n) for the fundamental's basis B_0 = sin(w t), B_1 = cos(w t) as each
+  // segment sees it (mean removed, windowed, transformed).
+  std::vector<double> tbuf_;
+  std::array<std::array<std::vector<std::complex<double>>, 2>, 3> pxb_;
+  std::array<std::vector<std::complex<double>>, 4> pbb_;  // (m, n) = (0,0), (0,1), (1,0), (1,1)
   std::vector<double> window_;
   struct Fft;
   Fft* fft_ = nullptr;
@@ -128,9 +142,10 @@ MotionDeparture sine_departure(const ReferenceAnalysis& a, const Vec3& commanded
 // commanded_covariance_g2: the commanded motion's covariance (e.g. from the PSD tables).
 MotionDeparture random_departure(const ReferenceAnalysis& a, const Eigen::Matrix3d& commanded_covariance_g2);
 
-// The measured motion a prediction takes: per-axis tones (sine) or PSD tables from the Welch
-// bins in [from_Hz, to_Hz] (random; welch_table: each bin a step over its width, so that the
-// table integrates to the bins' sum; bins <= 0 raised to 1e-12 of the largest).
+// The measured motion a prediction takes: per-axis tones (sine) or the measured cross-spectral
+// matrix with PSD tables from the Welch bins in [from_Hz, to_Hz] (random; welch_matrix, and
+// welch_table: each bin a step over its width, so that the table integrates to the bins'
+// sum; bins <= 0 raised to 1e-12 of the largest).
 struct MeasuredMotion {
   std::array<bool, 3> present{};
   double frequency_Hz = 0;
@@ -141,5 +156,9 @@ struct MeasuredMotion {
   bool used() const { return !tones.empty() || random.has_value(); }
 };
 vibration::PsdTable welch_table(const ReferenceAnalysis& a, int axis, double from_Hz, double to_Hz);
+// The measured 3x3 cross-spectral matrix over the Welch bins in [from_Hz, to_Hz] (the PSDs on
+// its diagonal, S_ij = the cross-spectrum of (i, j), S_ji its conjugate), for a reference on
+// all three axes (std::invalid_argument otherwise, or when no bin is in the band).
+vibration::CrossSpectralMatrix welch_matrix(const ReferenceAnalysis& a, double from_Hz, double to_Hz);
 
 }  // namespace vrelab::rectification

@@ -10,11 +10,14 @@
 //
 // The random motion x(t) is zero-mean Gaussian with the one-sided cross-spectral density
 // S_ij(f) (g^2/Hz): S_ii = G_i, and between axes S_ij = sqrt(G_i G_j) for `common` phases,
-// 0 for `independent` ones. Every linear response y = sum_j H_yj(f) x_j of the plant (the
+// 0 for `independent` ones, or a measured Hermitian matrix (RandomProfile::measured: any
+// coherence and phase between the axes, e.g. a transverse motion partly coherent with the
+// drive and delayed). Every linear response y = sum_j H_yj(f) x_j of the plant (the
 // felt motion F_i = T_i x_i behind a mechanical mode, the rebalance current I, the pendulum
 // angle Theta; rectification::loop_response) is then Gaussian too, with the covariances
 //     C_yz = integral Re( sum_ij H_yi(f) S_ij(f) conj(H_zj(f)) ) df
-// over the table band (piecewise Gauss-Legendre in ln f, RandomResponse). Each term of (1)
+// over the table band (piecewise Gauss-Legendre in ln f, RandomResponse; a measured
+// matrix's pieces are its bins). Each term of (1)
 // at its place then takes the Gaussian expectation of eq. (3)'s random form
 // (eq3.hpp random_rectification), with the covariance of what it sees: IA terms in the loop
 // or at the output the current's variance C_II; input terms and the cross terms the felt
@@ -60,8 +63,12 @@ struct RandomQuadrature {
   bool common_grid = false;
 };
 
-// The one-sided cross-spectral density S(f) of the profile, g^2/Hz (real: the synthesis
-// uses zero relative phase for common coupling).
+// The one-sided cross-spectral density S(f) of the profile, g^2/Hz, Hermitian: a profile's
+// measured matrix (vibration::RandomProfile::measured, the reference channels' Welch) as
+// measured; else from the tables, real (the synthesis uses zero relative phase for common
+// coupling, none for independent axes).
+Eigen::Matrix3cd cross_spectral_matrix_g2_per_Hz(const vibration::RandomProfile& p, double frequency_Hz);
+// Its real part (the covariance density of the input itself).
 Eigen::Matrix3d cross_spectrum_g2_per_Hz(const vibration::RandomProfile& p, double frequency_Hz);
 
 RandomResponse random_response(const vibration::RandomProfile& p, const ResponseAt& response,

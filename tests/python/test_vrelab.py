@@ -348,3 +348,35 @@ def test_diagnose_data_in_memory_equals_the_folder():
     del runs["frequency_Hz"]
     with pytest.raises(vrelab.InputError, match="^lab-1/runs.csv: the header lacks column 'frequency_Hz'"):
         vrelab.diagnose_data(static, runs, manifest, name="lab-1")
+
+
+def test_campaign_writes_raw_records_as_csv_or_hdf5(tmp_path):
+    # vrelab.campaign(..., raw_format=) as `vrelab campaign --raw-format`: a small raw campaign
+    # (2 runs of 0.2 s) written both ways; the same samples give the same diagnosis inputs
+    # (each run's measured error as read back), the HDF5 files are HDF5 (the signature), and
+    # a bad format or HDF5 for a case of summaries is refused.
+    text = open(case("campaign.toml")).read()
+    for key, value in [("frequencies_Hz", "[100.0]"), ("amplitudes_g", "[2.0]"), ("directions", "[[1.0, 0.0, 0.0]]")]:
+        start = text.index(key + " = ")
+        text = text[:start] + key + " = " + value + text[text.index("\n", start):]
+    summaries = tmp_path / "small.toml"
+    summaries.write_text(text)
+    raw = tmp_path / "small-raw.toml"
+    raw.write_text(text.replace("[campaign]", "[campaign]\nraw_series = true\nraw_record_s = 0.2", 1))
+    written = {}
+    for fmt, ext in [("csv", ".csv"), ("hdf5", ".h5")]:
+        out = tmp_path / fmt
+        w = vrelab.campaign(str(raw), str(out), raw_format=fmt)
+        assert w.raw_records and w.runs == 2
+        records = sorted(os.listdir(out / "records"))
+        assert len(records) == 2 and all(r.endswith(ext) for r in records), records
+        if fmt == "hdf5":
+            assert (out / "records" / records[0]).read_bytes()[:8] == b"\x89HDF\r\n\x1a\n"
+        written[fmt] = columns(out / "runs.csv")
+    assert list(written["csv"]["id"]) == list(written["hdf5"]["id"])
+    assert [s.replace(".csv", ".h5") for s in written["csv"]["series"]] == list(written["hdf5"]["series"])
+    with pytest.raises(ValueError, match="raw_format must be 'csv' or 'hdf5'"):
+        vrelab.campaign(str(raw), str(tmp_path / "bad"), raw_format="h5")
+    with pytest.raises(vrelab.InputError, match="--raw-format hdf5: the case writes summaries"):
+        vrelab.campaign(str(summaries), str(tmp_path / "sum"), raw_format="hdf5")
+    assert not (tmp_path / "sum" / "runs.csv").exists()

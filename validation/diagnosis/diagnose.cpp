@@ -223,7 +223,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     std::optional<rectification::LoopResponse> sine_h;
     if (r.random) {
       rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature);
-      if (r.sine_part) sine = r.vibration(), sine_h = h(r.frequency_Hz);
+      if (r.sine_part) sine = measured_sine(r) ? m.sine : r.vibration(), sine_h = h(r.frequency_Hz);
     }
     // Coefficients as identified, then the effect's own change of them (if any) on top.
     const Coefficients shift = [&] {
@@ -884,7 +884,7 @@ double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effe
     const rectification::RandomResponse rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature);
     std::optional<vibration::SineVibration> sine;
     std::optional<rectification::LoopResponse> sine_h;
-    if (r.sine_part) sine = r.vibration(), sine_h = h(r.frequency_Hz);
+    if (r.sine_part) sine = measured_sine(r) ? m.sine : r.vibration(), sine_h = h(r.frequency_Hz);
     return rectification::random_rectification_at_frequency(cfg, r.orientation_g, rr, sine, sine_h).total_g();
   }
   return rectification::periodic_rectification(cfg, r.orientation_g, run_input(r, m), h).total_g();
