@@ -7,9 +7,12 @@
 //        (s): for a sine run its frequency (the caller cuts the window to whole periods),
 //        for a random run the Welch segment length (0: chosen from the window).
 // Gives: per axis the mean and the rms about it; for a sine run the complex amplitude of
-//        the fundamental and of the 2nd and 3rd harmonics (a single-bin DFT, "lock-in", over
-//        the window's samples: W_h = 2 j mean(x e^{-j h w t}), the sine convention of
-//        vibration::SineVibration, a = Im(W e^{j h w t})) and the residual's rms; for a
+//        the fundamental and of the 2nd and 3rd harmonics (a least-squares fit of the mean
+//        and the three tones over the window's samples, in the sine convention of
+//        vibration::SineVibration, a = Im(W e^{j h w t}); over whole periods it is the
+//        single-bin DFT W_h = 2 j mean(x e^{-j h w t}) but for the O(1/N) by which sampled
+//        tones are not orthogonal when a period is not a whole number of samples) and the
+//        residual's rms; for a
 //        random run the one-sided PSD and cross-spectra by Welch (periodic Hann window, 50 %
 //        overlap, each segment's mean removed, density scaling as vibration::welch_psd,
 //        then each axis scaled so that its bins sum to the window's mean square: Welch for
@@ -96,8 +99,10 @@ class ReferenceAnalyzer {
   double last_t_ = 0, dt_ = 0;
   long seen_ = 0, n_ = 0;
   Vec3 sum_ = Vec3::Zero(), sum2_ = Vec3::Zero();
-  std::array<Eigen::Vector3cd, 4> sumh_{Eigen::Vector3cd::Zero(), Eigen::Vector3cd::Zero(), Eigen::Vector3cd::Zero(),
-                                       Eigen::Vector3cd::Zero()};
+  // Sine: the least-squares fit of the mean and three tones, streamed (the basis
+  // 1, sin h w t, cos h w t, h = 1..3: its Gram matrix and each axis's projections).
+  Eigen::Matrix<double, 7, 7> gram_ = Eigen::Matrix<double, 7, 7>::Zero();
+  Eigen::Matrix<double, 7, 3> proj_ = Eigen::Matrix<double, 7, 3>::Zero();
   // Welch
   int L_ = 0;
   std::array<std::vector<double>, 3> buf_;

@@ -110,9 +110,11 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
     const int pieces = std::max(1, static_cast<int>(std::ceil((l1 - l0) / q.max_log_step - 1e-9)));
     const double h = (l1 - l0) / pieces;
     // A measured matrix is constant over each piece (a bin or part of one): only the loop's
-    // responses vary there, smoothly over a bin (<= 0.1 in ln f), so 2-point Gauss-Legendre
-    // (exact for cubics in ln f; ~h^4 / 4320 of the curvature's scale, < 1e-7) does with a
-    // quarter of the responses (and of the response cache's memory).
+    // responses vary there, smoothly over a bin (<= 0.1 in ln f) for the loop alone, so 2-point
+    // Gauss-Legendre (exact for cubics in ln f) does with a quarter of the responses (and of the
+    // response cache's memory). A kept lightly damped mode is not smooth over a bin: at a mode
+    // of 503 Hz on 7.8 Hz bins its resonance's integral errs by 0.7 % at damping 0.01 and 5 %
+    // at 0.005 (the 8-point path on 0.1-wide pieces: 1.9 % and 6.5 %).
     static constexpr std::array<double, 2> kGl2X{-0.5773502691896258, 0.5773502691896258}, kGl2W{1.0, 1.0};
     const bool two = static_cast<bool>(p.measured);
     const std::size_t points = two ? kGl2X.size() : kGlX.size();

@@ -99,8 +99,10 @@ TEST(PreparedRectification, ASineClosedFormPreparedOnceIsThePredictionAtAnyCoeff
   }
 }
 
-// One linearisation for every frequency, asked in any order: each response is loop_response's,
-// bit for bit (the DC gain solved once is the one every frequency solved before).
+// One linearisation for every frequency, asked in any order: each response is a fresh
+// responder's (loop_response builds one per call), bit for bit. A property test: it fails when
+// a response depends on what was asked before (state kept between calls); the responses' values
+// are checked against the ODE elsewhere (test_frequency.cpp, test_random_at_frequency.cpp).
 TEST(PreparedRectification, ALoopResponderLinearisedOnceGivesEachFrequencysResponse) {
   const PlantConfig p = busy_plant(test::paper_like_coefficients());
   const rectification::LoopResponder responder(p);

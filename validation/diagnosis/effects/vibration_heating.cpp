@@ -19,8 +19,9 @@ Effect effect_vibration_heating() {
   e.acts_on = ActsOn::instrument;
   e.physics = "the vibration's power warms the sensor (time constant 50 ms) and the input axis's scale has a "
               "temperature coefficient: a_IA (1 + kappa (<|a|^2> - 1)), nothing in a 1 g static test; under a sine "
-              "kappa a_IA A^2 / 2, odd in the static a_IA, flat in frequency, the same along IA, PA or OA (outside "
-              "the diagnosis' library)";
+              "kappa a_IA A^2 / 2, odd in the static a_IA, flat in frequency along PA and OA (along IA more at low "
+              "frequency: the power's ripple at f, kappa a_IA A^2 / (1 + (w tau)^2) further) (outside the diagnosis' "
+              "library)";
   EffectParameter p("kappa_per_g2", "1/g^2");
   p.example = 2e-6;
   p.nominal = 0;
