@@ -79,11 +79,17 @@ std::string line_checksum(const std::string& text) {
   return fmt::format("{:08x}", h);
 }
 
-std::map<int, std::string> blind_done(const std::string& path, const std::string& header) {
+// stale: the file exists but under another header (its lines are not read back).
+std::map<int, std::string> blind_done(const std::string& path, const std::string& header, bool* stale) {
   std::map<int, std::string> done;
   std::ifstream in(path);
   std::string line;
-  if (!std::getline(in, line) || line + "\n" != header) return done;  // another seed, settings or program
+  *stale = false;
+  if (!std::getline(in, line)) return done;
+  if (line + "\n" != header) {  // another seed, settings or program
+    *stale = true;
+    return done;
+  }
   while (std::getline(in, line)) {
     const std::size_t a = line.find('\t'), b = line.rfind('\t');
     if (a == std::string::npos || b == a) continue;
@@ -106,7 +112,12 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   const std::string done_path = o.out_dir + "/campaigns.txt", header = blind_header(o.settings);
   std::map<int, std::string> done;
   if (writer) {
-    done = blind_done(done_path, header);
+    bool stale = false;
+    done = blind_done(done_path, header, &stale);
+    if (stale)
+      std::cerr << "blind: " << done_path
+                << " was written by another seed, settings or program build; its campaigns are not read back "
+                   "(all run again, the file replaced)\n";
     std::string kept = header;
     for (const auto& [i, t] : done) {
       const std::string body = fmt::format("{}\t{}", i, t);

@@ -101,7 +101,13 @@ check "predict under mpirun prints one report" test "$(grep -c '^vrelab ' "$tmp/
 
 blind_part() {
 # ---- blind: 2 campaigns (both clean: the cheapest).
-expect 0 'blind --n 2 --seed 5' blind --n 2 --seed 5 --out "$tmp/blind-threads" --no-progress
+# Over a campaigns.txt left by another seed: said on stderr, none of its lines read back (the
+# rows below must still equal the MPI run's).
+mkdir -p "$tmp/blind-threads"
+printf '# vrelab blind: another seed\n0\tforged\t00000000\n' >"$tmp/blind-threads/campaigns.txt"
+expect 0 'another seed, settings or program build; its campaigns are not read back' \
+  blind --n 2 --seed 5 --out "$tmp/blind-threads" --no-progress
+check "blind: the stale campaigns.txt replaced" grep -q 'seed 5 ' "$tmp/blind-threads/campaigns.txt"
 run_mpi 0 blind --n 2 --seed 5 --out "$tmp/blind-mpi" --no-progress
 check "blind: scores.json under mpirun -n 3 = threaded" same_json "$tmp/blind-threads/scores.json" "$tmp/blind-mpi/scores.json"
 check "blind: confusion.csv the same" cmp -s "$tmp/blind-threads/confusion.csv" "$tmp/blind-mpi/confusion.csv"
