@@ -73,8 +73,10 @@ struct BlindCampaign {
 //  unexplained, no_gap: those verdicts where they are not right;
 //  wrong: explained by an effect of another physics (confidently wrong);
 //  ambiguous: "ambiguous between" verdicts, counted apart (right_among: the truth among them).
-//  parameters_off (natural forms): the right effect, but a fitted parameter beyond 3 sigma of
-//         the truth (or a discrete one, the mode's axis, not the truth's).
+//  parameters_off (natural forms, dynamics_off): the right effect, but a fitted parameter beyond
+//         3 sigma of the truth (or a discrete one, the mode's axis, not the truth's); for
+//         dynamics_off the truth is the loop's departure from the manifest (servo_dynamics'
+//         crossover ratio, margin change and pendulum frequency ratio).
 struct FamilyScore {
   int n = 0, right = 0, family = 0, unexplained = 0, no_gap = 0, wrong = 0, ambiguous = 0, right_among = 0, error = 0;
   int parameters_off = 0;
