@@ -64,11 +64,21 @@ double batch_sigma(const std::vector<double>& means, double mean) {
 // for the batch means and least-squares sums of the running integral for the paper's slope.
 class SampledRecorder {
  public:
+  // rest_closed_form: without noise and without a sink every sample at rest is the same
+  // number, and each block's sum is taken as block_n times it (the running sum of block_n
+  // equal terms differs from it by rounding only, ~block_n ulp of the baseline; the sine
+  // paths keep the running sum, bit for bit as before).
   SampledRecorder(const Readout& ro, double k1, double baseline_g, int blocks, long block_n, double dt,
-                  const SampleSink& sink)
+                  const SampleSink& sink, bool rest_closed_form = false)
       : ro_(ro), k1_(k1), baseline_(baseline_g), block_n_(block_n), dt_(dt), sink_(sink), rng_(ro.seed),
         rest_(static_cast<std::size_t>(blocks), 0.0), vib_(rest_) {
     const long rest_n = blocks * block_n;
+    if (rest_closed_form && !sink_ && !(ro_.noise_sigma_g > 0)) {
+      const double u = acquire(baseline_g);
+      for (double& r : rest_) r = static_cast<double>(block_n) * (u / k1);
+      samples_ = rest_n;
+      return;
+    }
     long m = 0;
     for (std::size_t b = 0; b < rest_.size(); ++b)
       for (long i = 0; i < block_n; ++i, ++m) {
@@ -549,7 +559,7 @@ ShakeResult shake_excitation(const plant::PlantConfig& config, const Vec3& a_sta
       } else {
         r.method = "sampled record";
         r.sample_rate_Hz = rate;
-        SampledRecorder rec(ro, k1, r.baseline_g, s.blocks, block_n, dt, sink);
+        SampledRecorder rec(ro, k1, r.baseline_g, s.blocks, block_n, dt, sink, true);
         for (long k = 0; k < total_n; ++k) {
           if (k > 0) plant.advance();
           rec.sample(static_cast<double>(k) * dt, plant.input_g(), plant.output_g(), k - settle_n, plant.linear_output_g());
