@@ -340,6 +340,46 @@ double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx, 
   return out;
 }
 
+void Accelerometer::jacobian(double /*t*/, const double* x, double* jac) const {
+  if (!config_.effects.empty()) throw std::logic_error("Accelerometer::jacobian: the effects have no derivatives");
+  Eigen::Map<Eigen::MatrixXd> j(jac, n_, n_);
+  j.setZero();
+  // i = k G theta + (1 - k) L + w_i I (no effect: pickoff and current are the identity).
+  const double g = servo_.gain_g_per_rad, k = lead_ratio_, wi = servo_.integrator_rad_per_s;
+  const double wl = servo_.lead_pole_rad_per_s;
+  const double y = k * g * x[kTheta] + (1 - k) * x[kLead];
+  const double i = y + wi * x[kIntegral];
+  double di[kCoreStates] = {};
+  di[kTheta] = k * g, di[kLead] = 1 - k, di[kIntegral] = wi;
+  // z = m_il^-1(i): dz/di = 1 / m_il'(z); torque = m_in(z) + c2 i^2 + c3 i^3.
+  const double z = solve_z(i);
+  const double dz = (has_in_ia_ || has_loop_) ? 1 / (1 + f_ia_slope(Location::input, z) + f_ia_slope(Location::loop, z)) : 1.0;
+  const double dtorque = (has_in_ia_ ? 1 + f_ia_slope(Location::input, z) : 1.0) * dz +
+                         i * (2 * config_.torquer_c2_per_g + 3 * config_.torquer_c3_per_g2 * i);
+  const Dynamics& d = config_.dynamics;
+  const double wp = 2 * kPi * d.pendulum_frequency_Hz, b = d.angle_gain_rad_per_s2_per_g;
+  j(kTheta, kOmega) = 1;
+  j(kOmega, kTheta) = -wp * wp;
+  j(kOmega, kOmega) = -2 * d.pendulum_damping_ratio * wp;
+  for (int c : {kTheta, kLead, kIntegral}) j(kOmega, c) += -b * dtorque * di[c];
+  // Lead: L' = w_l (G theta - L).
+  j(kLead, kTheta) = wl * g;
+  j(kLead, kLead) = -wl;
+  if (wi > 0) j(kIntegral, kTheta) = k * g, j(kIntegral, kLead) = 1 - k;  // I' = y
+  // The output before the filter: i + C_output(a) + F_output(z).
+  const double dout = 1 + (has_out_ia_ ? f_ia_slope(Location::output, z) * dz : 0.0);
+  if (d.antialias_Hz > 0) {
+    const double wa = 2 * kPi * d.antialias_Hz;
+    j(kAA1, kAA2) = 1;
+    for (int c : {kTheta, kLead, kIntegral}) j(kAA2, c) = wa * wa * dout * di[c];
+    j(kAA2, kAA1) = -wa * wa;
+    j(kAA2, kAA2) = -std::numbers::sqrt2 * wa;
+    j(kQuadrature, kAA1) = 1;
+  } else {
+    for (int c : {kTheta, kLead, kIntegral}) j(kQuadrature, c) = dout * di[c];
+  }
+}
+
 double Accelerometer::output_g(double t, const double* x) const {
   if (config_.dynamics.antialias_Hz > 0) return x[kAA1];
   const Vec3 a_case = input_ ? Vec3(a_static_ + input_(t)) : a_static_;

@@ -87,6 +87,12 @@ class Accelerometer final : public OdeSystem {
 
   int size() const override { return n_; }
   void rhs(double t, const double* x, double* dx) const override;
+  // The analytic Jacobian d(rhs)/dx (the loop, model (1)'s IA terms through m_il^-1, the
+  // torquer polynomial, the anti-alias filter; the input and the cross terms do not depend on
+  // the state). Effects have no derivative hooks: with any effect has_jacobian() is false
+  // and CVODE forms the Jacobian by its column-wise difference quotients, as before.
+  bool has_jacobian() const override { return config_.effects.empty(); }
+  void jacobian(double t, const double* x, double* j) const override;
 
   // Normalised output U/K1 (g) at state x and time t (after the anti-alias filter if on).
   double output_g(double t, const double* x) const;

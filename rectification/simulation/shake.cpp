@@ -38,6 +38,16 @@ class WithLinearCompanion final : public plant::OdeSystem {
     Eigen::Map<Eigen::VectorXd> dz(dx + n_, n_);
     dz.noalias() = lin_.A * z + lin_.B * input_(t);
   }
+  // [[J_plant, 0], [0, A]]: the companion does not depend on the plant's state.
+  bool has_jacobian() const override { return plant_.has_jacobian(); }
+  void jacobian(double t, const double* x, double* j) const override {
+    Eigen::Map<Eigen::MatrixXd> m(j, 2 * n_, 2 * n_);
+    Eigen::MatrixXd jp(n_, n_);
+    plant_.jacobian(t, x, jp.data());
+    m.setZero();
+    m.topLeftCorner(n_, n_) = jp;
+    m.bottomRightCorner(n_, n_) = lin_.A;
+  }
   // The companion's linear output deviation (U/K1 - baseline) at state x.
   double linear_output(double t, const double* x) const {
     const Eigen::Map<const Eigen::VectorXd> z(x + n_, n_);
@@ -259,6 +269,7 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
   std::vector<double> x0(x_eq);
   plant::SolverSettings solver;
   solver.relative_tolerance = s.relative_tolerance;
+  solver.analytic_jacobian = s.analytic_jacobian;
   const std::vector<double> scale = rest.state_scale();
   const double amplitude = std::max(v.amplitude_g.cwiseAbs().maxCoeff(), 1e-12);
   for (int k = 0; k < n; ++k) {
@@ -581,6 +592,7 @@ ShakeResult shake_excitation(const plant::PlantConfig& config, const Vec3& a_sta
   const double amplitude = std::max(std::sqrt(ms), 1e-6);
   plant::SolverSettings solver;
   solver.relative_tolerance = s.relative_tolerance;
+  solver.analytic_jacobian = s.analytic_jacobian;
   const std::vector<double> scale = rest.state_scale();
   for (int copy = 0; copy < 2; ++copy)
     for (int k = 0; k < n; ++k)

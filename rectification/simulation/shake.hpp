@@ -60,6 +60,9 @@ struct ShakeSettings {
   // discretisation of the linear loop and an exponential-integrator correction for the
   // nonlinear terms (rectification/simulation/discretised.hpp); false forces CVODE.
   bool exponential_integrator = true;
+  // CVODE (the transient path, the random fallback) with the plant's analytic Jacobian where
+  // it has one (plant/accelerometer.hpp: no effects); false: CVODE's difference quotients.
+  bool analytic_jacobian = true;
   bool IsValid(std::string* error) const;
 };
 
