@@ -336,6 +336,7 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
     // of the state, so this is still a loose relative tolerance on it (cheap), and it puts
     // the answer's own error near 1e-11 g, below the transient path's (~5e-10 g at 5 g).
     plant::SolverSettings dev_solver = solver;
+    dev_solver.analytic_jacobian = true;  // the linearisation's A below (not the plant's Jacobian)
     for (double& a : dev_solver.absolute_tolerance) a *= 0.01;
     auto pass = [&](double t0, const std::vector<double>& y0, double t_measure) {
       plant::OdeSolver ode(dev, t0, y0, dev_solver);

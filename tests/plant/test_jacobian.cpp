@@ -101,6 +101,7 @@ TEST(AnalyticJacobian, TransientShakeEqualsCvodesDifferenceQuotientsWithin1e9g) 
     v.frequency_Hz = f;
     rectification::ShakeSettings s;
     s.periodic_steady_state = false;
+    s.analytic_jacobian = true;
     const auto a = rectification::shake_sine(cfg, Vec3(0.5, std::sqrt(0.75), 0), v, s);
     s.analytic_jacobian = false;
     const auto q = rectification::shake_sine(cfg, Vec3(0.5, std::sqrt(0.75), 0), v, s);
