@@ -174,6 +174,9 @@ Accelerometer::Accelerometer(PlantConfig config, const Vec3& a_static_g, Input i
   for (int c : kIaTerms)
     if (config_.coefficients[c] != 0 && config_.location[c] != Location::output)
       newton_terms_[static_cast<std::size_t>(n_newton_terms_++)] = {c, config_.coefficients[c], config_.location[c] == Location::input};
+  for (int t = 0; t < n_newton_terms_; ++t)
+    if (newton_terms_[static_cast<std::size_t>(t)].c == k1_asym) newton_smooth_ = false;
+  lead_ratio_ = servo_.lead_pole_rad_per_s / servo_.lead_zero_rad_per_s;
   n_ = kCoreStates;
   for (const auto& e : config_.effects) {
     effect_offset_.push_back(n_);
@@ -246,6 +249,39 @@ double Accelerometer::solve_z(double i) const {
   return z;
 }
 
+double Accelerometer::solve_z_fast(double i) const {
+  if (!has_in_ia_ && !has_loop_) return i;
+  if (!newton_smooth_) return solve_z(i);
+  // F(z) = F_input(z) + F_loop(z), its slope and a bound on its curvature |F''| at z.
+  const auto sums = [this](double z, double* f, double* s, double* c) {
+    *f = *s = *c = 0;
+    for (int t = 0; t < n_newton_terms_; ++t) {
+      const NewtonTerm& term = newton_terms_[static_cast<std::size_t>(t)];
+      switch (term.c) {
+        case k0: *f += term.k; break;
+        case k2: *f += term.k * (z * z), *s += term.k * (2 * z), *c += std::abs(term.k) * 2; break;
+        case k3: *f += term.k * (z * z * z), *s += term.k * (3 * z * z), *c += std::abs(term.k) * (6 * std::abs(z)); break;
+        default: *f += term.k * (z * z * z * z), *s += term.k * (4 * z * z * z), *c += std::abs(term.k) * (12 * z * z); break;
+      }
+    }
+  };
+  double f, sl, c;
+  sums(i, &f, &sl, &c);
+  // z = i - F(z): z ~ i - F(i - F(i)) ~ i - F(i) + F'(i) F(i), an error O(F'^2 F + F'' F^2).
+  double z = i - f + sl * f;
+  for (int it = 0; it < 30; ++it) {
+    sums(z, &f, &sl, &c);
+    const double d = 1 + sl;
+    const double dz = (z + f - i) / d;
+    z -= dz;
+    // Newton's next step is ~ F'' dz^2 / (2 F'); |F''| over [z - dz, z] is within twice c for
+    // |dz| << |z| (the terms are polynomials of degree <= 4): stop when that is below the
+    // rounding of z, or on solve_z's own criterion.
+    if (std::abs(dz) <= 1e-16 * (1 + std::abs(z)) || 2 * c * dz * dz <= 1e-17 * (1 + std::abs(z)) * std::abs(d)) break;
+  }
+  return z;
+}
+
 double Accelerometer::readout(double i, const Vec3& a) const {
   double out = i + cross(Location::output, a);
   if (has_out_ia_) out += f_ia(Location::output, solve_z(i));
@@ -258,10 +294,10 @@ void Accelerometer::rhs(double t, const double* x, double* dx) const {
 }
 
 double Accelerometer::rhs_output(const Vec3& dynamic_input_g, const double* x, double* dx) const {
-  return evaluate(Vec3(a_static_ + dynamic_input_g), x, dx);
+  return evaluate(Vec3(a_static_ + dynamic_input_g), x, dx, true);
 }
 
-double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx) const {
+double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx, bool fast_z) const {
   Vec3 a = a_case;
   for (std::size_t e = 0; e < config_.effects.size(); ++e)
     a = config_.effects[e]->input(a, x + effect_offset_[e], dx + effect_offset_[e]);
@@ -271,14 +307,14 @@ double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx) 
   double p = theta;
   for (const auto& e : config_.effects) p = e->pickoff(p);
   const double u = servo_.gain_g_per_rad * p;
-  const double k = servo_.lead_pole_rad_per_s / servo_.lead_zero_rad_per_s;
+  const double k = lead_ratio_;  // lead pole / lead zero
   const double y = k * u + (1 - k) * x[kLead];
   dx[kLead] = servo_.lead_pole_rad_per_s * (u - x[kLead]);
   double i = y + servo_.integrator_rad_per_s * x[kIntegral];
   dx[kIntegral] = servo_.integrator_rad_per_s > 0 ? y : 0.0;
   for (const auto& e : config_.effects) i = e->current(i);
 
-  const double z = solve_z(i);
+  const double z = fast_z ? solve_z_fast(i) : solve_z(i);
   double torque = has_in_ia_ ? z + f_ia(Location::input, z) : z;  // m_in(m_il^-1(i))
   torque += i * i * (config_.torquer_c2_per_g + config_.torquer_c3_per_g2 * i);
   const Dynamics& d = config_.dynamics;
@@ -302,6 +338,46 @@ double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx) 
   }
   dx[kQuadrature] = out - q_ref_;
   return out;
+}
+
+void Accelerometer::jacobian(double /*t*/, const double* x, double* jac) const {
+  if (!config_.effects.empty()) throw std::logic_error("Accelerometer::jacobian: the effects have no derivatives");
+  Eigen::Map<Eigen::MatrixXd> j(jac, n_, n_);
+  j.setZero();
+  // i = k G theta + (1 - k) L + w_i I (no effect: pickoff and current are the identity).
+  const double g = servo_.gain_g_per_rad, k = lead_ratio_, wi = servo_.integrator_rad_per_s;
+  const double wl = servo_.lead_pole_rad_per_s;
+  const double y = k * g * x[kTheta] + (1 - k) * x[kLead];
+  const double i = y + wi * x[kIntegral];
+  double di[kCoreStates] = {};
+  di[kTheta] = k * g, di[kLead] = 1 - k, di[kIntegral] = wi;
+  // z = m_il^-1(i): dz/di = 1 / m_il'(z); torque = m_in(z) + c2 i^2 + c3 i^3.
+  const double z = solve_z(i);
+  const double dz = (has_in_ia_ || has_loop_) ? 1 / (1 + f_ia_slope(Location::input, z) + f_ia_slope(Location::loop, z)) : 1.0;
+  const double dtorque = (has_in_ia_ ? 1 + f_ia_slope(Location::input, z) : 1.0) * dz +
+                         i * (2 * config_.torquer_c2_per_g + 3 * config_.torquer_c3_per_g2 * i);
+  const Dynamics& d = config_.dynamics;
+  const double wp = 2 * kPi * d.pendulum_frequency_Hz, b = d.angle_gain_rad_per_s2_per_g;
+  j(kTheta, kOmega) = 1;
+  j(kOmega, kTheta) = -wp * wp;
+  j(kOmega, kOmega) = -2 * d.pendulum_damping_ratio * wp;
+  for (int c : {kTheta, kLead, kIntegral}) j(kOmega, c) += -b * dtorque * di[c];
+  // Lead: L' = w_l (G theta - L).
+  j(kLead, kTheta) = wl * g;
+  j(kLead, kLead) = -wl;
+  if (wi > 0) j(kIntegral, kTheta) = k * g, j(kIntegral, kLead) = 1 - k;  // I' = y
+  // The output before the filter: i + C_output(a) + F_output(z).
+  const double dout = 1 + (has_out_ia_ ? f_ia_slope(Location::output, z) * dz : 0.0);
+  if (d.antialias_Hz > 0) {
+    const double wa = 2 * kPi * d.antialias_Hz;
+    j(kAA1, kAA2) = 1;
+    for (int c : {kTheta, kLead, kIntegral}) j(kAA2, c) = wa * wa * dout * di[c];
+    j(kAA2, kAA1) = -wa * wa;
+    j(kAA2, kAA2) = -std::numbers::sqrt2 * wa;
+    j(kQuadrature, kAA1) = 1;
+  } else {
+    for (int c : {kTheta, kLead, kIntegral}) j(kQuadrature, c) = dout * di[c];
+  }
 }
 
 double Accelerometer::output_g(double t, const double* x) const {
@@ -441,6 +517,7 @@ double settled_output_g(const PlantConfig& config, const Vec3& a_g, double rtol)
   const double tau = plant.slowest_time_constant_s(plant.linearise());
   SolverSettings s;
   s.relative_tolerance = rtol;
+  s.analytic_jacobian = false;  // CVODE's quotients, as before (the static answers bit for bit)
   const double amplitude = std::max(1.0, a_g.norm());
   for (double scale : plant.state_scale()) s.absolute_tolerance.push_back(rtol * 1e-3 * amplitude * scale);
   OdeSolver ode(plant, 0.0, std::vector<double>(static_cast<std::size_t>(plant.size()), 0.0), s);

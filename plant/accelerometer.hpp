@@ -87,6 +87,12 @@ class Accelerometer final : public OdeSystem {
 
   int size() const override { return n_; }
   void rhs(double t, const double* x, double* dx) const override;
+  // The analytic Jacobian d(rhs)/dx (the loop, model (1)'s IA terms through m_il^-1, the
+  // torquer polynomial, the anti-alias filter; the input and the cross terms do not depend on
+  // the state). Effects have no derivative hooks: with any effect has_jacobian() is false
+  // and CVODE forms the Jacobian by its column-wise difference quotients, as before.
+  bool has_jacobian() const override { return config_.effects.empty(); }
+  void jacobian(double t, const double* x, double* j) const override;
 
   // Normalised output U/K1 (g) at state x and time t (after the anti-alias filter if on).
   double output_g(double t, const double* x) const;
@@ -117,8 +123,14 @@ class Accelerometer final : public OdeSystem {
   const Vec3& static_g() const { return a_static_; }
 
  private:
-  double evaluate(const Vec3& a_case, const double* x, double* dx) const;  // rhs; returns the output
+  // rhs; returns the output. fast_z: solve_z's fast variant (rhs_output only).
+  double evaluate(const Vec3& a_case, const double* x, double* dx, bool fast_z = false) const;
   double solve_z(double i) const;  // m_il^-1
+  // m_il^-1 from the inverse's second-order series i - F(i) + F'(i) F(i), stopped when the next
+  // Newton step is bounded below the rounding (|F''| dz^2): the same root to the last ulp or
+  // two, one Newton step instead of three for model (1)'s small terms. Not used where the plant
+  // is linearised by difference quotients (an ulp there is amplified; docs/performance.md).
+  double solve_z_fast(double i) const;
   double f_ia(Location l, double z) const;
   double f_ia_slope(Location l, double z) const;
   double cross(Location l, const Vec3& a) const;
@@ -128,6 +140,7 @@ class Accelerometer final : public OdeSystem {
   Vec3 a_static_;
   Input input_;
   Servo servo_;
+  double lead_ratio_ = 1.0;  // servo_.lead_pole_rad_per_s / servo_.lead_zero_rad_per_s
   int n_;
   std::vector<int> effect_offset_;
   double q_ref_ = 0.0;
@@ -141,6 +154,7 @@ class Accelerometer final : public OdeSystem {
   };
   std::array<NewtonTerm, 5> newton_terms_{};
   int n_newton_terms_ = 0;
+  bool newton_smooth_ = true;  // no k1_asym among them (|z| has no curvature bound at 0)
 };
 
 // The plant run statically: from rest with every state zero (the instrument switched on in

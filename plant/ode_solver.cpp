@@ -130,7 +130,7 @@ OdeSolver::OdeSolver(const OdeSystem& system, double t0, const std::vector<doubl
   m.ls = SUNLinSol_Dense(m.y, m.a, m.ctx);
   if (!m.a || !m.ls) throw SolverError("SUNLinSol_Dense", 0, t0, "allocation failed");
   m.check(CVodeSetLinearSolver(m.mem, m.ls, m.a), "CVodeSetLinearSolver", t0);
-  if (system.has_jacobian()) m.check(CVodeSetJacFn(m.mem, &Impl::jac), "CVodeSetJacFn", t0);
+  if (s.analytic_jacobian && system.has_jacobian()) m.check(CVodeSetJacFn(m.mem, &Impl::jac), "CVodeSetJacFn", t0);
   m.check(CVodeSetMaxNumSteps(m.mem, s.max_steps), "CVodeSetMaxNumSteps", t0);
   if (s.max_step_s > 0) m.check(CVodeSetMaxStep(m.mem, s.max_step_s), "CVodeSetMaxStep", t0);
 }

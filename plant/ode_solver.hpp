@@ -35,6 +35,9 @@ struct SolverSettings {
   std::vector<double> absolute_tolerance;  // one per state
   double max_step_s = 0.0;                 // 0: no limit
   long max_steps = 50'000'000;
+  // Give CVODE the system's own Jacobian when it has one (OdeSystem::has_jacobian); false:
+  // CVODE's difference quotients always (a check of the analytic one).
+  bool analytic_jacobian = true;
   bool IsValid(std::string* error) const;
 };
 

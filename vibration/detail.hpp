@@ -1,7 +1,13 @@
 #pragma once
 // vibration/detail.hpp -- helpers internal to the vibration stage (not part of its API).
+#include <array>
+#include <cstddef>
+#include <cstdint>
 #include <sstream>
 #include <string>
+#include <vector>
+
+#include "vibration/random.hpp"
 
 namespace vrelab::vibration::detail {
 
@@ -12,5 +18,15 @@ inline std::string num(double x, int precision = 6) {
   s << x;
   return s.str();
 }
+
+// The phases of a random block (random.hpp): phase[a][k] = 2 pi u for the bins k = 1 .. kmax
+// (phase[a][0] unused), u = (top 53 bits of an std::mt19937_64 draw) / 2^53, the engine seeded
+// by std::seed_seq{seed lo, seed hi, block lo, block hi}; axis by axis in the order x, y, z,
+// whatever the levels, so the draw sequence depends only on (seed, block, kmax). With common
+// coupling the y and z axes copy x's phases. The one draw both random_phase_block and
+// RandomExcitation's block synthesiser use (their blocks are bit-identical). phase's vectors
+// are resized (their storage reused between calls).
+void draw_block_phases(AxisCoupling coupling, std::uint64_t seed, std::int64_t block_index, std::size_t kmax,
+                       std::array<std::vector<double>, 3>& phase);
 
 }  // namespace vrelab::vibration::detail

@@ -86,6 +86,23 @@ double unit_uniform(std::mt19937_64& e) { return static_cast<double>(e() >> 11) 
 
 }  // namespace
 
+void detail::draw_block_phases(AxisCoupling coupling, std::uint64_t seed, std::int64_t block_index, std::size_t kmax,
+                               std::array<std::vector<double>, 3>& phase) {
+  const auto b = static_cast<std::uint64_t>(block_index);
+  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                    static_cast<std::uint32_t>(b), static_cast<std::uint32_t>(b >> 32)};
+  std::mt19937_64 engine(seq);
+  for (int a = 0; a < 3; ++a) {
+    if (a > 0 && coupling == AxisCoupling::common) {
+      phase[a] = phase[0];
+      continue;
+    }
+    phase[a].resize(kmax + 1);
+    phase[a][0] = 0.0;
+    for (std::size_t k = 1; k <= kmax; ++k) phase[a][k] = 2 * std::numbers::pi * unit_uniform(engine);
+  }
+}
+
 Eigen::Matrix3cd CrossSpectralMatrix::at(double f) const {
   if (frequency_Hz.empty() || !(resolution_Hz > 0)) return Eigen::Matrix3cd::Zero();
   // Bin k covers [f_k - res/2, f_k + res/2]: k = ceil((f - f_0) / res - 1/2), the lower at an edge.
@@ -157,22 +174,11 @@ SampledSignal random_phase_block(const RandomProfile& p, std::size_t length, dou
   const int n = fft_length(length, "block length");
   const std::size_t nbins = length / 2 + 1;
 
-  const auto b = static_cast<std::uint64_t>(block_index);
-  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
-                    static_cast<std::uint32_t>(b), static_cast<std::uint32_t>(b >> 32)};
-  std::mt19937_64 engine(seq);
   // Bins 0 < k < N/2 carry power; phases are drawn for all of them (whatever the levels) so
   // the draw sequence depends only on (seed, block, N).
   const std::size_t kmax = (length - 1) / 2;  // last k with 2k < N
   std::array<std::vector<double>, 3> phase;
-  for (int a = 0; a < 3; ++a) {
-    if (a > 0 && p.coupling == AxisCoupling::common) {
-      phase[a] = phase[0];
-      continue;
-    }
-    phase[a].resize(kmax + 1);
-    for (std::size_t k = 1; k <= kmax; ++k) phase[a][k] = 2 * std::numbers::pi * unit_uniform(engine);
-  }
+  detail::draw_block_phases(p.coupling, seed, block_index, kmax, phase);
 
   SampledSignal out;
   out.sample_rate_Hz = fs;
@@ -188,8 +194,10 @@ SampledSignal random_phase_block(const RandomProfile& p, std::size_t length, dou
       const double g = psd_g2_per_Hz(psd, static_cast<double>(k) * fs / static_cast<double>(length));
       if (g == 0.0) continue;
       const double amp = std::sqrt(g * fs / (2.0 * static_cast<double>(length)));
-      spec[k][0] = amp * std::cos(phase[a][k]);
-      spec[k][1] = amp * std::sin(phase[a][k]);
+      double sn, cs;
+      ::sincos(phase[a][k], &sn, &cs);  // glibc: the same numbers as std::sin and std::cos
+      spec[k][0] = amp * cs;
+      spec[k][1] = amp * sn;
     }
     fftw_execute_dft_c2r(plan.get(), spec.get(), sig.get());
     std::copy(sig.get(), sig.get() + length, out.samples_g[a].begin());

@@ -9,7 +9,6 @@
 #include <limits>
 #include <new>
 #include <numbers>
-#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <utility>
@@ -170,8 +169,9 @@ namespace {
 // with what does not depend on j made once: the amplitude of every bin (the PSD's log-log
 // interpolation, a pow and a log per bin), the FFTW plan (FFTW_ESTIMATE, as random_phase_block
 // plans it; an FFTW plan gives the same numbers for the same size and flags) and its aligned
-// buffers. The phases are drawn and turned into the spectrum exactly as random_phase_block
-// does (test RandomExcitation.BlocksEqualRandomPhaseBlock checks the equality).
+// buffers. The phases are drawn by the same function (detail::draw_block_phases) and turned
+// into the spectrum exactly as random_phase_block does (test
+// RandomExcitation.BlocksEqualRandomPhaseBlockBitForBit checks the equality).
 class BlockSynthesiser {
  public:
   BlockSynthesiser(const RandomProfile& p, double fs, std::uint64_t seed, std::size_t m)
@@ -204,21 +204,7 @@ class BlockSynthesiser {
   BlockSynthesiser& operator=(const BlockSynthesiser&) = delete;
 
   SampledSignal block(double fs, std::int64_t block_index) {
-    const auto b = static_cast<std::uint64_t>(block_index);
-    std::seed_seq seq{static_cast<std::uint32_t>(seed_), static_cast<std::uint32_t>(seed_ >> 32),
-                      static_cast<std::uint32_t>(b), static_cast<std::uint32_t>(b >> 32)};
-    std::mt19937_64 engine(seq);
-    std::array<std::vector<double>, 3> phase;
-    for (int a = 0; a < 3; ++a) {
-      if (a > 0 && profile_.coupling == AxisCoupling::common) {
-        phase[a] = phase[0];
-        continue;
-      }
-      phase[a].resize(kmax_ + 1);
-      // Uniform in [0, 1) from the top 53 bits (random.cpp's unit_uniform).
-      for (std::size_t k = 1; k <= kmax_; ++k)
-        phase[a][k] = 2 * std::numbers::pi * (static_cast<double>(engine() >> 11) * 0x1p-53);
-    }
+    detail::draw_block_phases(profile_.coupling, seed_, block_index, kmax_, phase_);
     SampledSignal out;
     out.sample_rate_Hz = fs;
     const std::size_t nbins = m_ / 2 + 1;
@@ -228,8 +214,10 @@ class BlockSynthesiser {
       for (std::size_t k = 0; k < nbins; ++k) spec_[k][0] = spec_[k][1] = 0.0;
       for (std::size_t i = 0; i < bins_[a].size(); ++i) {
         const std::size_t k = bins_[a][i];
-        spec_[k][0] = amp_[a][i] * std::cos(phase[a][k]);
-        spec_[k][1] = amp_[a][i] * std::sin(phase[a][k]);
+        double sn, cs;
+        ::sincos(phase_[a][k], &sn, &cs);  // glibc: the same numbers as std::sin and std::cos
+        spec_[k][0] = amp_[a][i] * cs;
+        spec_[k][1] = amp_[a][i] * sn;
       }
       fftw_execute_dft_c2r(plan_, spec_, sig_);
       std::copy(sig_, sig_ + m_, out.samples_g[a].begin());
@@ -238,7 +226,7 @@ class BlockSynthesiser {
   }
   std::size_t bytes() const {
     std::size_t n = sizeof(fftw_complex) * (m_ / 2 + 1) + sizeof(double) * m_;
-    for (int a = 0; a < 3; ++a) n += bins_[a].size() * (sizeof(std::size_t) + sizeof(double));
+    for (int a = 0; a < 3; ++a) n += bins_[a].size() * (sizeof(std::size_t) + sizeof(double)) + phase_[a].capacity() * sizeof(double);
     return n;
   }
 
@@ -257,6 +245,7 @@ class BlockSynthesiser {
   std::size_t m_, kmax_;
   std::array<std::vector<std::size_t>, 3> bins_;  // bins with power, per axis
   std::array<std::vector<double>, 3> amp_;        // their amplitudes
+  std::array<std::vector<double>, 3> phase_;      // the block's phases (storage reused)
   fftw_complex* spec_ = nullptr;
   double* sig_ = nullptr;
   fftw_plan plan_ = nullptr;

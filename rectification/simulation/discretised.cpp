@@ -117,11 +117,11 @@ struct DiscretisedRandomPlant::Coefficients {
     if (first != std::numeric_limits<std::int64_t>::min() && lo >= first && hi < first + kLength) return;
     core::throw_if_cancelled();  // a caller's cancel flag (core/cancel.hpp), every 8192 knots
     first = lo;
-    const vibration::SampledSignal s = ex.samples(first - kMargin, static_cast<std::size_t>(kLength + 2 * kMargin));
+    vibration::SampledSignal s = ex.samples(first - kMargin, static_cast<std::size_t>(kLength + 2 * kMargin));
     const std::size_t k = axes.size();
-    c.assign(static_cast<std::size_t>(kLength) * k, 0.0);
+    c.resize(static_cast<std::size_t>(kLength) * k);  // every element written below
     for (std::size_t a = 0; a < k; ++a) {
-      std::vector<double> v = s.samples_g[static_cast<std::size_t>(axes[a])];
+      std::vector<double>& v = s.samples_g[static_cast<std::size_t>(axes[a])];  // prefiltered in place
       vibration::quintic_prefilter(v);
       for (std::int64_t i = 0; i < kLength; ++i)
         c[static_cast<std::size_t>(i) * k + a] = v[static_cast<std::size_t>(i + kMargin)];
