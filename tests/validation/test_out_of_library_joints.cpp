@@ -9,6 +9,7 @@
 #include <numbers>
 
 #include "plant/effects/fixture_rattle.hpp"
+#include "plant/effects/proof_mass_torsion.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/instrument.hpp"
 
@@ -111,6 +112,30 @@ TEST(OutOfLibraryJoints, FixtureRattleHasAThresholdThatMovesWithTheStaticOrienta
   EXPECT_GT(std::abs(change_g(quad, joint, Vec3(-1, 0, 1).normalized(), sine(Vec3(A, 0, 0), f))), 50 * bound);
   EXPECT_THROW(plant::FixtureRattle(Vec3::Zero(), 2.0), std::invalid_argument);
   EXPECT_THROW(plant::FixtureRattle(Vec3::UnitX(), -1.0), std::invalid_argument);
+}
+
+// The proof mass's torsion on the linear instrument, 4 g along OA with a_OA0 = 0.71 g: the
+// pendulum feels a_IA cos psi + a_OA sin psi, whose mean change from rest is
+// kappa A^2 Re H / 2 (H = 1 / (1 - r^2 + 2 j zeta r), r = f / 600 Hz) from a_OA psi, less
+// a_IA0 <psi_dyn^2> / 2 = a_IA0 kappa^2 A^2 |H|^2 / 4 from cos psi (1.1e-9 g at the mode, where
+// Re H = 0 and |H| = 10), through the loop's DC gain (1 - 8e-10). The next terms are
+// a_OA psi^3 / 6 ~ 1e-13 g. Tolerance 1e-3 relative + 1e-11 g: a wrong sign of the turn or of
+// H's real part misses by 100 % or more. Checked at and across the mode (400, 600, 800 Hz:
+// Re H = 1.8, 0, -1.28).
+TEST(OutOfLibraryJoints, ProofMassTorsionRectifiesKappaTimesReHAlongOa) {
+  constexpr double kappa = 2e-6, A = 4;
+  const auto twist = std::make_shared<plant::ProofMassTorsion>(kappa);
+  const Vec3 g = Vec3(1, 0, 1).normalized();
+  for (double f : {400.0, 600.0, 800.0}) {
+    const double r = f / 600;
+    const double re_h = (1 - r * r) / ((1 - r * r) * (1 - r * r) + (2 * 0.05 * r) * (2 * 0.05 * r));
+    const double h2 = 1 / ((1 - r * r) * (1 - r * r) + (2 * 0.05 * r) * (2 * 0.05 * r));
+    const double expected = kappa * A * A / 2 * re_h - g[0] * kappa * kappa * A * A * h2 / 4;
+    EXPECT_NEAR(change_g(test::paper_like_linear_plant(), twist, g, sine(Vec3(0, 0, A), f)), expected,
+                1e-3 * std::abs(expected) + 1e-11)
+        << f << " Hz";
+  }
+  EXPECT_THROW(plant::ProofMassTorsion(1e-6, 0), std::invalid_argument);
 }
 
 }  // namespace
