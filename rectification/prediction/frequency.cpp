@@ -274,12 +274,19 @@ PeriodicInput film_harmonic_balance(const PlantConfig& with_films, const PlantCo
     }
     return F;
   };
-  // Newton from the describing function (R = 0), slopes by forward differences, a halved step
-  // while |F| does not fall.
+  // From the describing function (R = 0): the plain iteration R <- R(theta(R)) first (the
+  // linearised loop already carries the film's fundamental damping, so it contracts fast away
+  // from contact: one residual a step); where it does not, Newton, slopes by forward
+  // differences, a halved step while |F| does not fall.
   // g: the size of the film's fundamental, c_lin |theta_1| w / b, for steps and tolerances.
   const double scale = std::max(std::abs(c_lin) * std::abs(theta_table[1]) * w / b, 1e-12);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(2 * K);
   Eigen::VectorXd F = residual(x);
+  for (int it = 0; it < 30 && F.norm() > 1e-12 * scale; ++it) {
+    const Eigen::VectorXd xn = x + F, Fn = residual(xn);
+    if (!(Fn.norm() < 0.5 * F.norm())) break;  // not contracting well: Newton from here
+    x = xn, F = Fn;
+  }
   for (int it = 0; it < 50 && F.norm() > 1e-12 * scale; ++it) {
     Eigen::MatrixXd J(2 * K, 2 * K);
     const double step = 1e-7 * scale;
