@@ -15,7 +15,8 @@ SqueezeFilmDamping::SqueezeFilmDamping(double gap, double c0, double b) : gap_ra
 
 double SqueezeFilmDamping::extra_input_g(double theta, double omega, double, const Vec3&) const {
   const double x = std::min(std::abs(theta) / gap_rad_, 0.95);
-  const double factor = 1 / std::pow(1 - x * x, 1.5) - 1;
+  const double y = 1 - x * x;
+  const double factor = 1 / (y * std::sqrt(y)) - 1;  // (1 - x^2)^(-3/2)
   return -c0_ * factor * omega / b_;  // the plant multiplies by b
 }
 

@@ -211,7 +211,110 @@ FrequencyPrediction PreparedSineRectification::operator()(const Coefficients& co
 }
 
 bool PeriodicInput::single_tone() const {
-  return mean_g.isZero(0.0) && tones.size() == 1 && tones.front().first == 1;
+  return mean_g.isZero(0.0) && tones.size() == 1 && tones.front().first == 1 && loop.empty();
+}
+
+PeriodicInput film_harmonic_balance(const PlantConfig& with_films, const PlantConfig& linearised, const PeriodicInput& in,
+                                    const ResponseAt& response) {
+  std::vector<const Effect*> films;
+  for (const auto& e : with_films.effects)
+    if (e->amplitude_dependent_damping()) films.push_back(e.get());
+  if (films.empty() || in.tones.empty()) return in;
+  const Dynamics& d0 = with_films.dynamics;
+  const double b = d0.angle_gain_rad_per_s2_per_g;
+  const double wp = 2 * std::numbers::pi * d0.pendulum_frequency_Hz;
+  // The damping the linearised loop already has beyond the nominal (1/s): taken back out of R.
+  const double c_lin = (linearised.dynamics.pendulum_damping_ratio - d0.pendulum_damping_ratio) * 2 * wp;
+  const double w = 2 * std::numbers::pi * in.frequency_Hz;
+  const bool odd = std::all_of(in.tones.begin(), in.tones.end(), [](const auto& t) { return t.first % 2 == 1; });
+  std::vector<int> hs;
+  for (int h = 1; h <= kFilmHarmonics; h += odd ? 2 : 1) hs.push_back(h);
+  const int K = static_cast<int>(hs.size());
+  // The table's angle per harmonic, and the loop's angle and current per g along IA.
+  std::vector<std::complex<double>> theta_table(static_cast<std::size_t>(kFilmHarmonics + 1)), A(theta_table.size()),
+      C(theta_table.size());
+  for (const auto& [h, W] : in.tones) {
+    if (h > kFilmHarmonics) continue;
+    const LoopResponse r = response(h * in.frequency_Hz);
+    for (int j = 0; j < 3; ++j) theta_table[static_cast<std::size_t>(h)] += r.angle_rad[static_cast<std::size_t>(j)] * W[j];
+  }
+  for (int h : hs) {
+    const LoopResponse r = response(h * in.frequency_Hz);
+    A[static_cast<std::size_t>(h)] = r.angle_rad[IA];
+    C[static_cast<std::size_t>(h)] = r.current[IA];
+  }
+  // e^{j h phi_k} on the period's points.
+  std::vector<std::complex<double>> ph(static_cast<std::size_t>(kFilmPoints * K));
+  for (int k = 0; k < kFilmPoints; ++k)
+    for (int i = 0; i < K; ++i)
+      ph[static_cast<std::size_t>(k * K + i)] = std::polar(1.0, hs[static_cast<std::size_t>(i)] * 2 * std::numbers::pi * k / kFilmPoints);
+  // x: the real and imaginary parts of R_h (g). F(x) = R(theta(x))_h - x.
+  const auto residual = [&](const Eigen::VectorXd& x) {
+    std::vector<std::complex<double>> th(static_cast<std::size_t>(K));
+    for (int i = 0; i < K; ++i) {
+      const auto h = static_cast<std::size_t>(hs[static_cast<std::size_t>(i)]);
+      th[static_cast<std::size_t>(i)] = theta_table[h] + A[h] * std::complex<double>(x[2 * i], x[2 * i + 1]);
+    }
+    std::vector<std::complex<double>> R(static_cast<std::size_t>(K));
+    for (int k = 0; k < kFilmPoints; ++k) {
+      double theta = 0, rate = 0;
+      for (int i = 0; i < K; ++i) {
+        const std::complex<double> z = th[static_cast<std::size_t>(i)] * ph[static_cast<std::size_t>(k * K + i)];
+        theta += z.imag(), rate += hs[static_cast<std::size_t>(i)] * w * z.real();  // d/dt Im(Th e^{jh w t})
+      }
+      double r = c_lin * rate / b;
+      for (const Effect* f : films) r += f->extra_input_g(theta, rate, 0.0, Vec3::Zero());
+      // Im(R_h e^{j h phi}) resolved: R_h = (2 / N) sum r e^{-j h phi} times j.
+      for (int i = 0; i < K; ++i) R[static_cast<std::size_t>(i)] += r * std::conj(ph[static_cast<std::size_t>(k * K + i)]);
+    }
+    Eigen::VectorXd F(2 * K);
+    for (int i = 0; i < K; ++i) {
+      const std::complex<double> Rh = std::complex<double>(0, 2.0 / kFilmPoints) * R[static_cast<std::size_t>(i)];
+      F[2 * i] = Rh.real() - x[2 * i], F[2 * i + 1] = Rh.imag() - x[2 * i + 1];
+    }
+    return F;
+  };
+  // From the describing function (R = 0): the plain iteration R <- R(theta(R)) first (the
+  // linearised loop already carries the film's fundamental damping, so it contracts fast away
+  // from contact: one residual a step); where it does not, Newton, slopes by forward
+  // differences, a halved step while |F| does not fall.
+  // g: the size of the film's fundamental, c_lin |theta_1| w / b, for steps and tolerances.
+  const double scale = std::max(std::abs(c_lin) * std::abs(theta_table[1]) * w / b, 1e-12);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(2 * K);
+  Eigen::VectorXd F = residual(x);
+  for (int it = 0; it < 30 && F.norm() > 1e-12 * scale; ++it) {
+    const Eigen::VectorXd xn = x + F, Fn = residual(xn);
+    if (!(Fn.norm() < 0.5 * F.norm())) break;  // not contracting well: Newton from here
+    x = xn, F = Fn;
+  }
+  for (int it = 0; it < 50 && F.norm() > 1e-12 * scale; ++it) {
+    Eigen::MatrixXd J(2 * K, 2 * K);
+    const double step = 1e-7 * scale;
+    for (int c = 0; c < 2 * K; ++c) {
+      Eigen::VectorXd xp = x;
+      xp[c] += step;
+      J.col(c) = (residual(xp) - F) / step;
+    }
+    const Eigen::VectorXd dx = J.partialPivLu().solve(-F);
+    double t = 1;
+    Eigen::VectorXd xn = x + dx, Fn = residual(xn);
+    while (Fn.norm() >= F.norm() && t > 1e-3) {
+      t /= 2;
+      xn = x + t * dx, Fn = residual(xn);
+    }
+    if (Fn.norm() >= F.norm()) break;  // no further progress: at the sampling's rounding
+    x = xn, F = Fn;
+  }
+  if (!(F.norm() <= 1e-6 * scale))
+    throw std::runtime_error("film_harmonic_balance: the squeeze film's harmonic balance did not converge at " +
+                             std::to_string(in.frequency_Hz) + " Hz");
+  PeriodicInput out = in;
+  for (int i = 0; i < K; ++i) {
+    const auto h = static_cast<std::size_t>(hs[static_cast<std::size_t>(i)]);
+    const std::complex<double> Rh(x[2 * i], x[2 * i + 1]);
+    out.loop.push_back({hs[static_cast<std::size_t>(i)], C[h] * Rh, A[h] * Rh});
+  }
+  return out;
 }
 
 PeriodicInput periodic_input(const vibration::SineVibration& v) {
@@ -336,6 +439,14 @@ PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& 
       x.Theta += r.angle_rad[sj] * W[j];
     }
     hs_.push_back(x);
+  }
+  for (const PeriodicInput::LoopTone& l : in.loop) {  // inside the loop: the current and angle only
+    auto it = std::find_if(hs_.begin(), hs_.end(), [&l](const Harmonic& x) { return x.h == l.h; });
+    if (it == hs_.end()) {
+      hs_.push_back({l.h, Eigen::Vector3cd::Zero(), 0.0, 0.0});
+      it = hs_.end() - 1;
+    }
+    it->I += l.current_g, it->Theta += l.angle_rad;
   }
   FrequencyPrediction& out = fixed_;
   out.loop_dc_gain = dc_gain;

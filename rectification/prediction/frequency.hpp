@@ -108,7 +108,14 @@ struct PeriodicInput {
   double frequency_Hz = 0;
   Vec3 mean_g = Vec3::Zero();
   std::vector<std::pair<int, Eigen::Vector3cd>> tones;  // (h >= 1, W_h)
-  bool single_tone() const;  // one tone at h = 1 and no mean
+  // What a disturbance inside the loop adds (a squeeze film's torque, film_harmonic_balance):
+  // per harmonic h >= 1 the current and the angle, on top of the table tones' response.
+  struct LoopTone {
+    int h = 1;
+    std::complex<double> current_g, angle_rad;
+  };
+  std::vector<LoopTone> loop;
+  bool single_tone() const;  // one tone at h = 1, no mean, nothing inside the loop
 };
 PeriodicInput periodic_input(const vibration::SineVibration& v);  // exact
 // One period of `e` (which must repeat with 1 / frequency_Hz) sampled on 64 points and
@@ -131,6 +138,22 @@ using ResponseAt = std::function<LoopResponse(double frequency_Hz)>;
 FrequencyPrediction periodic_rectification(const plant::PlantConfig& plant, const Vec3& a_static_g,
                                            const PeriodicInput& input, const ResponseAt& response,
                                            bool allow_closed_form = true);
+
+// The squeeze film by harmonic balance. `linearised` is amplitude_linearised(with_films, ...):
+// the films replaced by their describing function, a damping the loop responses `response`
+// are for. The film's torque is not sinusoidal near contact (c(theta) theta' with c rising
+// as 1 / (1 - x^2)^(3/2)): its remainder beyond that linear damping,
+//   R(t) = sum_films extra_input_g(theta(t), theta'(t)) + (zeta_lin - zeta_0) 2 w_p theta'(t) / b,
+// enters the pendulum like an input along IA, so theta_h = theta_table_h + A(h f) R_h and the
+// current I_h = I_table_h + C(h f) R_h (A, C: the linearised loop's angle and current per g
+// along IA). Solved for the harmonics R_h, h = 1..kFilmHarmonics (odd only when the table's
+// tones are odd: the film, even in theta, then makes odd harmonics only), by Newton's method on
+// R = R(theta(R)), each R_h from kFilmPoints samples of one period; returned as `in` with the
+// film's part in `loop`, which periodic_rectification then averages with the table's tones.
+// The describing function alone is this with R_h = 0. Without a film `in` is returned as it is.
+inline constexpr int kFilmHarmonics = 31, kFilmPoints = 256;
+PeriodicInput film_harmonic_balance(const plant::PlantConfig& with_films, const plant::PlantConfig& linearised,
+                                    const PeriodicInput& in, const ResponseAt& response);
 
 // The same two predictions split in two (for a caller that varies the coefficients only, such
 // as a prediction's gradient in them): what does not depend on the coefficients (the vibration

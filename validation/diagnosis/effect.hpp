@@ -117,6 +117,12 @@ struct Effect {
   bool in_library = true;         // false: only the virtual lab knows it (diagnose must call it unexplained)
   int rank = 1000;                // the registry's order (the diagnosis' order: ties, output); a new effect takes the next
   bool changes_dynamics = false;  // the loop's linear response depends on the parameter
+  // The hypothesis' own accuracy: the relative error of the change it predicts against the
+  // ODE with the truth (tests/validation/test_effect_sweep.cpp bounds it at 1 % over the band
+  // and the drawn range; the squeeze film's harmonic balance 2 %,
+  // test_squeeze_film_harmonic_balance.cpp). A fitted parameter's reported sigma adds what
+  // that error, run by run, moves the fit (diagnose.cpp, EffectFitter::add_model_error).
+  double model_accuracy = 0.01;
   // Acts at rest too (linear effects only): the static test took up part of it into the
   // identified coefficients; diagnose gives that part back (docs/diagnose.md).
   bool acts_at_rest = false;
