@@ -243,11 +243,13 @@ PeriodicInput film_harmonic_balance(const PlantConfig& with_films, const PlantCo
     A[static_cast<std::size_t>(h)] = r.angle_rad[IA];
     C[static_cast<std::size_t>(h)] = r.current[IA];
   }
-  // e^{j h phi_k} on the period's points.
+  // e^{j h phi_k} on the period's points: e^{j 2 pi (h k mod N) / N}, from one table of N.
+  std::vector<std::complex<double>> unit(static_cast<std::size_t>(kFilmPoints));
+  for (int k = 0; k < kFilmPoints; ++k) unit[static_cast<std::size_t>(k)] = std::polar(1.0, 2 * std::numbers::pi * k / kFilmPoints);
   std::vector<std::complex<double>> ph(static_cast<std::size_t>(kFilmPoints * K));
   for (int k = 0; k < kFilmPoints; ++k)
     for (int i = 0; i < K; ++i)
-      ph[static_cast<std::size_t>(k * K + i)] = std::polar(1.0, hs[static_cast<std::size_t>(i)] * 2 * std::numbers::pi * k / kFilmPoints);
+      ph[static_cast<std::size_t>(k * K + i)] = unit[static_cast<std::size_t>((hs[static_cast<std::size_t>(i)] * k) % kFilmPoints)];
   // x: the real and imaginary parts of R_h (g). F(x) = R(theta(x))_h - x.
   const auto residual = [&](const Eigen::VectorXd& x) {
     std::vector<std::complex<double>> th(static_cast<std::size_t>(K));
