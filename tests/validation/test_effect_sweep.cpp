@@ -209,7 +209,7 @@ void sweep(const std::vector<double>& frequencies, bool whole_range) {
           if (f == frequencies.front()) id = identified(e, values);
           x = compare(e, values, id, f, ode_without);
         } catch (const std::invalid_argument& why) {
-          // A grid end the plant cannot be (servo_phase_margin's +32 deg needs more phase lead
+          // A grid end the plant cannot be (servo_dynamics' margin +32 deg needs more phase lead
           // than one network gives): the fit skips it too. Never a drawn value.
           EXPECT_TRUE(whole_range) << e.name << " = " << p << ": " << why.what();
           std::printf("  %-28s %g: no such plant (%s)\n", e.name.c_str(), p, why.what());

@@ -129,7 +129,7 @@ TEST(NuisanceTransport, BlindResultLineCarriesTheVerdictAmbiguityAndNuisances) {
   k.called = "clean", k.top = "pickoff_nonlinearity";
   Diagnosis& d = k.diagnosis;
   d.verdict = "no significant gap (sigma understated x2.21;\tjudged with the corrected sigma)";
-  d.ambiguous_with = {"servo_dynamics", "servo_phase_margin"};
+  d.ambiguous_with = {"servo_dynamics", "nonlinearity_at_input"};
   EffectFit e;
   e.name = "pickoff_nonlinearity", e.value = 0.125;
   d.effects = {e};
