@@ -272,14 +272,17 @@ double Accelerometer::solve_z_fast(double i) const {
   for (int it = 0; it < 30; ++it) {
     sums(z, &f, &sl, &c);
     const double d = 1 + sl;
+    // Far from the near-linear regime (the map not monotone here, or a non-finite step): the
+    // full solver, which starts from i and damps nothing either but is the reference path.
+    if (!(d > 0) || !std::isfinite(z)) return solve_z(i);
     const double dz = (z + f - i) / d;
     z -= dz;
     // Newton's next step is ~ F'' dz^2 / (2 F'); |F''| over [z - dz, z] is within twice c for
     // |dz| << |z| (the terms are polynomials of degree <= 4): stop when that is below the
     // rounding of z, or on solve_z's own criterion.
-    if (std::abs(dz) <= 1e-16 * (1 + std::abs(z)) || 2 * c * dz * dz <= 1e-17 * (1 + std::abs(z)) * std::abs(d)) break;
+    if (std::abs(dz) <= 1e-16 * (1 + std::abs(z)) || 2 * c * dz * dz <= 1e-17 * (1 + std::abs(z)) * std::abs(d)) return z;
   }
-  return z;
+  return solve_z(i);  // not converged in 30 steps: the reference path
 }
 
 double Accelerometer::readout(double i, const Vec3& a) const {

@@ -238,10 +238,13 @@ PeriodicInput film_harmonic_balance(const PlantConfig& with_films, const PlantCo
     const LoopResponse r = response(h * in.frequency_Hz);
     for (int j = 0; j < 3; ++j) theta_table[static_cast<std::size_t>(h)] += r.angle_rad[static_cast<std::size_t>(j)] * W[j];
   }
+  // The film's torque acts at the pendulum, after any mechanical mode: its responses are the
+  // case's per g divided by the modes' transmissibility along IA.
   for (int h : hs) {
     const LoopResponse r = response(h * in.frequency_Hz);
-    A[static_cast<std::size_t>(h)] = r.angle_rad[IA];
-    C[static_cast<std::size_t>(h)] = r.current[IA];
+    const std::complex<double> t = r.mechanical[IA];
+    A[static_cast<std::size_t>(h)] = r.angle_rad[IA] / t;
+    C[static_cast<std::size_t>(h)] = r.current[IA] / t;
   }
   // e^{j h phi_k} on the period's points: e^{j 2 pi (h k mod N) / N}, from one table of N.
   std::vector<std::complex<double>> unit(static_cast<std::size_t>(kFilmPoints));
@@ -308,7 +311,8 @@ PeriodicInput film_harmonic_balance(const PlantConfig& with_films, const PlantCo
     x = xn, F = Fn;
   }
   if (!(F.norm() <= 1e-6 * scale))
-    throw std::runtime_error("film_harmonic_balance: the squeeze film's harmonic balance did not converge at " +
+    // invalid_argument: a hypothesis' value the prediction cannot make (the fit leaves it out).
+    throw std::invalid_argument("film_harmonic_balance: the squeeze film's harmonic balance did not converge at " +
                              std::to_string(in.frequency_Hz) + " Hz");
   PeriodicInput out = in;
   for (int i = 0; i < K; ++i) {

@@ -101,10 +101,10 @@ check "predict under mpirun prints one report" test "$(grep -c '^vrelab ' "$tmp/
 
 blind_part() {
 # ---- blind: 2 campaigns (both clean: the cheapest).
-# Over a campaigns.txt left by another seed: said on stderr, none of its lines read back (the
-# rows below must still equal the MPI run's).
+# Over a campaigns.txt left by another seed (its line's checksum right): said on stderr, none
+# of its lines read back (the rows below must still equal the MPI run's).
 mkdir -p "$tmp/blind-threads"
-printf '# vrelab blind: another seed\n0\tforged\t00000000\n' >"$tmp/blind-threads/campaigns.txt"
+printf '# vrelab blind: another seed\n0\tforged\t3ef6ef83\n' >"$tmp/blind-threads/campaigns.txt"
 expect 0 'another seed, settings or program build; its campaigns are not read back' \
   blind --n 2 --seed 5 --out "$tmp/blind-threads" --no-progress
 check "blind: the stale campaigns.txt replaced" grep -q 'seed 5 ' "$tmp/blind-threads/campaigns.txt"

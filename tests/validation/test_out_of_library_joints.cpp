@@ -98,7 +98,7 @@ TEST(OutOfLibraryJoints, FixtureRattleMatchesTheJointAloneAndRectifiesOnlyThroug
 // Below the threshold (2 g against a preload of 2 g plus 0.71 g of gravity) the joint stays
 // shut and the sensor sees the table through the contact's 30 kHz compliance alone:
 // <d_s^2> = <d_t^2> |T|^2, |T|^2 - 1 ~ 2 (f / f_c)^2 = 3.6e-4 at 400 Hz, so the change is at
-// most k2 A^2 / 2 * 3.6e-4 (with margin 2x: 2.2e-9 g), against ~1e-4 g above the threshold.
+// most k2 A^2 / 2 * 3.6e-4 = 1.1e-8 g (with margin 2x: 2.1e-8 g), against ~1e-4 g above the threshold.
 // On the other static orientation (gravity's share -0.71 g) the same 2 g opens the joint
 // (2 > 1.29): the threshold moves with the orientation.
 TEST(OutOfLibraryJoints, FixtureRattleHasAThresholdThatMovesWithTheStaticOrientation) {
@@ -121,7 +121,7 @@ TEST(OutOfLibraryJoints, FixtureRattleHasAThresholdThatMovesWithTheStaticOrienta
 // Re H = 0 and |H| = 10), through the loop's DC gain (1 - 8e-10). The next terms are
 // a_OA psi^3 / 6 ~ 1e-13 g. Tolerance 1e-3 relative + 1e-11 g: a wrong sign of the turn or of
 // H's real part misses by 100 % or more. Checked at and across the mode (400, 600, 800 Hz:
-// Re H = 1.8, 0, -1.28).
+// Re H = 1.77, 0, -1.25).
 TEST(OutOfLibraryJoints, ProofMassTorsionRectifiesKappaTimesReHAlongOa) {
   constexpr double kappa = 2e-6, A = 4;
   const auto twist = std::make_shared<plant::ProofMassTorsion>(kappa);

@@ -496,15 +496,18 @@ class EffectFitter {
   }
 
   // The fitted parameters' sigma with the hypothesis' own error added: the change the effect
-  // makes, Delta = pred(v) - pred(nominal), is right to model_accuracy run by run (not better:
-  // test_effect_sweep.cpp), an error e_i ~ N(0, (f Delta_i)^2) the fit takes as data. The
-  // estimate moves by C J^T V^-1 e (C the parameters' covariance, J their slopes), so its
-  // covariance gains C J^T V^-1 diag((f Delta)^2) V^-1 J C. A large effect seen at hundreds of
-  // sigma had sigma from the noise only (a mode's frequency at 0.03 %, a harmonic's phase
-  // 4 sigma off its truth at 0.056 rad); a small one is left as it was (f Delta << sigma_run).
+  // makes, Delta = pred(v) - pred(nominal), is right to hypothesis_accuracy f (not better:
+  // test_effect_sweep.cpp). That error is systematic (the same approximation at every run,
+  // smooth in frequency and amplitude), not noise: taken as one common relative error
+  // e = eps f Delta, eps ~ N(0, 1), it moves the estimate by C J^T V^-1 f Delta eps, so the
+  // covariance gains b b^T, b = C J^T V^-1 f Delta (for a linear one-parameter effect b = f p:
+  // the parameter known to f of itself). Independent errors per run would give f p / sqrt(N)
+  // of N like runs, which a systematic error does not average down. A large effect seen at
+  // hundreds of sigma had sigma from the noise only (a harmonic's phase 4 sigma off its truth
+  // at 0.056 rad); a small one is left as it was (f Delta << sigma_run).
   // Reported only: the folds' fits, the evidence and the verdict do not use it.
   void add_model_error(const Data& d, const std::vector<int>& idx, Multi& mf) const {
-    const double f = e_.model_accuracy;
+    const double f = e_.hypothesis_accuracy;
     if (!(f > 0)) return;
     std::vector<double> v = mf.values;
     Eigen::MatrixXd C, J;
@@ -528,8 +531,8 @@ class EffectFitter {
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, t.G, idx));
     const Eigen::VectorXd delta = f * (sub(t.pred, idx) - sub(nominal_.pred, idx));
     const Eigen::MatrixXd W = ldlt.solve(J);  // V^-1 J
-    const Eigen::MatrixXd B = C * (W.transpose() * delta.asDiagonal());  // how each run's error moves the estimate
-    const Eigen::MatrixXd extra = B * B.transpose();
+    const Eigen::VectorXd b = C * (W.transpose() * delta);  // how the common error moves the estimate
+    const Eigen::MatrixXd extra = b * b.transpose();
     for (std::size_t a = 0; a < which.size(); ++a) {
       const auto j = static_cast<std::size_t>(which[a]);
       if (std::isfinite(mf.sigma[j])) mf.sigma[j] = std::sqrt(mf.sigma[j] * mf.sigma[j] + extra(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a)));

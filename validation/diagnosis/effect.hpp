@@ -121,8 +121,9 @@ struct Effect {
   // ODE with the truth (tests/validation/test_effect_sweep.cpp bounds it at 1 % over the band
   // and the drawn range; the squeeze film's harmonic balance 2 %,
   // test_squeeze_film_harmonic_balance.cpp). A fitted parameter's reported sigma adds what
-  // that error, run by run, moves the fit (diagnose.cpp, EffectFitter::add_model_error).
-  double model_accuracy = 0.01;
+  // that error, as one common relative error, moves the fit (diagnose.cpp,
+  // EffectFitter::add_model_error); apart from DiagnoseSettings::model_accuracy (the simulation's).
+  double hypothesis_accuracy = 0.01;
   // Acts at rest too (linear effects only): the static test took up part of it into the
   // identified coefficients; diagnose gives that part back (docs/diagnose.md).
   bool acts_at_rest = false;

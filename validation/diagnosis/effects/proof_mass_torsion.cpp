@@ -24,8 +24,8 @@ Effect effect_proof_mass_torsion() {
   e.truth = [](ParameterValues v, VirtualLab& lab) {
     if (v[0] != 0) lab.instrument.effects.push_back(std::make_shared<plant::ProofMassTorsion>(v[0]));
   };
-  // 0.5-3 urad/g either sign: at 4 g along OA, kappa * 8 g^2 * (Re H - 1) is -1.8 kappa*8 at
-  // 800 Hz: 7-43 ug, i.e. 15-90 sigma of a run.
+  // 0.5-3 urad/g either sign: at 4 g along OA, kappa * 8 g^2 * (Re H - 1) is -2.25 kappa*8 at
+  // 800 Hz: 9-54 ug, i.e. 18-110 sigma of a run.
   e.draw = [](std::mt19937_64& rng) {
     const double s = effects::random_sign(rng);
     return std::vector<double>{s * effects::log_uniform(rng, 0.5e-6, 3e-6)};

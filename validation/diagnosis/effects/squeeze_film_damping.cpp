@@ -21,7 +21,7 @@ Effect effect_squeeze_film_damping() {
   e.rank = 13;
   e.acts_on = ActsOn::instrument;
   e.changes_dynamics = true;
-  e.model_accuracy = 0.02;  // the harmonic balance against the ODE near contact
+  e.hypothesis_accuracy = 0.02;  // the harmonic balance against the ODE near contact
   e.physics = "the gas film's damping rises as the pendulum nears the case, c0 / (1 - (theta / theta_gap)^2)^(3/2); "
               "the parameter is 1 / theta_gap (0: no film nonlinearity). It does not rectify by itself (its torque "
               "is c0 theta' times a function of theta, mean zero over a period) but the damping grows with the "
