@@ -8,9 +8,16 @@ zero: the instrument switched on), settled for 30 slowest time constants, then t
 the output over 4 whole periods from the quadrature state. vrelab: `shake --json`, its
 in-process CPU time solver_stats.cpu_s. Prints per frequency both answers, their
 difference and CPU seconds.
-Run: bench/scipy_shake.py [build/vrelab] [frequencies...]   (docs/performance.md)
+
+SciPy runs in a child process with a CPU-time limit (--scipy-cpu-limit T seconds, default 300;
+RLIMIT_CPU, so a loaded machine does not cut it short): the solver, its settings and its start
+are the same with or without the limit. When SciPy does not finish within T CPU seconds (its
+explicit DOP853 on the stiff loop at 1 Hz) the line says so and prints the bound
+"SciPy > T s, vrelab x ms: > R x" instead of a ratio.
+Run: bench/scipy_shake.py [--scipy-cpu-limit T] [build/vrelab] [frequencies...]
+     (docs/performance.md)
 """
-import json, math, os, subprocess, sys, tempfile, time
+import json, math, multiprocessing, os, resource, signal, subprocess, sys, tempfile, time
 import numpy as np
 from scipy.integrate import solve_ivp
 
@@ -117,14 +124,52 @@ def vrelab_measure(binary, f):
         return j["measured_g"], j["solver_stats"].get("cpu_s", j["solver_stats"]["wall_s"])
 
 
+def _scipy_child(f, limit_s, conn):
+    # The child's own CPU time is limited; SIGXCPU at the soft limit ends it.
+    resource.setrlimit(resource.RLIMIT_CPU, (int(math.ceil(limit_s)), int(math.ceil(limit_s)) + 10))
+    conn.send(scipy_measure(f))
+    conn.close()
+
+
+def scipy_measure_limited(f, limit_s):
+    """(mean_g, cpu_s) or None when SciPy used limit_s CPU seconds without finishing."""
+    ctx = multiprocessing.get_context("fork")
+    parent, child = ctx.Pipe(duplex=False)
+    proc = ctx.Process(target=_scipy_child, args=(f, limit_s, child))
+    proc.start()
+    child.close()
+    try:
+        result = parent.recv()
+    except EOFError:  # the child ended without sending (SIGXCPU)
+        result = None
+    proc.join()
+    if proc.exitcode != 0 or result is None:
+        if proc.exitcode in (-signal.SIGXCPU, -signal.SIGKILL):
+            return None
+        raise RuntimeError(f"SciPy child at {f} Hz ended with exit code {proc.exitcode}")
+    return result
+
+
 def main():
-    binary = sys.argv[1] if len(sys.argv) > 1 else "build/vrelab"
-    freqs = [float(x) for x in sys.argv[2:]] or [1, 10, 100, 1000, 5000]
+    args = sys.argv[1:]
+    limit_s = 300.0
+    if args[:1] == ["--scipy-cpu-limit"]:
+        limit_s, args = float(args[1]), args[2:]
+    binary = args[0] if args else "build/vrelab"
+    freqs = [float(x) for x in args[1:]] or [1, 10, 100, 1000, 5000]
+    print(f"SciPy CPU limit {limit_s:g} s; load average at start {os.getloadavg()[0]:.2f}")
     print(f"{'f_Hz':>7} {'vrelab_g':>16} {'scipy_g':>16} {'diff_g':>9} {'vrelab_cpu_s':>12} {'scipy_cpu_s':>11} {'ratio':>7}")
     for f in freqs:
         v, vc = vrelab_measure(binary, f)
-        s, sc = scipy_measure(f)
-        print(f"{f:7g} {v:16.10e} {s:16.10e} {s - v:+9.1e} {vc:12.4g} {sc:11.4g} {sc / vc:7.0f}")
+        r = scipy_measure_limited(f, limit_s)
+        if r is None:
+            print(f"{f:7g} {v:16.10e} {'-':>16} {'-':>9} {vc:12.4g} {'>' + format(limit_s, 'g'):>11} {'>' + format(limit_s / vc, '.0f'):>7}"
+                  f"   SciPy > {limit_s:g} s, vrelab {1e3 * vc:.3g} ms: > {limit_s / vc:.0f} x")
+        else:
+            s, sc = r
+            print(f"{f:7g} {v:16.10e} {s:16.10e} {s - v:+9.1e} {vc:12.4g} {sc:11.4g} {sc / vc:7.0f}")
+        sys.stdout.flush()
+    print(f"load average at end {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":
