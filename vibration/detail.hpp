@@ -26,7 +26,12 @@ inline std::string num(double x, int precision = 6) {
 // coupling the y and z axes copy x's phases. The one draw both random_phase_block and
 // RandomExcitation's block synthesiser use (their blocks are bit-identical). phase's vectors
 // are resized (their storage reused between calls).
+// `wanted` (default every axis): the axes whose phases the caller reads; the others' vectors
+// are left as they are (not copied, not filled), their draws skipped where none follows
+// (trailing axes) or discarded from the engine otherwise, so the wanted axes' phases are the
+// same numbers either way.
 void draw_block_phases(AxisCoupling coupling, std::uint64_t seed, std::int64_t block_index, std::size_t kmax,
-                       std::array<std::vector<double>, 3>& phase);
+                       std::array<std::vector<double>, 3>& phase,
+                       const std::array<bool, 3>& wanted = {true, true, true});
 
 }  // namespace vrelab::vibration::detail

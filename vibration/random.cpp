@@ -87,14 +87,24 @@ double unit_uniform(std::mt19937_64& e) { return static_cast<double>(e() >> 11) 
 }  // namespace
 
 void detail::draw_block_phases(AxisCoupling coupling, std::uint64_t seed, std::int64_t block_index, std::size_t kmax,
-                               std::array<std::vector<double>, 3>& phase) {
+                               std::array<std::vector<double>, 3>& phase, const std::array<bool, 3>& wanted) {
   const auto b = static_cast<std::uint64_t>(block_index);
   std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
                     static_cast<std::uint32_t>(b), static_cast<std::uint32_t>(b >> 32)};
   std::mt19937_64 engine(seq);
+  const bool common = coupling == AxisCoupling::common;
   for (int a = 0; a < 3; ++a) {
-    if (a > 0 && coupling == AxisCoupling::common) {
-      phase[a] = phase[0];
+    if (a > 0 && common) {
+      if (wanted[static_cast<std::size_t>(a)]) phase[a] = phase[0];
+      continue;
+    }
+    // Common: x's phases are the others' too. Independent: an axis not wanted is drawn only
+    // as far as the engine must advance for a wanted axis after it.
+    bool needed = wanted[static_cast<std::size_t>(a)] || (common && (wanted[1] || wanted[2]));
+    if (!needed) {
+      bool later = false;
+      for (int c = a + 1; c < 3; ++c) later |= wanted[static_cast<std::size_t>(c)];
+      if (later) engine.discard(kmax);
       continue;
     }
     phase[a].resize(kmax + 1);

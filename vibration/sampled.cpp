@@ -204,13 +204,16 @@ class BlockSynthesiser {
   BlockSynthesiser& operator=(const BlockSynthesiser&) = delete;
 
   SampledSignal block(double fs, std::int64_t block_index) {
-    detail::draw_block_phases(profile_.coupling, seed_, block_index, kmax_, phase_);
+    // Only the axes with a PSD are drawn and kept: stream_samples reads no other (an axis
+    // without one is +0, written there); the wanted axes' numbers are the same.
+    const std::array<bool, 3> wanted{static_cast<bool>(profile_.psd[0]), static_cast<bool>(profile_.psd[1]),
+                                     static_cast<bool>(profile_.psd[2])};
+    detail::draw_block_phases(profile_.coupling, seed_, block_index, kmax_, phase_, wanted);
     SampledSignal out;
     out.sample_rate_Hz = fs;
     const std::size_t nbins = m_ / 2 + 1;
     for (int a = 0; a < 3; ++a) {
-      out.samples_g[a].assign(m_, 0.0);
-      if (!profile_.psd[a]) continue;
+      if (!profile_.psd[a]) continue;  // left empty
       for (std::size_t k = 0; k < nbins; ++k) spec_[k][0] = spec_[k][1] = 0.0;
       for (std::size_t i = 0; i < bins_[a].size(); ++i) {
         const std::size_t k = bins_[a][i];
@@ -220,7 +223,7 @@ class BlockSynthesiser {
         spec_[k][1] = amp_[a][i] * sn;
       }
       fftw_execute_dft_c2r(plan_, spec_, sig_);
-      std::copy(sig_, sig_ + m_, out.samples_g[a].begin());
+      out.samples_g[a].assign(sig_, sig_ + m_);
     }
     return out;
   }
@@ -312,7 +315,13 @@ void stream_samples(const RandomProfile& profile, double fs, std::uint64_t seed,
     }
   }
   BlockSynthesiser& synth = *cache.synthesiser;
-  for (auto& v : out) v.assign(count, 0.0);
+  // The axes with a PSD are written in full below; the others are +0.
+  for (int a = 0; a < 3; ++a) {
+    if (profile.psd[a])
+      out[a].resize(count);
+    else
+      out[a].assign(count, 0.0);
+  }
   std::size_t i = 0;
   while (i < count) {
     const std::int64_t c = floor_div(first + static_cast<std::int64_t>(i), h);  // [cH, (c+1)H): blocks c, c+1
@@ -338,10 +347,14 @@ void stream_samples(const RandomProfile& profile, double fs, std::uint64_t seed,
 
 SampledSignal RandomExcitation::samples(std::int64_t first, std::size_t count) const {
   SampledSignal out;
+  samples_into(first, count, out);
+  return out;
+}
+
+void RandomExcitation::samples_into(std::int64_t first, std::size_t count, SampledSignal& out) const {
   out.sample_rate_Hz = fs_;
   std::lock_guard lock(cache_->mutex);
   stream_samples(profile_, fs_, seed_, m_, *cache_, first, count, out.samples_g);
-  return out;
 }
 
 Vec3 RandomExcitation::acceleration_g(double t) const {

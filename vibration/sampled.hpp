@@ -88,6 +88,9 @@ class RandomExcitation final : public Excitation {
   // Stream samples n = first .. first + count - 1 (the values acceleration_g passes through
   // at t = n / fs), per axis.
   SampledSignal samples(std::int64_t first, std::size_t count) const;
+  // The same into `out`, reusing its vectors' storage (a stream read window by window
+  // allocates nothing after the first window).
+  void samples_into(std::int64_t first, std::size_t count, SampledSignal& out) const;
   std::size_t memory_bytes() const;
   // Beside the caches, fixed for the object's life once it has synthesised: the amplitude of
   // every bin with power, the FFT's buffers and plan, the blocks' overlap weights (~1.2 MB

@@ -111,13 +111,14 @@ struct DiscretisedRandomPlant::Coefficients {
   std::vector<int> axes;
   std::int64_t first = std::numeric_limits<std::int64_t>::min();
   std::vector<double> c;
+  vibration::SampledSignal s;  // the window's samples (storage reused)
 
   // Coefficients [lo, hi] available.
   void ensure(std::int64_t lo, std::int64_t hi) {
     if (first != std::numeric_limits<std::int64_t>::min() && lo >= first && hi < first + kLength) return;
     core::throw_if_cancelled();  // a caller's cancel flag (core/cancel.hpp), every 8192 knots
     first = lo;
-    vibration::SampledSignal s = ex.samples(first - kMargin, static_cast<std::size_t>(kLength + 2 * kMargin));
+    ex.samples_into(first - kMargin, static_cast<std::size_t>(kLength + 2 * kMargin), s);
     const std::size_t k = axes.size();
     c.resize(static_cast<std::size_t>(kLength) * k);  // every element written below
     for (std::size_t a = 0; a < k; ++a) {
@@ -171,7 +172,7 @@ DiscretisedRandomPlant::DiscretisedRandomPlant(const Accelerometer& plant, const
         }
   }
   k_ = static_cast<int>(axes_.size());
-  coef_ = std::make_unique<Coefficients>(Coefficients{ex, axes_, std::numeric_limits<std::int64_t>::min(), {}});
+  coef_ = std::make_unique<Coefficients>(Coefficients{ex, axes_, std::numeric_limits<std::int64_t>::min(), {}, {}});
 
   const Eigen::Index n = n_, k = k_;
   a_mat_ = lin.A;

@@ -84,8 +84,12 @@ class SampledRecorder {
         rest_(static_cast<std::size_t>(blocks), 0.0), vib_(rest_) {
     const long rest_n = blocks * block_n;
     if (rest_closed_form && !sink_ && !(ro_.noise_sigma_g > 0)) {
-      const double u = acquire(baseline_g);
-      for (double& r : rest_) r = static_cast<double>(block_n) * (u / k1);
+      // The exponential-integrator path: without noise, quantisation or a sink, a sample is
+      // taken as the output itself, not K1 (out) / K1, which differs from it by an ulp at most
+      // (~1e-16 g at 1 g, the same for the record at rest; the mean moves by < 1e-15 g).
+      exact_ = !(ro_.quantisation_lsb_g > 0);
+      const double u = exact_ ? k1_ * baseline_g : acquire(baseline_g);
+      for (double& r : rest_) r = static_cast<double>(block_n) * (exact_ ? baseline_g : u / k1);
       samples_ = rest_n;
       return;
     }
@@ -102,11 +106,18 @@ class SampledRecorder {
   // One sample of the vibration record at t; `measured_index` >= 0 counts the samples of the
   // measuring interval (negative while settling); `linear_g` is taken off (the companion).
   void sample(double t, const Vec3& input_g, double out_g, long measured_index, double linear_g = 0.0) {
+    ++samples_;
+    if (exact_) {  // no noise, no quantisation, no sink: u / K1 is out_g (to an ulp; see exact_)
+      if (measured_index < 0) return;
+      accumulate(out_g - linear_g, measured_index);
+      return;
+    }
     const double u = acquire(out_g);
     if (sink_) sink_(t, input_g, u);
-    ++samples_;
     if (measured_index < 0) return;
-    const double x = u / k1_ - linear_g;
+    accumulate(u / k1_ - linear_g, measured_index);
+  }
+  void accumulate(double x, long measured_index) {
     // The block of measured_index: counted along (the samples come in order), no division.
     if (measured_index != next_index_) {
       block_ = measured_index / block_n_;
@@ -155,6 +166,7 @@ class SampledRecorder {
   double integral_ = 0, st_ = 0, stt_ = 0, si_ = 0, sti_ = 0;
   long n_fit_ = 0, samples_ = 0;
   long next_index_ = 0, block_ = 0, in_block_ = 0;  // the next measured sample expected, its block
+  bool exact_ = false;
 };
 
 
