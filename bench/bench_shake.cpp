@@ -6,6 +6,13 @@
 //  - RandomGevs20kHz/1/60 (exponential integrator, 60 s) and /0/4 (CVODE, 4 s): GEVS
 //    20-2000 Hz along IA with the output sampled at 20 kHz, the shipped random-case
 //    tolerance (1e-4); counter: simulated seconds per CPU second of the run's thread.
+//  - CvodeJacobian/<case>/<analytic>: the CVODE paths with the plant's Jacobian
+//    (ShakeSettings::analytic_jacobian = 1) or CVODE's difference quotients (0). Cases:
+//    0 the transient sine path at 2 Hz (settle 16 time constants, 4 periods, rtol 1e-10),
+//    default plant; 1 the same with effects (pendulum geometry, pickoff p2 = 20 /rad, squeeze
+//    film); 2 GEVS 20-2000 Hz with the pickoff nonlinearity (the random path's CVODE fallback,
+//    rtol 1e-4, 2 s); 3 sine-on-random-like: 5 g at 80 Hz on the default plant through
+//    CVODE's transient path at 1 kHz. Counters: CPU ms per run and right-hand sides per run.
 // Run: taskset -c 0 build/vrelab_bench   (Release build; one core; docs/performance.md)
 #include <benchmark/benchmark.h>
 
@@ -15,6 +22,7 @@
 #include <cmath>
 #include <vector>
 
+#include "plant/effects/effects.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "vibration/sampled.hpp"
 
@@ -89,6 +97,56 @@ void RandomGevs20kHz(benchmark::State& state) {
   state.counters["simulated_s_per_cpu_s"] = simulated / (1e-3 * cpu_ms);
 }
 BENCHMARK(RandomGevs20kHz)->Args({1, 60})->Args({0, 4})->Iterations(3)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
+
+void CvodeJacobian(benchmark::State& state) {
+  plant::PlantConfig cfg = default_plant();
+  const int which = static_cast<int>(state.range(0));
+  if (which == 1 || which == 2) {
+    cfg.effects.push_back(std::make_shared<plant::PendulumGeometry>());
+    cfg.effects.push_back(std::make_shared<plant::PickoffNonlinearity>(20.0));
+  }
+  if (which == 1) {
+    const double b = cfg.dynamics.angle_gain_rad_per_s2_per_g;
+    cfg.effects.push_back(std::make_shared<plant::SqueezeFilmDamping>(5e-3, 2 * 0.3 * 2 * 3.141592653589793 * 50, b));
+  }
+  const Vec3 a(0.5, std::sqrt(0.75), 0);
+  rectification::ShakeSettings s;
+  s.analytic_jacobian = state.range(1) != 0;
+  s.periodic_steady_state = false;
+  double cpu_ms = 0, rhs = 0, runs = 0;
+  vibration::RandomProfile p;
+  vibration::PsdTable t;
+  t.rows = {vibration::PsdRow::level(20, 0.026), vibration::PsdRow::level(50, 0.16),
+            vibration::PsdRow::level(800, 0.16), vibration::PsdRow::level(2000, 0.026)};
+  p.psd[IA] = t;
+  const vibration::RandomExcitation ex(p, 16000, 1);
+  for (auto _ : state) {
+    const double t0 = thread_cpu_ms();
+    rectification::ShakeResult r;
+    if (which == 2) {
+      rectification::ShakeSettings sr = s;
+      sr.relative_tolerance = 1e-4;
+      sr.blocks = 16;
+      r = rectification::shake_excitation(cfg, a, ex, 2.0, sr);
+    } else {
+      vibration::SineVibration v;
+      v.amplitude_g = Vec3(5, 0, 0);
+      v.frequency_Hz = which == 3 ? 1000.0 : 2.0;
+      r = rectification::shake_sine(cfg, a, v, s);
+    }
+    benchmark::DoNotOptimize(r.measured_g);
+    cpu_ms += thread_cpu_ms() - t0;
+    rhs += static_cast<double>(r.rhs_evaluations);
+    runs += 1;
+  }
+  state.counters["cpu_ms_per_run"] = cpu_ms / runs;
+  state.counters["rhs_per_run"] = rhs / runs;
+}
+BENCHMARK(CvodeJacobian)
+    ->ArgsProduct({{0, 1, 2, 3}, {0, 1}})
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond)
+    ->MeasureProcessCPUTime();
 
 }  // namespace
 

@@ -177,6 +177,8 @@ Accelerometer::Accelerometer(PlantConfig config, const Vec3& a_static_g, Input i
   for (int t = 0; t < n_newton_terms_; ++t)
     if (newton_terms_[static_cast<std::size_t>(t)].c == k1_asym) newton_smooth_ = false;
   lead_ratio_ = servo_.lead_pole_rad_per_s / servo_.lead_zero_rad_per_s;
+  // Without the polynomial its term is +0 (z + 0 = z, but for the sign of a zero z).
+  has_torquer_poly_ = config_.torquer_c2_per_g != 0 || config_.torquer_c3_per_g2 != 0;
   n_ = kCoreStates;
   for (const auto& e : config_.effects) {
     effect_offset_.push_back(n_);
@@ -249,7 +251,8 @@ double Accelerometer::solve_z(double i) const {
   return z;
 }
 
-double Accelerometer::solve_z_fast(double i) const {
+// Inlined into evaluate (its one caller, per sample of the discretised random path).
+[[gnu::always_inline]] inline double Accelerometer::solve_z_fast(double i) const {
   if (!has_in_ia_ && !has_loop_) return i;
   if (!newton_smooth_) return solve_z(i);
   // F(z) = F_input(z) + F_loop(z), its slope and a bound on its curvature |F''| at z.
@@ -304,7 +307,9 @@ double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx, 
   Vec3 a = a_case;
   for (std::size_t e = 0; e < config_.effects.size(); ++e)
     a = config_.effects[e]->input(a, x + effect_offset_[e], dx + effect_offset_[e]);
-  const double s1 = a[IA] + (has_in_ia_ ? f_ia(Location::input, a[IA]) : 0.0) + cross(Location::input, a);
+  // (cross() is 0 without a cross term there: the call skipped, the same sums.)
+  const double s1 = a[IA] + (has_in_ia_ ? f_ia(Location::input, a[IA]) : 0.0) +
+                    (has_cross_[static_cast<std::size_t>(Location::input)] ? cross(Location::input, a) : 0.0);
 
   const double theta = x[kTheta], omega = x[kOmega];
   double p = theta;
@@ -319,7 +324,7 @@ double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx, 
 
   const double z = fast_z ? solve_z_fast(i) : solve_z(i);
   double torque = has_in_ia_ ? z + f_ia(Location::input, z) : z;  // m_in(m_il^-1(i))
-  torque += i * i * (config_.torquer_c2_per_g + config_.torquer_c3_per_g2 * i);
+  if (has_torquer_poly_) torque += i * i * (config_.torquer_c2_per_g + config_.torquer_c3_per_g2 * i);
   const Dynamics& d = config_.dynamics;
   const double wp = 2 * kPi * d.pendulum_frequency_Hz;
   double drive = s1 - torque;
@@ -328,7 +333,7 @@ double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx, 
   dx[kTheta] = omega;
   dx[kOmega] = alpha;
 
-  double out = i + cross(Location::output, a);
+  double out = i + (has_cross_[static_cast<std::size_t>(Location::output)] ? cross(Location::output, a) : 0.0);
   if (has_out_ia_) out += f_ia(Location::output, z);
   for (const auto& e : config_.effects) out = e->readout(out);
   if (d.antialias_Hz > 0) {
@@ -343,8 +348,11 @@ double Accelerometer::evaluate(const Vec3& a_case, const double* x, double* dx, 
   return out;
 }
 
-void Accelerometer::jacobian(double /*t*/, const double* x, double* jac) const {
-  if (!config_.effects.empty()) throw std::logic_error("Accelerometer::jacobian: the effects have no derivatives");
+void Accelerometer::jacobian(double t, const double* x, double* jac) const {
+  if (!config_.effects.empty()) {
+    jacobian_with_effects(t, x, jac);
+    return;
+  }
   Eigen::Map<Eigen::MatrixXd> j(jac, n_, n_);
   j.setZero();
   // i = k G theta + (1 - k) L + w_i I (no effect: pickoff and current are the identity).
@@ -380,6 +388,145 @@ void Accelerometer::jacobian(double /*t*/, const double* x, double* jac) const {
     j(kQuadrature, kAA1) = 1;
   } else {
     for (int c : {kTheta, kLead, kIntegral}) j(kQuadrature, c) = dout * di[c];
+  }
+}
+
+// With effects: the chain rule of evaluate() through the effects' hooks, each hook's derivative
+// by a central difference of the hook alone (step 1e-6 of the argument's size plus its typical
+// size: truncation ~1e-12, rounding ~1e-10 of the derivative for smooth hooks; at a kink of a
+// non-smooth one, clipping or a contact, the mean of the two slopes, which is all Newton's
+// iteration needs). No right-hand side is evaluated.
+void Accelerometer::jacobian_with_effects(double t, const double* x, double* jac) const {
+  Eigen::Map<Eigen::MatrixXd> j(jac, n_, n_);
+  j.setZero();
+  const std::vector<double> scale = state_scale();
+  const auto step = [](double v, double typical) { return 1e-6 * (std::abs(v) + typical); };
+  const auto& effects = config_.effects;
+
+  // Mechanical path: the felt acceleration a and da/dx (3 x n: through the effects' states);
+  // the rows of the effects' states, d(ds)/dx.
+  Vec3 a = input_ ? Vec3(a_static_ + input_(t)) : a_static_;
+  Eigen::MatrixXd da = Eigen::MatrixXd::Zero(3, n_);
+  bool a_moves = false;  // da != 0
+  std::vector<double> ds(static_cast<std::size_t>(n_)), dsp(ds), dsm(ds), sp, sm;
+  for (std::size_t e = 0; e < effects.size(); ++e) {
+    const int ns = effects[e]->num_states(), off = effect_offset_[e];
+    const double* s = x + off;
+    Eigen::MatrixXd je(3 + ns, 3 + ns);  // d(a_out, ds) / d(a_in, s)
+    for (int c = 0; c < 3 + ns; ++c) {
+      Vec3 ap = a, am = a;
+      sp.assign(s, s + ns), sm = sp;
+      double h;
+      if (c < 3) {
+        h = step(a[c], 1.0);
+        ap[c] += h, am[c] -= h;
+      } else {
+        const std::size_t q = static_cast<std::size_t>(c - 3);
+        h = step(s[q], scale[static_cast<std::size_t>(off) + q]);
+        sp[q] += h, sm[q] -= h;
+      }
+      const Vec3 op = effects[e]->input(ap, sp.data(), dsp.data()), om = effects[e]->input(am, sm.data(), dsm.data());
+      for (int r = 0; r < 3; ++r) je(r, c) = (op[r] - om[r]) / (2 * h);
+      for (int r = 0; r < ns; ++r)
+        je(3 + r, c) = (dsp[static_cast<std::size_t>(r)] - dsm[static_cast<std::size_t>(r)]) / (2 * h);
+    }
+    if (ns > 0) {
+      j.block(off, 0, ns, n_) = je.bottomLeftCorner(ns, 3) * da;
+      j.block(off, off, ns, ns) += je.bottomRightCorner(ns, ns);
+    }
+    Eigen::MatrixXd next = je.topLeftCorner(3, 3) * da;
+    if (ns > 0) next.block(0, off, 3, ns) += je.topRightCorner(3, ns);
+    da = next;
+    a_moves = a_moves || ns > 0;
+    a = effects[e]->input(a, s, ds.data());
+  }
+  // d f(a) / dx for a scalar function of the felt acceleration (zero unless a moves).
+  const auto through_a = [&](const auto& f) {
+    Eigen::RowVectorXd r = Eigen::RowVectorXd::Zero(n_);
+    if (!a_moves) return r;
+    for (int c = 0; c < 3; ++c) {
+      const double h = step(a[c], 1.0);
+      Vec3 ap = a, am = a;
+      ap[c] += h, am[c] -= h;
+      r += (f(ap) - f(am)) / (2 * h) * da.row(c);
+    }
+    return r;
+  };
+  const auto s1_of = [this](const Vec3& v) {
+    return v[IA] + (has_in_ia_ ? f_ia(Location::input, v[IA]) : 0.0) + cross(Location::input, v);
+  };
+  const double s1 = s1_of(a);
+  const Eigen::RowVectorXd ds1 = through_a(s1_of);
+
+  // The loop: pickoff and current through the effects' chains.
+  const auto pickoff = [&](double v) {
+    for (const auto& e : effects) v = e->pickoff(v);
+    return v;
+  };
+  const auto current = [&](double v) {
+    for (const auto& e : effects) v = e->current(v);
+    return v;
+  };
+  const double theta = x[kTheta], omega = x[kOmega];
+  const double h_theta = step(theta, scale[kTheta]);
+  const double p = pickoff(theta), dp = (pickoff(theta + h_theta) - pickoff(theta - h_theta)) / (2 * h_theta);
+  const double g = servo_.gain_g_per_rad, k = lead_ratio_, wi = servo_.integrator_rad_per_s;
+  const double wl = servo_.lead_pole_rad_per_s;
+  const double y = k * g * p + (1 - k) * x[kLead];
+  const double i_in = y + wi * x[kIntegral];
+  const double h_i = step(i_in, 1.0);
+  const double i = current(i_in), dc = (current(i_in + h_i) - current(i_in - h_i)) / (2 * h_i);
+  Eigen::RowVectorXd di = Eigen::RowVectorXd::Zero(n_);
+  di[kTheta] = dc * k * g * dp, di[kLead] = dc * (1 - k), di[kIntegral] = dc * wi;
+  j(kLead, kTheta) = wl * g * dp;
+  j(kLead, kLead) = -wl;
+  if (wi > 0) j(kIntegral, kTheta) = k * g * dp, j(kIntegral, kLead) = 1 - k;  // I' = y
+
+  // The torque balance: drive = s1 - m_in(z) - c2 i^2 - c3 i^3 + the effects' extra input.
+  const double z = solve_z(i);
+  const double dz = (has_in_ia_ || has_loop_) ? 1 / (1 + f_ia_slope(Location::input, z) + f_ia_slope(Location::loop, z)) : 1.0;
+  const double dtorque = (has_in_ia_ ? 1 + f_ia_slope(Location::input, z) : 1.0) * dz +
+                         i * (2 * config_.torquer_c2_per_g + 3 * config_.torquer_c3_per_g2 * i);
+  const auto extra = [&](double th, double om, double s, const Vec3& v) {
+    double sum = 0;
+    for (const auto& e : effects) sum += e->extra_input_g(th, om, s, v);
+    return sum;
+  };
+  const double h_omega = step(omega, scale[kOmega]), h_s1 = step(s1, 1.0);
+  const double e_theta = (extra(theta + h_theta, omega, s1, a) - extra(theta - h_theta, omega, s1, a)) / (2 * h_theta);
+  const double e_omega = (extra(theta, omega + h_omega, s1, a) - extra(theta, omega - h_omega, s1, a)) / (2 * h_omega);
+  const double e_s1 = (extra(theta, omega, s1 + h_s1, a) - extra(theta, omega, s1 - h_s1, a)) / (2 * h_s1);
+  const Eigen::RowVectorXd e_a = through_a([&](const Vec3& v) { return extra(theta, omega, s1, v); });
+  Eigen::RowVectorXd drive = ds1 * (1 + e_s1) - dtorque * di + e_a;
+  drive[kTheta] += e_theta;
+  drive[kOmega] += e_omega;
+  const Dynamics& d = config_.dynamics;
+  const double wp = 2 * kPi * d.pendulum_frequency_Hz, b = d.angle_gain_rad_per_s2_per_g;
+  j.row(kOmega) = b * drive;
+  j(kOmega, kTheta) += -wp * wp;
+  j(kOmega, kOmega) += -2 * d.pendulum_damping_ratio * wp;
+  j(kTheta, kOmega) = 1;
+
+  // The output: R(i + C_output(a) + F_output(z)), R the effects' readout chain.
+  const auto readout_chain = [&](double v) {
+    for (const auto& e : effects) v = e->readout(v);
+    return v;
+  };
+  const double out_pre = i + cross(Location::output, a) + (has_out_ia_ ? f_ia(Location::output, z) : 0.0);
+  const double h_out = step(out_pre, 1.0);
+  const double dr = (readout_chain(out_pre + h_out) - readout_chain(out_pre - h_out)) / (2 * h_out);
+  const Eigen::RowVectorXd dout =
+      dr * ((1 + (has_out_ia_ ? f_ia_slope(Location::output, z) * dz : 0.0)) * di +
+            through_a([this](const Vec3& v) { return cross(Location::output, v); }));
+  if (d.antialias_Hz > 0) {
+    const double wa = 2 * kPi * d.antialias_Hz;
+    j.row(kAA2) = wa * wa * dout;
+    j(kAA1, kAA2) = 1;
+    j(kAA2, kAA1) += -wa * wa;
+    j(kAA2, kAA2) += -std::numbers::sqrt2 * wa;
+    j(kQuadrature, kAA1) = 1;
+  } else {
+    j.row(kQuadrature) = dout;
   }
 }
 

@@ -87,11 +87,13 @@ class Accelerometer final : public OdeSystem {
 
   int size() const override { return n_; }
   void rhs(double t, const double* x, double* dx) const override;
-  // The analytic Jacobian d(rhs)/dx (the loop, model (1)'s IA terms through m_il^-1, the
-  // torquer polynomial, the anti-alias filter; the input and the cross terms do not depend on
-  // the state). Effects have no derivative hooks: with any effect has_jacobian() is false
-  // and CVODE forms the Jacobian by its column-wise difference quotients, as before.
-  bool has_jacobian() const override { return config_.effects.empty(); }
+  // The Jacobian d(rhs)/dx: analytic for the loop, model (1)'s IA terms through m_il^-1, the
+  // torquer polynomial and the anti-alias filter; with effects, the chain rule through their
+  // hooks, each hook's own derivative by a central difference of that hook alone (the
+  // mechanical input with its states, pickoff, current, readout, extra input; the cross
+  // terms' dependence on the felt acceleration likewise). Cheap: no right-hand side is
+  // evaluated, only the hooks.
+  bool has_jacobian() const override { return true; }
   void jacobian(double t, const double* x, double* j) const override;
 
   // Normalised output U/K1 (g) at state x and time t (after the anti-alias filter if on).
@@ -125,6 +127,7 @@ class Accelerometer final : public OdeSystem {
  private:
   // rhs; returns the output. fast_z: solve_z's fast variant (rhs_output only).
   double evaluate(const Vec3& a_case, const double* x, double* dx, bool fast_z = false) const;
+  void jacobian_with_effects(double t, const double* x, double* j) const;
   double solve_z(double i) const;  // m_il^-1
   // m_il^-1 from the inverse's second-order series i - F(i) + F'(i) F(i), stopped when the next
   // Newton step is bounded below the rounding (|F''| dz^2): the same root to the last ulp or
@@ -154,7 +157,8 @@ class Accelerometer final : public OdeSystem {
   };
   std::array<NewtonTerm, 5> newton_terms_{};
   int n_newton_terms_ = 0;
-  bool newton_smooth_ = true;  // no k1_asym among them (|z| has no curvature bound at 0)
+  bool newton_smooth_ = true;
+  bool has_torquer_poly_ = false;  // a torquer polynomial c2, c3  // no k1_asym among them (|z| has no curvature bound at 0)
 };
 
 // The plant run statically: from rest with every state zero (the instrument switched on in
