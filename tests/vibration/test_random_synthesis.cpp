@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "vibration/detail.hpp"
 #include "vibration/sampled.hpp"
 
 using namespace vrelab;
@@ -50,5 +51,46 @@ TEST(RandomExcitation, BlocksEqualRandomPhaseBlockBitForBit) {
     // overlap weights; independent of the run's length.
     EXPECT_GT(r.synthesis_bytes(), 0u);
     EXPECT_LT(r.synthesis_bytes(), 64 * m);
+  }
+}
+
+TEST(RandomExcitation, WantedAxesDrawTheSamePhases) {
+  // draw_block_phases with a mask of wanted axes: each wanted axis gets the numbers the full
+  // draw gives it (an unwanted axis before a wanted one is discarded from the engine, not
+  // skipped: a skip would shift the later axis's phases); the unwanted ones are not filled.
+  for (AxisCoupling coupling : {AxisCoupling::common, AxisCoupling::independent}) {
+    std::array<std::vector<double>, 3> all, some;
+    detail::draw_block_phases(coupling, 42, 3, 500, all);
+    for (const std::array<bool, 3> wanted : {std::array<bool, 3>{false, false, true}, std::array<bool, 3>{true, false, false},
+                                             std::array<bool, 3>{false, true, false}}) {
+      some = {};
+      detail::draw_block_phases(coupling, 42, 3, 500, some, wanted);
+      for (int a = 0; a < 3; ++a) {
+        if (wanted[static_cast<std::size_t>(a)]) {
+          EXPECT_EQ(some[static_cast<std::size_t>(a)], all[static_cast<std::size_t>(a)]) << "axis " << a;
+        } else if (!(coupling == AxisCoupling::common && a == 0)) {
+          EXPECT_TRUE(some[static_cast<std::size_t>(a)].empty()) << "axis " << a;
+        }
+      }
+    }
+    // The axes' phases differ with independent coupling (the comparison above can fail).
+    if (coupling == AxisCoupling::independent) {
+      EXPECT_NE(all[2], all[0]);
+    }
+  }
+}
+
+TEST(RandomExcitation, SamplesIntoReusedStorageEqualSamples) {
+  RandomProfile p;
+  p.psd[OA] = PsdTable{{PsdRow::level(50, 0.01), PsdRow::level(400, 0.02)}};
+  const RandomExcitation r(p, 4000, 7, 1024);
+  SampledSignal reused;
+  for (std::int64_t first : {0L, 900L, -300L}) {
+    r.samples_into(first, 1500, reused);
+    const SampledSignal fresh = r.samples(first, 1500);
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(reused.samples_g[a], fresh.samples_g[a]) << first << " axis " << a;
+    EXPECT_EQ(reused.sample_rate_Hz, 4000.0);
+    EXPECT_NE(reused.samples_g[OA][100], 0.0);
+    EXPECT_EQ(reused.samples_g[IA], std::vector<double>(1500, 0.0));
   }
 }
