@@ -113,7 +113,7 @@ void CvodeJacobian(benchmark::State& state) {
   rectification::ShakeSettings s;
   s.analytic_jacobian = state.range(1) != 0;
   s.periodic_steady_state = false;
-  double cpu_ms = 0, rhs = 0, runs = 0;
+  double cpu_ms = 0, rhs = 0, steps = 0, runs = 0;
   vibration::RandomProfile p;
   vibration::PsdTable t;
   t.rows = {vibration::PsdRow::level(20, 0.026), vibration::PsdRow::level(50, 0.16),
@@ -137,10 +137,12 @@ void CvodeJacobian(benchmark::State& state) {
     benchmark::DoNotOptimize(r.measured_g);
     cpu_ms += thread_cpu_ms() - t0;
     rhs += static_cast<double>(r.rhs_evaluations);
+    steps += static_cast<double>(r.steps);
     runs += 1;
   }
   state.counters["cpu_ms_per_run"] = cpu_ms / runs;
   state.counters["rhs_per_run"] = rhs / runs;
+  state.counters["steps_per_run"] = steps / runs;
 }
 BENCHMARK(CvodeJacobian)
     ->ArgsProduct({{0, 1, 2, 3}, {0, 1}})
