@@ -1,6 +1,7 @@
 #include "plant/effects/squeeze_film_damping.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -20,13 +21,35 @@ double SqueezeFilmDamping::extra_input_g(double theta, double omega, double, con
   return -c0_ * factor * omega / b_;  // the plant multiplies by b
 }
 
+namespace {
+constexpr int kDampingPoints = 128;  // trapezoid over a period: spectral for the smooth law below 0.95 theta_gap
+// sin(phi_k) and cos(phi_k)^2 on the period's points, computed once by the same expressions
+// as the sum would compute them (the same numbers; damping_factor is called ~13 times per run
+// and film value by the fixed point of rectification::amplitude_linearised).
+struct DampingTable {
+  std::array<double, kDampingPoints> sin{}, cos2{};
+  DampingTable() {
+    for (int k = 0; k < kDampingPoints; ++k) {
+      const double phi = 2 * std::numbers::pi * k / kDampingPoints;
+      sin[static_cast<std::size_t>(k)] = std::sin(phi);
+      cos2[static_cast<std::size_t>(k)] = std::cos(phi) * std::cos(phi);
+    }
+  }
+};
+const DampingTable& damping_table() {
+  static const DampingTable table;
+  return table;
+}
+}  // namespace
+
 double SqueezeFilmDamping::damping_factor(double theta_amplitude) const {
-  constexpr int kN = 128;  // trapezoid over a period: spectral for the smooth law below 0.95 theta_gap
+  constexpr int kN = kDampingPoints;
+  const DampingTable& t = damping_table();
   double sum = 0;
   for (int k = 0; k < kN; ++k) {
-    const double phi = 2 * std::numbers::pi * k / kN;
-    const double x = std::min(std::abs(theta_amplitude * std::sin(phi)) / gap_rad_, 0.95);
-    sum += std::cos(phi) * std::cos(phi) / std::pow(1 - x * x, 1.5);
+    const auto kk = static_cast<std::size_t>(k);
+    const double x = std::min(std::abs(theta_amplitude * t.sin[kk]) / gap_rad_, 0.95);
+    sum += t.cos2[kk] / std::pow(1 - x * x, 1.5);
   }
   return 2 * sum / kN;
 }

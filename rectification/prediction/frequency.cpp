@@ -254,27 +254,37 @@ PeriodicInput film_harmonic_balance(const PlantConfig& with_films, const PlantCo
     for (int i = 0; i < K; ++i)
       ph[static_cast<std::size_t>(k * K + i)] = unit[static_cast<std::size_t>((hs[static_cast<std::size_t>(i)] * k) % kFilmPoints)];
   // x: the real and imaginary parts of R_h (g). F(x) = R(theta(x))_h - x.
+  // The same phasors split into real and imaginary parts (the loops below in real arithmetic,
+  // as the complex products computed them: the same numbers, without the products' NaN checks).
+  std::vector<double> ph_re(ph.size()), ph_im(ph.size()), hw(static_cast<std::size_t>(K));
+  for (std::size_t q = 0; q < ph.size(); ++q) ph_re[q] = ph[q].real(), ph_im[q] = ph[q].imag();
+  for (int i = 0; i < K; ++i) hw[static_cast<std::size_t>(i)] = hs[static_cast<std::size_t>(i)] * w;
   const auto residual = [&](const Eigen::VectorXd& x) {
-    std::vector<std::complex<double>> th(static_cast<std::size_t>(K));
+    std::vector<double> th_re(static_cast<std::size_t>(K)), th_im(th_re.size()), R_re(th_re.size()), R_im(th_re.size());
     for (int i = 0; i < K; ++i) {
       const auto h = static_cast<std::size_t>(hs[static_cast<std::size_t>(i)]);
-      th[static_cast<std::size_t>(i)] = theta_table[h] + A[h] * std::complex<double>(x[2 * i], x[2 * i + 1]);
+      const std::complex<double> t = theta_table[h] + A[h] * std::complex<double>(x[2 * i], x[2 * i + 1]);
+      th_re[static_cast<std::size_t>(i)] = t.real(), th_im[static_cast<std::size_t>(i)] = t.imag();
     }
-    std::vector<std::complex<double>> R(static_cast<std::size_t>(K));
-    for (int k = 0; k < kFilmPoints; ++k) {
+    const auto Ks = static_cast<std::size_t>(K);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(kFilmPoints); ++k) {
+      const double* pr = ph_re.data() + k * Ks;
+      const double* pi = ph_im.data() + k * Ks;
       double theta = 0, rate = 0;
-      for (int i = 0; i < K; ++i) {
-        const std::complex<double> z = th[static_cast<std::size_t>(i)] * ph[static_cast<std::size_t>(k * K + i)];
-        theta += z.imag(), rate += hs[static_cast<std::size_t>(i)] * w * z.real();  // d/dt Im(Th e^{jh w t})
+      for (std::size_t i = 0; i < Ks; ++i) {
+        // z = th e^{j h phi}: Im z = a d + b c, Re z = a c - b d (a + jb = th, c + jd = e).
+        theta += th_re[i] * pi[i] + th_im[i] * pr[i];
+        rate += hw[i] * (th_re[i] * pr[i] - th_im[i] * pi[i]);  // d/dt Im(Th e^{jh w t})
       }
       double r = c_lin * rate / b;
       for (const Effect* f : films) r += f->extra_input_g(theta, rate, 0.0, Vec3::Zero());
       // Im(R_h e^{j h phi}) resolved: R_h = (2 / N) sum r e^{-j h phi} times j.
-      for (int i = 0; i < K; ++i) R[static_cast<std::size_t>(i)] += r * std::conj(ph[static_cast<std::size_t>(k * K + i)]);
+      for (std::size_t i = 0; i < Ks; ++i) R_re[i] += r * pr[i], R_im[i] += r * -pi[i];
     }
     Eigen::VectorXd F(2 * K);
     for (int i = 0; i < K; ++i) {
-      const std::complex<double> Rh = std::complex<double>(0, 2.0 / kFilmPoints) * R[static_cast<std::size_t>(i)];
+      const auto si = static_cast<std::size_t>(i);
+      const std::complex<double> Rh = std::complex<double>(0, 2.0 / kFilmPoints) * std::complex<double>(R_re[si], R_im[si]);
       F[2 * i] = Rh.real() - x[2 * i], F[2 * i + 1] = Rh.imag() - x[2 * i + 1];
     }
     return F;
@@ -365,6 +375,31 @@ const std::vector<std::complex<double>>& period_phasors() {
     return t;
   }();
   return table;
+}
+
+// The same for kM = 6 h_max + 1 points (h_max = 11..kFilmHarmonics: a squeeze film's
+// harmonics through the loop), e^{j h phi_k}, phi_k = 2 pi k / kM, h = 1..h_max, by the same
+// expression as the loop computed them (the same numbers): was a sincos per point and
+// harmonic of every run of every film value.
+constexpr int kLongMaxHarmonic = kFilmHarmonics;
+const std::vector<std::complex<double>>* long_period_phasors(int points) {
+  static const std::vector<std::vector<std::complex<double>>> tables = [] {
+    std::vector<std::vector<std::complex<double>>> all(static_cast<std::size_t>(kLongMaxHarmonic + 1));
+    for (int h_max = kPeriodMaxHarmonic + 1; h_max <= kLongMaxHarmonic; ++h_max) {
+      const int kM = 6 * h_max + 1;
+      std::vector<std::complex<double>>& t = all[static_cast<std::size_t>(h_max)];
+      for (int h = 1; h <= h_max; ++h)
+        for (int k = 0; k < kM; ++k) {
+          const double phi = 2 * std::numbers::pi * k / kM;
+          t.push_back(std::polar(1.0, h * phi));
+        }
+    }
+    return all;
+  }();
+  if (points % 6 != 1) return nullptr;
+  const int h_max = (points - 1) / 6;
+  if (h_max <= kPeriodMaxHarmonic || h_max > kLongMaxHarmonic) return nullptr;
+  return &tables[static_cast<std::size_t>(h_max)];
 }
 
 }  // namespace
@@ -468,18 +503,24 @@ PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& 
   const Vec3 a_mean = a + in.mean_g;
   b0_ = plant::basis(a);
   if (!readout_.empty()) phasors_.reserve(static_cast<std::size_t>(kM) * hs_.size());
-  const bool tabled = kM == kPeriodPoints && h_max <= kPeriodMaxHarmonic &&
-                      std::all_of(hs_.begin(), hs_.end(), [](const Harmonic& x) { return x.h >= 1; });
-  const std::vector<std::complex<double>>& table = period_phasors();
+  const bool positive = std::all_of(hs_.begin(), hs_.end(), [](const Harmonic& x) { return x.h >= 1; });
+  const std::vector<std::complex<double>>* table =
+      !positive ? nullptr : kM == kPeriodPoints && h_max <= kPeriodMaxHarmonic ? &period_phasors() : long_period_phasors(kM);
+  // Harmonics only inside the loop (a film's) move the current, not the felt acceleration.
+  std::vector<char> felt_moves(hs_.size());
+  for (std::size_t j = 0; j < hs_.size(); ++j) felt_moves[j] = !hs_[j].F.isZero(0.0);
   for (int k = 0; k < kM; ++k) {
     const double phi = 2 * std::numbers::pi * k / kM;
     Vec3 felt = a_mean;
     double current = 0;
-    for (const Harmonic& x : hs_) {
-      const std::complex<double> e =
-          tabled ? table[static_cast<std::size_t>((x.h - 1) * kPeriodPoints + k)] : std::polar(1.0, x.h * phi);
-      for (int i = 0; i < 3; ++i) felt[i] += std::imag(x.F[i] * e);
-      current += std::imag(x.I * e);
+    for (std::size_t j = 0; j < hs_.size(); ++j) {
+      const Harmonic& x = hs_[j];
+      const std::complex<double> e = table ? (*table)[static_cast<std::size_t>((x.h - 1) * kM + k)] : std::polar(1.0, x.h * phi);
+      // Im(z e) written out as the complex product computes it, a d + b c (the same numbers
+      // without the product's NaN checks); a zero F adds only zeros.
+      if (felt_moves[j])
+        for (int i = 0; i < 3; ++i) felt[i] += x.F[i].real() * e.imag() + x.F[i].imag() * e.real();
+      current += x.I.real() * e.imag() + x.I.imag() * e.real();
       if (!readout_.empty()) phasors_.push_back(e);
     }
     const plant::Basis bf = plant::basis(felt);
