@@ -422,13 +422,15 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
   for (int h = 1; h <= kMaxHarmonic; ++h) {
     // X_h = sum_k a_k e^{-j 2 pi h k / N}; for a_k = Im(W e^{j 2 pi h k / N}), X_h = N W / (2j).
     // (In real arithmetic, as the complex product (a + 0j)(c + js) = (a c - 0 s) + j (a s + 0 c)
-    // computes it: the same numbers without the product's NaN checks.)
+    // computes it, less its zero terms: a c - 0 s is a c but for the sign of a zero, and a sum
+    // that ends at zero is a part dropped below (|w| <= floor): the same numbers, without the
+    // product's NaN checks.)
     double xr[3] = {0, 0, 0}, xi[3] = {0, 0, 0};
     const std::complex<double>* tw = twiddle.data() + static_cast<std::ptrdiff_t>(h - 1) * kN;
     for (int k = 0; k < kN; ++k) {
       const double c = tw[k].real(), sn = tw[k].imag();
       const Vec3& ak = a[static_cast<std::size_t>(k)];
-      for (int i = 0; i < 3; ++i) xr[i] += ak[i] * c - 0.0 * sn, xi[i] += ak[i] * sn + 0.0 * c;
+      for (int i = 0; i < 3; ++i) xr[i] += ak[i] * c, xi[i] += ak[i] * sn;
     }
     Eigen::Vector3cd x;
     for (int i = 0; i < 3; ++i) x[i] = std::complex<double>(xr[i], xi[i]);

@@ -216,7 +216,22 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
         key += buf;
       }
     }
-    const rectification::ResponseAt h = [&](double f) { return cache.get(cfg, key, f); };
+    // A squeeze film's linearised plant is this run's own (its damping is in the key): its
+    // responses are kept for the run only, not in the cache (the same numbers: the plant
+    // linearised once, each frequency solved once).
+    const bool own = cfg.dynamics.pendulum_damping_ratio != with_films.dynamics.pendulum_damping_ratio && cfg.servo;
+    std::optional<rectification::LoopResponder> own_responder;
+    std::map<double, rectification::LoopResponse> own_responses;
+    const rectification::ResponseAt h = [&](double f) {
+      if (!own) return cache.get(cfg, key, f);
+      auto it = own_responses.find(f);
+      if (it == own_responses.end()) {
+        if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+        if (!own_responder) own_responder.emplace(cfg);
+        it = own_responses.emplace(f, (*own_responder)(f)).first;
+      }
+      return it->second;
+    };
     const rectification::PeriodicInput input =
         r.random ? rectification::PeriodicInput{} : rectification::film_harmonic_balance(with_films, cfg, run_input(r, m), h);
     // A random or sine-on-random run: the random part's covariances through the loop, once.
