@@ -511,6 +511,8 @@ PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& 
   // Harmonics only inside the loop (a film's) move the current, not the felt acceleration.
   std::vector<char> felt_moves(hs_.size());
   for (std::size_t j = 0; j < hs_.size(); ++j) felt_moves[j] = !hs_[j].F.isZero(0.0);
+  const bool pow2 = (kM & (kM - 1)) == 0;
+  const double inv_points = 1.0 / kM;
   for (int k = 0; k < kM; ++k) {
     const double phi = 2 * std::numbers::pi * k / kM;
     Vec3 felt = a_mean;
@@ -529,7 +531,10 @@ PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& 
     Vec3 loop = felt;
     loop[IA] = a_mean[IA] + current;
     const plant::Basis bl = plant::basis(loop);
-    for (int c = 0; c < kNumCoefficients; ++c) at_input_[c] += bf[c] / kM, in_loop_[c] += bl[c] / kM;
+    if (pow2)  // x / kM = x (1 / kM) exactly for a power of two (both the same real number rounded)
+      for (int c = 0; c < kNumCoefficients; ++c) at_input_[c] += bf[c] * inv_points, in_loop_[c] += bl[c] * inv_points;
+    else
+      for (int c = 0; c < kNumCoefficients; ++c) at_input_[c] += bf[c] / kM, in_loop_[c] += bl[c] / kM;
   }
   out.input_mean_g = 0.0;
   // Effects beyond (1): quadratic in the angle, so harmonics add (their cross products
