@@ -27,8 +27,9 @@ constexpr int kDampingPoints = 128;  // trapezoid over a period: spectral for th
 // sin(phi_k) and cos(phi_k)^2 on the period's points, computed once by the same expressions
 // as the sum would compute them (the same numbers; damping_factor is called ~13 times per run
 // and film value by the fixed point of rectification::amplitude_linearised).
-// The film's factor depends on |sin(phi_k)| only, which repeats over the period's quarters:
-// the points whose |sin| is the same number (bit for bit) share one pow (`distinct`: the
+// The film's factor depends on |sin(phi_k)| only, which repeats over the period's quarters
+// up to the sine's rounding (97 distinct values of 128): the points whose |sin| is the same
+// number (bit for bit) share one pow (`distinct`: the
 // first point of each such value, `of`: each point's); the sum still runs over every point in
 // order, so the result is the same number.
 struct DampingTable {
