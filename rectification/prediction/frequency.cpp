@@ -1,5 +1,7 @@
 #include "rectification/prediction/frequency.hpp"
 
+#include <cstdint>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -9,6 +11,8 @@
 #include <vector>
 
 #include <Eigen/Dense>
+
+#include "plant/effects/squeeze_film_damping.hpp"
 
 namespace vrelab::rectification {
 
@@ -331,6 +335,45 @@ PeriodicInput film_harmonic_balance(const PlantConfig& with_films, const PlantCo
     out.loop.push_back({hs[static_cast<std::size_t>(i)], C[h] * Rh, A[h] * Rh});
   }
   return out;
+}
+
+std::string film_balance_key(const PlantConfig& config, const vibration::SineVibration& v, const PeriodicInput& in) {
+  if (std::none_of(config.effects.begin(), config.effects.end(), [](const auto& e) { return e->amplitude_dependent_damping(); }))
+    return {};
+  std::string key;
+  const auto put = [&key](const auto& x) { key.append(reinterpret_cast<const char*>(&x), sizeof x); };
+  for (double c : config.coefficients.v) put(c);
+  for (const Location l : config.location) put(static_cast<int>(l));
+  const Dynamics& d = config.dynamics;
+  for (double x : {d.pendulum_frequency_Hz, d.pendulum_damping_ratio, d.angle_gain_rad_per_s2_per_g, d.loop_bandwidth_Hz,
+                   d.phase_margin_deg, d.integrator_zero_ratio, d.antialias_Hz})
+    put(x);
+  put(static_cast<int>(d.integrator));
+  put(static_cast<int>(config.servo.has_value()));
+  if (config.servo)
+    for (double x : {config.servo->gain_g_per_rad, config.servo->lead_zero_rad_per_s, config.servo->lead_pole_rad_per_s,
+                     config.servo->integrator_rad_per_s})
+      put(x);
+  put(config.torquer_c2_per_g), put(config.torquer_c3_per_g2);
+  for (const auto& e : config.effects) {
+    if (const auto* f = dynamic_cast<const plant::SqueezeFilmDamping*>(e.get())) {
+      put(1);
+      put(f->gap_angle_rad()), put(f->c0_own_per_s()), put(f->angle_gain_own_rad_per_s2_per_g());
+    } else {
+      put(2);
+      put(reinterpret_cast<std::uintptr_t>(e.get()));
+    }
+  }
+  for (int i = 0; i < 3; ++i) put(v.amplitude_g[i]), put(v.phase_rad[i]);
+  put(v.frequency_Hz);
+  put(in.frequency_Hz);
+  for (int i = 0; i < 3; ++i) put(in.mean_g[i]);
+  for (const auto& [h, W] : in.tones) {
+    put(h);
+    for (int i = 0; i < 3; ++i) put(W[i].real()), put(W[i].imag());
+  }
+  for (const PeriodicInput::LoopTone& l : in.loop) put(l.h), put(l.current_g.real()), put(l.current_g.imag()), put(l.angle_rad.real()), put(l.angle_rad.imag());
+  return key;
 }
 
 PeriodicInput periodic_input(const vibration::SineVibration& v) {

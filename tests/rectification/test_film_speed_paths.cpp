@@ -15,10 +15,13 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 
 #include "plant/accelerometer.hpp"
+#include "plant/effects/mechanical_mode.hpp"
 #include "plant/effects/squeeze_film_damping.hpp"
 #include "rectification/prediction/frequency.hpp"
 
@@ -76,4 +79,47 @@ TEST(FilmSpeedPaths, LoopHarmonicsUpTo31AverageAsTheCubicsClosedForm) {
   in.loop[2].current_g = C31 * std::polar(1.0, 1.0);
   EXPECT_NEAR(rectification::periodic_rectification(p, a_static, in, no_response).total_g(), expected,
               1e-13 * std::abs(expected));
+}
+
+// diagnose reuses a film run's linearisation and balance for runs whose film_balance_key is
+// equal (the same plant and motion: runs that differ only in orientation). The key must tell
+// films apart by their parameters (a film is made afresh per run), and anything else it cannot
+// compare by identity; equal keys must give equal results (computed here without reuse).
+TEST(FilmSpeedPaths, FilmBalanceKeyIsEqualExactlyForTheSamePlantAndMotion) {
+  const auto plant_with = [](double gap_rad) {
+    PlantConfig p;
+    p.coefficients[K1] = 1.0;
+    const double c0 = 2 * p.dynamics.pendulum_damping_ratio * 2 * std::numbers::pi * p.dynamics.pendulum_frequency_Hz;
+    p.effects.push_back(std::make_shared<SqueezeFilmDamping>(gap_rad, c0, p.dynamics.angle_gain_rad_per_s2_per_g));
+    return p;
+  };
+  vibration::SineVibration v;
+  v.amplitude_g = Vec3(4.0, 0, 0);
+  v.frequency_Hz = 130.0;
+  const rectification::PeriodicInput in = rectification::periodic_input(v);
+  const PlantConfig a = plant_with(1.1e-3), b = plant_with(1.1e-3), c = plant_with(1.2e-3);
+  const std::string ka = rectification::film_balance_key(a, v, in);
+  ASSERT_FALSE(ka.empty());
+  EXPECT_EQ(ka, rectification::film_balance_key(b, v, in));  // two films made alike
+  EXPECT_NE(ka, rectification::film_balance_key(c, v, in));  // another gap
+  vibration::SineVibration v2 = v;
+  v2.amplitude_g[0] = 4.0 * (1 + 1e-15);
+  EXPECT_NE(ka, rectification::film_balance_key(a, v2, rectification::periodic_input(v2)));  // another motion
+  PlantConfig d = a, e = a;
+  d.effects.push_back(std::make_shared<MechanicalMode>(1800.0, 0.04, Vec3(1, 1, 0)));
+  e.effects.push_back(std::make_shared<MechanicalMode>(1800.0, 0.04, Vec3(1, 1, 0)));
+  EXPECT_NE(rectification::film_balance_key(d, v, in), rectification::film_balance_key(e, v, in));  // by identity
+  EXPECT_TRUE(rectification::film_balance_key(PlantConfig{}, v, in).empty());  // no film
+  // Equal keys: the linearisation and the balance computed afresh are the same numbers.
+  const PlantConfig la = rectification::amplitude_linearised(a, v), lb = rectification::amplitude_linearised(b, v);
+  EXPECT_EQ(la.dynamics.pendulum_damping_ratio, lb.dynamics.pendulum_damping_ratio);
+  const rectification::ResponseAt ha = [&la](double f) { return rectification::loop_response(la, f); };
+  const rectification::ResponseAt hb = [&lb](double f) { return rectification::loop_response(lb, f); };
+  const rectification::PeriodicInput ba = rectification::film_harmonic_balance(a, la, in, ha);
+  const rectification::PeriodicInput bb = rectification::film_harmonic_balance(b, lb, in, hb);
+  ASSERT_EQ(ba.loop.size(), bb.loop.size());
+  for (std::size_t i = 0; i < ba.loop.size(); ++i) {
+    EXPECT_EQ(ba.loop[i].current_g, bb.loop[i].current_g) << i;
+    EXPECT_EQ(ba.loop[i].angle_rad, bb.loop[i].angle_rad) << i;
+  }
 }

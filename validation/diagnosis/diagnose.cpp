@@ -197,13 +197,20 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
   const double p = values.empty() ? 0.0 : values.front();
   const int n = static_cast<int>(runs.size());
   Table t{Eigen::VectorXd(n), Eigen::MatrixXd(n, plant::kNumCoefficients)};
+  std::map<std::string, std::pair<PlantConfig, rectification::PeriodicInput>> film_memo;
   for (int k = 0; k < n; ++k) {
     const RunRecord& r = runs[static_cast<std::size_t>(k)];
     PlantConfig cfg = nominal;
     TableMotion m = table_motion(r);
     apply_effect(e, values, r, cfg, m);
     const PlantConfig with_films = cfg;
-    if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
+    // A film's linearisation and balance once per (plant, motion) in the table: runs that
+    // differ only in orientation share them (the same function of the same numbers).
+    const rectification::PeriodicInput motion = r.random ? rectification::PeriodicInput{} : run_input(r, m);
+    const std::string film_key = r.random ? std::string() : rectification::film_balance_key(with_films, m.sine, motion);
+    const auto memo = film_key.empty() ? film_memo.end() : film_memo.find(film_key);
+    if (memo != film_memo.end()) cfg = memo->second.first;
+    else if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
     // The loop responses depend on the effect's value and, for an amplitude-dependent one,
     // on the run: the key says both.
     std::string key;
@@ -232,8 +239,10 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       }
       return it->second;
     };
-    const rectification::PeriodicInput input =
-        r.random ? rectification::PeriodicInput{} : rectification::film_harmonic_balance(with_films, cfg, run_input(r, m), h);
+    const rectification::PeriodicInput input = r.random                  ? rectification::PeriodicInput{}
+                                               : memo != film_memo.end() ? memo->second.second
+                                                                         : rectification::film_harmonic_balance(with_films, cfg, motion, h);
+    if (!film_key.empty() && memo == film_memo.end()) film_memo.emplace(film_key, std::make_pair(cfg, input));
     // A random or sine-on-random run: the random part's covariances through the loop, once.
     std::optional<rectification::RandomResponse> rr;
     std::optional<vibration::SineVibration> sine;
