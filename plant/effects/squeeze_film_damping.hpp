@@ -22,6 +22,9 @@ class SqueezeFilmDamping final : public Effect {
   // f = c / c0 (1 + 3 x^2 / 8 + O(x^4), x = Theta / theta_gap).
   double damping_factor(double theta_amplitude_rad) const;
   double gap_angle_rad() const { return gap_rad_; }
+  // Its own c0 and b as constructed (what makes two films the same film).
+  double c0_own_per_s() const { return c0_; }
+  double angle_gain_own_rad_per_s2_per_g() const { return b_; }
   // The film's nominal damping as the plant feels it, 1/s: c0 times b(plant) / b(film).
   double c0_per_s(double plant_angle_gain_rad_per_s2_per_g) const { return c0_ * plant_angle_gain_rad_per_s2_per_g / b_; }
   bool amplitude_dependent_damping() const override { return true; }

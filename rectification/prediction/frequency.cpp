@@ -1,5 +1,7 @@
 #include "rectification/prediction/frequency.hpp"
 
+#include <cstdint>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -9,6 +11,8 @@
 #include <vector>
 
 #include <Eigen/Dense>
+
+#include "plant/effects/squeeze_film_damping.hpp"
 
 namespace vrelab::rectification {
 
@@ -254,27 +258,37 @@ PeriodicInput film_harmonic_balance(const PlantConfig& with_films, const PlantCo
     for (int i = 0; i < K; ++i)
       ph[static_cast<std::size_t>(k * K + i)] = unit[static_cast<std::size_t>((hs[static_cast<std::size_t>(i)] * k) % kFilmPoints)];
   // x: the real and imaginary parts of R_h (g). F(x) = R(theta(x))_h - x.
+  // The same phasors split into real and imaginary parts (the loops below in real arithmetic,
+  // as the complex products computed them: the same numbers, without the products' NaN checks).
+  std::vector<double> ph_re(ph.size()), ph_im(ph.size()), hw(static_cast<std::size_t>(K));
+  for (std::size_t q = 0; q < ph.size(); ++q) ph_re[q] = ph[q].real(), ph_im[q] = ph[q].imag();
+  for (int i = 0; i < K; ++i) hw[static_cast<std::size_t>(i)] = hs[static_cast<std::size_t>(i)] * w;
   const auto residual = [&](const Eigen::VectorXd& x) {
-    std::vector<std::complex<double>> th(static_cast<std::size_t>(K));
+    std::vector<double> th_re(static_cast<std::size_t>(K)), th_im(th_re.size()), R_re(th_re.size()), R_im(th_re.size());
     for (int i = 0; i < K; ++i) {
       const auto h = static_cast<std::size_t>(hs[static_cast<std::size_t>(i)]);
-      th[static_cast<std::size_t>(i)] = theta_table[h] + A[h] * std::complex<double>(x[2 * i], x[2 * i + 1]);
+      const std::complex<double> t = theta_table[h] + A[h] * std::complex<double>(x[2 * i], x[2 * i + 1]);
+      th_re[static_cast<std::size_t>(i)] = t.real(), th_im[static_cast<std::size_t>(i)] = t.imag();
     }
-    std::vector<std::complex<double>> R(static_cast<std::size_t>(K));
-    for (int k = 0; k < kFilmPoints; ++k) {
+    const auto Ks = static_cast<std::size_t>(K);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(kFilmPoints); ++k) {
+      const double* pr = ph_re.data() + k * Ks;
+      const double* pi = ph_im.data() + k * Ks;
       double theta = 0, rate = 0;
-      for (int i = 0; i < K; ++i) {
-        const std::complex<double> z = th[static_cast<std::size_t>(i)] * ph[static_cast<std::size_t>(k * K + i)];
-        theta += z.imag(), rate += hs[static_cast<std::size_t>(i)] * w * z.real();  // d/dt Im(Th e^{jh w t})
+      for (std::size_t i = 0; i < Ks; ++i) {
+        // z = th e^{j h phi}: Im z = a d + b c, Re z = a c - b d (a + jb = th, c + jd = e).
+        theta += th_re[i] * pi[i] + th_im[i] * pr[i];
+        rate += hw[i] * (th_re[i] * pr[i] - th_im[i] * pi[i]);  // d/dt Im(Th e^{jh w t})
       }
       double r = c_lin * rate / b;
       for (const Effect* f : films) r += f->extra_input_g(theta, rate, 0.0, Vec3::Zero());
       // Im(R_h e^{j h phi}) resolved: R_h = (2 / N) sum r e^{-j h phi} times j.
-      for (int i = 0; i < K; ++i) R[static_cast<std::size_t>(i)] += r * std::conj(ph[static_cast<std::size_t>(k * K + i)]);
+      for (std::size_t i = 0; i < Ks; ++i) R_re[i] += r * pr[i], R_im[i] += r * -pi[i];
     }
     Eigen::VectorXd F(2 * K);
     for (int i = 0; i < K; ++i) {
-      const std::complex<double> Rh = std::complex<double>(0, 2.0 / kFilmPoints) * R[static_cast<std::size_t>(i)];
+      const auto si = static_cast<std::size_t>(i);
+      const std::complex<double> Rh = std::complex<double>(0, 2.0 / kFilmPoints) * std::complex<double>(R_re[si], R_im[si]);
       F[2 * i] = Rh.real() - x[2 * i], F[2 * i + 1] = Rh.imag() - x[2 * i + 1];
     }
     return F;
@@ -323,6 +337,45 @@ PeriodicInput film_harmonic_balance(const PlantConfig& with_films, const PlantCo
   return out;
 }
 
+std::string film_balance_key(const PlantConfig& config, const vibration::SineVibration& v, const PeriodicInput& in) {
+  if (std::none_of(config.effects.begin(), config.effects.end(), [](const auto& e) { return e->amplitude_dependent_damping(); }))
+    return {};
+  std::string key;
+  const auto put = [&key](const auto& x) { key.append(reinterpret_cast<const char*>(&x), sizeof x); };
+  for (double c : config.coefficients.v) put(c);
+  for (const Location l : config.location) put(static_cast<int>(l));
+  const Dynamics& d = config.dynamics;
+  for (double x : {d.pendulum_frequency_Hz, d.pendulum_damping_ratio, d.angle_gain_rad_per_s2_per_g, d.loop_bandwidth_Hz,
+                   d.phase_margin_deg, d.integrator_zero_ratio, d.antialias_Hz})
+    put(x);
+  put(static_cast<int>(d.integrator));
+  put(static_cast<int>(config.servo.has_value()));
+  if (config.servo)
+    for (double x : {config.servo->gain_g_per_rad, config.servo->lead_zero_rad_per_s, config.servo->lead_pole_rad_per_s,
+                     config.servo->integrator_rad_per_s})
+      put(x);
+  put(config.torquer_c2_per_g), put(config.torquer_c3_per_g2);
+  for (const auto& e : config.effects) {
+    if (const auto* f = dynamic_cast<const plant::SqueezeFilmDamping*>(e.get())) {
+      put(1);
+      put(f->gap_angle_rad()), put(f->c0_own_per_s()), put(f->angle_gain_own_rad_per_s2_per_g());
+    } else {
+      put(2);
+      put(reinterpret_cast<std::uintptr_t>(e.get()));
+    }
+  }
+  for (int i = 0; i < 3; ++i) put(v.amplitude_g[i]), put(v.phase_rad[i]);
+  put(v.frequency_Hz);
+  put(in.frequency_Hz);
+  for (int i = 0; i < 3; ++i) put(in.mean_g[i]);
+  for (const auto& [h, W] : in.tones) {
+    put(h);
+    for (int i = 0; i < 3; ++i) put(W[i].real()), put(W[i].imag());
+  }
+  for (const PeriodicInput::LoopTone& l : in.loop) put(l.h), put(l.current_g.real()), put(l.current_g.imag()), put(l.angle_rad.real()), put(l.angle_rad.imag());
+  return key;
+}
+
 PeriodicInput periodic_input(const vibration::SineVibration& v) {
   vibration::validate(v);
   PeriodicInput p;
@@ -367,6 +420,31 @@ const std::vector<std::complex<double>>& period_phasors() {
   return table;
 }
 
+// The same for kM = 6 h_max + 1 points (h_max = 11..kFilmHarmonics: a squeeze film's
+// harmonics through the loop), e^{j h phi_k}, phi_k = 2 pi k / kM, h = 1..h_max, by the same
+// expression as the loop computed them (the same numbers): was a sincos per point and
+// harmonic of every run of every film value.
+constexpr int kLongMaxHarmonic = kFilmHarmonics;
+const std::vector<std::complex<double>>* long_period_phasors(int points) {
+  static const std::vector<std::vector<std::complex<double>>> tables = [] {
+    std::vector<std::vector<std::complex<double>>> all(static_cast<std::size_t>(kLongMaxHarmonic + 1));
+    for (int h_max = kPeriodMaxHarmonic + 1; h_max <= kLongMaxHarmonic; ++h_max) {
+      const int kM = 6 * h_max + 1;
+      std::vector<std::complex<double>>& t = all[static_cast<std::size_t>(h_max)];
+      for (int h = 1; h <= h_max; ++h)
+        for (int k = 0; k < kM; ++k) {
+          const double phi = 2 * std::numbers::pi * k / kM;
+          t.push_back(std::polar(1.0, h * phi));
+        }
+    }
+    return all;
+  }();
+  if (points % 6 != 1) return nullptr;
+  const int h_max = (points - 1) / 6;
+  if (h_max <= kPeriodMaxHarmonic || h_max > kLongMaxHarmonic) return nullptr;
+  return &tables[static_cast<std::size_t>(h_max)];
+}
+
 }  // namespace
 
 PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz) {
@@ -387,19 +465,23 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
   for (int h = 1; h <= kMaxHarmonic; ++h) {
     // X_h = sum_k a_k e^{-j 2 pi h k / N}; for a_k = Im(W e^{j 2 pi h k / N}), X_h = N W / (2j).
     // (In real arithmetic, as the complex product (a + 0j)(c + js) = (a c - 0 s) + j (a s + 0 c)
-    // computes it: the same numbers without the product's NaN checks.)
+    // computes it, less its zero terms: a c - 0 s is a c but for the sign of a zero, and a sum
+    // that ends at zero is a part dropped below (|w| <= floor): the same numbers, without the
+    // product's NaN checks.)
     double xr[3] = {0, 0, 0}, xi[3] = {0, 0, 0};
     const std::complex<double>* tw = twiddle.data() + static_cast<std::ptrdiff_t>(h - 1) * kN;
     for (int k = 0; k < kN; ++k) {
       const double c = tw[k].real(), sn = tw[k].imag();
       const Vec3& ak = a[static_cast<std::size_t>(k)];
-      for (int i = 0; i < 3; ++i) xr[i] += ak[i] * c - 0.0 * sn, xi[i] += ak[i] * sn + 0.0 * c;
+      for (int i = 0; i < 3; ++i) xr[i] += ak[i] * c, xi[i] += ak[i] * sn;
     }
     Eigen::Vector3cd x;
     for (int i = 0; i < 3; ++i) x[i] = std::complex<double>(xr[i], xi[i]);
     Eigen::Vector3cd w = std::complex<double>(0, 2.0 / kN) * x;
     for (int i = 0; i < 3; ++i)
-      if (std::abs(w[i]) <= floor_g) w[i] = 0.0;
+      // |w| >= max(|Re w|, |Im w|) holds for the rounded modulus too (faithful rounding of a
+      // value at least that representable number): the modulus only where it can decide.
+      if (std::max(std::abs(w[i].real()), std::abs(w[i].imag())) <= floor_g && std::abs(w[i]) <= floor_g) w[i] = 0.0;
     if (!w.isZero(0.0)) p.tones.push_back({h, w});
   }
   return p;
@@ -468,25 +550,36 @@ PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& 
   const Vec3 a_mean = a + in.mean_g;
   b0_ = plant::basis(a);
   if (!readout_.empty()) phasors_.reserve(static_cast<std::size_t>(kM) * hs_.size());
-  const bool tabled = kM == kPeriodPoints && h_max <= kPeriodMaxHarmonic &&
-                      std::all_of(hs_.begin(), hs_.end(), [](const Harmonic& x) { return x.h >= 1; });
-  const std::vector<std::complex<double>>& table = period_phasors();
+  const bool positive = std::all_of(hs_.begin(), hs_.end(), [](const Harmonic& x) { return x.h >= 1; });
+  const std::vector<std::complex<double>>* table =
+      !positive ? nullptr : kM == kPeriodPoints && h_max <= kPeriodMaxHarmonic ? &period_phasors() : long_period_phasors(kM);
+  // Harmonics only inside the loop (a film's) move the current, not the felt acceleration.
+  std::vector<char> felt_moves(hs_.size());
+  for (std::size_t j = 0; j < hs_.size(); ++j) felt_moves[j] = !hs_[j].F.isZero(0.0);
+  const bool pow2 = (kM & (kM - 1)) == 0;
+  const double inv_points = 1.0 / kM;
   for (int k = 0; k < kM; ++k) {
     const double phi = 2 * std::numbers::pi * k / kM;
     Vec3 felt = a_mean;
     double current = 0;
-    for (const Harmonic& x : hs_) {
-      const std::complex<double> e =
-          tabled ? table[static_cast<std::size_t>((x.h - 1) * kPeriodPoints + k)] : std::polar(1.0, x.h * phi);
-      for (int i = 0; i < 3; ++i) felt[i] += std::imag(x.F[i] * e);
-      current += std::imag(x.I * e);
+    for (std::size_t j = 0; j < hs_.size(); ++j) {
+      const Harmonic& x = hs_[j];
+      const std::complex<double> e = table ? (*table)[static_cast<std::size_t>((x.h - 1) * kM + k)] : std::polar(1.0, x.h * phi);
+      // Im(z e) written out as the complex product computes it, a d + b c (the same numbers
+      // without the product's NaN checks); a zero F adds only zeros.
+      if (felt_moves[j])
+        for (int i = 0; i < 3; ++i) felt[i] += x.F[i].real() * e.imag() + x.F[i].imag() * e.real();
+      current += x.I.real() * e.imag() + x.I.imag() * e.real();
       if (!readout_.empty()) phasors_.push_back(e);
     }
     const plant::Basis bf = plant::basis(felt);
     Vec3 loop = felt;
     loop[IA] = a_mean[IA] + current;
     const plant::Basis bl = plant::basis(loop);
-    for (int c = 0; c < kNumCoefficients; ++c) at_input_[c] += bf[c] / kM, in_loop_[c] += bl[c] / kM;
+    if (pow2)  // x / kM = x (1 / kM) exactly for a power of two (both the same real number rounded)
+      for (int c = 0; c < kNumCoefficients; ++c) at_input_[c] += bf[c] * inv_points, in_loop_[c] += bl[c] * inv_points;
+    else
+      for (int c = 0; c < kNumCoefficients; ++c) at_input_[c] += bf[c] / kM, in_loop_[c] += bl[c] / kM;
   }
   out.input_mean_g = 0.0;
   // Effects beyond (1): quadratic in the angle, so harmonics add (their cross products

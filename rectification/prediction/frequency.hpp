@@ -26,6 +26,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -154,6 +155,12 @@ FrequencyPrediction periodic_rectification(const plant::PlantConfig& plant, cons
 inline constexpr int kFilmHarmonics = 31, kFilmPoints = 256;
 PeriodicInput film_harmonic_balance(const plant::PlantConfig& with_films, const plant::PlantConfig& linearised,
                                     const PeriodicInput& in, const ResponseAt& response);
+
+// What amplitude_linearised(with_films, v) and film_harmonic_balance(with_films, ., in, .)
+// depend on, as bytes: equal keys give equal results (a caller may reuse them, e.g. for runs
+// that differ only in the orientation). Films are compared by their parameters, every other
+// effect by its identity (an effect made afresh gives another key). Empty without a film.
+std::string film_balance_key(const plant::PlantConfig& with_films, const vibration::SineVibration& v, const PeriodicInput& in);
 
 // The same two predictions split in two (for a caller that varies the coefficients only, such
 // as a prediction's gradient in them): what does not depend on the coefficients (the vibration

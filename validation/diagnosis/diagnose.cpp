@@ -197,13 +197,20 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
   const double p = values.empty() ? 0.0 : values.front();
   const int n = static_cast<int>(runs.size());
   Table t{Eigen::VectorXd(n), Eigen::MatrixXd(n, plant::kNumCoefficients)};
+  std::map<std::string, std::pair<PlantConfig, rectification::PeriodicInput>> film_memo;
   for (int k = 0; k < n; ++k) {
     const RunRecord& r = runs[static_cast<std::size_t>(k)];
     PlantConfig cfg = nominal;
     TableMotion m = table_motion(r);
     apply_effect(e, values, r, cfg, m);
     const PlantConfig with_films = cfg;
-    if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
+    // A film's linearisation and balance once per (plant, motion) in the table: runs that
+    // differ only in orientation share them (the same function of the same numbers).
+    const rectification::PeriodicInput motion = r.random ? rectification::PeriodicInput{} : run_input(r, m);
+    const std::string film_key = r.random ? std::string() : rectification::film_balance_key(with_films, m.sine, motion);
+    const auto memo = film_key.empty() ? film_memo.end() : film_memo.find(film_key);
+    if (memo != film_memo.end()) cfg = memo->second.first;
+    else if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
     // The loop responses depend on the effect's value and, for an amplitude-dependent one,
     // on the run: the key says both.
     std::string key;
@@ -216,9 +223,26 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
         key += buf;
       }
     }
-    const rectification::ResponseAt h = [&](double f) { return cache.get(cfg, key, f); };
-    const rectification::PeriodicInput input =
-        r.random ? rectification::PeriodicInput{} : rectification::film_harmonic_balance(with_films, cfg, run_input(r, m), h);
+    // A squeeze film's linearised plant is this run's own (its damping is in the key): its
+    // responses are kept for the run only, not in the cache (the same numbers: the plant
+    // linearised once, each frequency solved once).
+    const bool own = cfg.dynamics.pendulum_damping_ratio != with_films.dynamics.pendulum_damping_ratio && cfg.servo;
+    std::optional<rectification::LoopResponder> own_responder;
+    std::map<double, rectification::LoopResponse> own_responses;
+    const rectification::ResponseAt h = [&](double f) {
+      if (!own) return cache.get(cfg, key, f);
+      auto it = own_responses.find(f);
+      if (it == own_responses.end()) {
+        if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+        if (!own_responder) own_responder.emplace(cfg);
+        it = own_responses.emplace(f, (*own_responder)(f)).first;
+      }
+      return it->second;
+    };
+    const rectification::PeriodicInput input = r.random                  ? rectification::PeriodicInput{}
+                                               : memo != film_memo.end() ? memo->second.second
+                                                                         : rectification::film_harmonic_balance(with_films, cfg, motion, h);
+    if (!film_key.empty() && memo == film_memo.end()) film_memo.emplace(film_key, std::make_pair(cfg, input));
     // A random or sine-on-random run: the random part's covariances through the loop, once.
     std::optional<rectification::RandomResponse> rr;
     std::optional<vibration::SineVibration> sine;
