@@ -82,7 +82,7 @@ inline bool harmonic_ratio(const std::string& name, ParameterValues p, std::stri
 inline EffectParameter harmonic_phase(const std::string& name) {
   EffectParameter q(name, "rad");
   q.nominal = 0, q.lower = -std::numbers::pi, q.upper = std::numbers::pi, q.example = std::numbers::pi / 2;
-  q.periodic = true, q.step = 1e-3;
+  q.periodic = true, q.step = 2e-2;
   q.starts = {0, std::numbers::pi / 2, -std::numbers::pi, -std::numbers::pi / 2};
   return q;
 }

@@ -1,0 +1,85 @@
+// The natural-form misses of blind's fresh seeds 8601 and 8701 (session 7), each campaign
+// replayed exactly as `blind` makes it (run_blind with every other campaign of the draw read
+// back from a result line, so only this one is simulated on the ODE plant through the effects'
+// truth hooks and diagnosed): the truth is the key's, never the diagnosis' hypothesis.
+// Each diagnoses a 168-run campaign (20-40 s in Release): label "campaign".
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numbers>
+#include <string>
+
+#include "validation/diagnosis/blind.hpp"
+
+using namespace vrelab;
+using namespace vrelab::validation;
+
+namespace {
+
+// Campaign `index` of blind's draw `seed`, simulated and diagnosed as blind does; the others
+// read back as clean (not simulated).
+BlindResult replay(std::uint64_t seed, int index) {
+  BlindSettings s;
+  s.n = index + 1, s.seed = seed, s.threads = 1;
+  std::map<int, std::string> done;
+  for (int i = 0; i < index; ++i) {
+    BlindCampaign k = blind_key(i, seed);
+    k.called = "clean";
+    EffectFit e;
+    e.name = "pickoff_nonlinearity";
+    k.diagnosis.effects = {e};
+    k.top = e.name;
+    done[i] = campaign_result_text(k);
+  }
+  return run_blind(s, {}, done, {});
+}
+
+const FittedParameter& parameter(const EffectFit& e, const std::string& name) {
+  for (const FittedParameter& q : e.parameters)
+    if (q.name == name) return q;
+  throw std::logic_error(e.name + " has no parameter " + name);
+}
+
+}  // namespace
+
+// Seed 8601, campaign 19: a 3rd harmonic, ratio 0.1855 at 0.143 rad. Its phase was reported
+// 0.219 +- 0.0094 rad (7.6 sigma off) although -2 ln L at the truth was 0.29 above the
+// minimum: the sigma came from second differences over a 1e-3 rad step, below the
+// simulation's rounding in -2 ln L. With the objective's Hessian over steps the likelihood
+// resolves, the phase's sigma is what -2 ln L says (~0.3 rad) and the truth lies within 3 sigma.
+TEST(NaturalMisses, AThirdHarmonicsPhaseSigmaIsWhatTheLikelihoodSays) {
+  const BlindResult r = replay(8601, 19);
+  const BlindCampaign& k = r.campaigns.at(19);
+  ASSERT_EQ(k.category, "natural");
+  ASSERT_EQ(k.hidden.at(0).name, "shaker_third_harmonic");
+  const Diagnosis& d = k.diagnosis;
+  std::printf("  %s\n", d.verdict.c_str());
+  ASSERT_EQ(d.effects.front().name, "shaker_third_harmonic");
+  const FittedParameter& phase = parameter(d.effects.front(), "third_harmonic_phase_rad");
+  const double truth = k.hidden[0].form.at(0);
+  std::printf("  phase %.4f +- %.4f rad (truth %.4f)\n", phase.value, phase.sigma, truth);
+  EXPECT_EQ(phase.status, "fitted");
+  EXPECT_LE(std::abs(std::remainder(phase.value - truth, 2 * std::numbers::pi)), 3 * phase.sigma);
+  // -2 ln L rises by 0.13 over +-0.1 rad about the minimum (the profile, printed while
+  // developing this): a sigma below 0.05 rad would contradict it.
+  EXPECT_GT(phase.sigma, 0.05);
+  EXPECT_EQ(r.scores.families.at("natural").right, 1);
+}
+
+// Seed 8701, campaign 43: a 3rd harmonic, ratio 0.2317 at 2.255 rad, was called "not
+// explained": on the fold that leaves 2 g out, Levenberg-Marquardt from the best start (0 rad)
+// ended in the phase's other valley (0.30 rad, 36 above the one at 2.3 rad that the start at
+// pi/2 leads to), and the held-out 2 g runs failed it. Every start within 25 of the best now
+// descends; the lowest wins.
+TEST(NaturalMisses, AThirdHarmonicsPhaseIsFoundFromEveryStartOnEveryFold) {
+  const BlindResult r = replay(8701, 43);
+  const BlindCampaign& k = r.campaigns.at(43);
+  ASSERT_EQ(k.category, "natural");
+  const Diagnosis& d = k.diagnosis;
+  std::printf("  %s; held-out chi2 %.1f\n", d.verdict.c_str(), d.effects.front().heldout_chi2);
+  EXPECT_TRUE(d.explained);
+  EXPECT_EQ(d.chosen, "shaker_third_harmonic");
+  EXPECT_EQ(r.scores.families.at("natural").right, 1);
+}
