@@ -109,6 +109,13 @@ TEST(NaturalBlind, ParametersAreScoredWithinThreeSigma) {
   EXPECT_TRUE(parameters_match(HiddenEffect("shaker_harmonic_distortion", 0.21, {3.1}), h, &why)) << why;
   h.effects[0].parameters[1].value = 2.9;
   EXPECT_FALSE(parameters_match(HiddenEffect("shaker_harmonic_distortion", 0.21, {3.1}), h, &why));
+  // A phase +- 1.1 rad (3 sigma over pi: within 3 sigma of any truth) claims nothing: not
+  // judged, said as not pinned; +- 1.0 rad (3 sigma under pi) is judged, 3.1 rad off: wrong.
+  h.effects[0].parameters[1] = {"second_harmonic_phase_rad", "rad", 0.0, 1.1, "fitted"};
+  EXPECT_TRUE(parameters_match(HiddenEffect("shaker_harmonic_distortion", 0.21, {3.1}), h, &why)) << why;
+  EXPECT_NE(why.find("second_harmonic_phase_rad not pinned"), std::string::npos) << why;
+  h.effects[0].parameters[1].sigma = 1.0;
+  EXPECT_FALSE(parameters_match(HiddenEffect("shaker_harmonic_distortion", 0.21, {3.1}), h, &why));
 }
 
 // The result line carries the top effect's parameters, read back exactly; cut short, refused.

@@ -186,8 +186,12 @@ bool match_parameters(const HiddenEffect& h, const Diagnosis& d, std::string* of
         *off = fmt::format("{} {} {:.4g}, truth {:.4g}", q.name, q.status, q.value, truth[i]);
         return false;
       }
-    } else if (q.status == "held") {
-      held += fmt::format("{}{} held at {:.4g} (truth {:.4g})", held.empty() ? "" : ", ", q.name, q.value, truth[i]);
+    } else if (q.status == "held" || (e->parameters[i].periodic && !(3 * q.sigma < std::numbers::pi))) {
+      // A phase with 3 sigma over half the circle claims nothing: not judged, said (as held).
+      held += q.status == "held"
+                  ? fmt::format("{}{} held at {:.4g} (truth {:.4g})", held.empty() ? "" : ", ", q.name, q.value, truth[i])
+                  : fmt::format("{}{} not pinned: {:.4g} +- {:.2g} (truth {:.4g})", held.empty() ? "" : ", ", q.name,
+                                q.value, q.sigma, truth[i]);
     } else if (q.status == "chosen") {
       if (diff != 0) {
         *off = fmt::format("{} chosen {:.4g}, truth {:.4g}", q.name, q.value, truth[i]);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <limits>
 #include <tuple>
 #include <memory>
 #include <set>
@@ -506,18 +507,23 @@ class EffectFitter {
         res.cov = covariance_at(d, idx, v, fr, res.slopes);
         // The Hessian's sigma judged like the Gauss-Newton one (step 4): a further parameter
         // whose sigma is not below its prior width is not pinned (a phase level over the circle).
+        // So is one whose variance is not a positive number, and every further one when the
+        // Hessian was never positive definite (the Gauss-Newton fallback then understates it).
         std::vector<int> loose;
-        for (std::size_t a = 1; a < fr.size(); ++a)
-          if (!(std::sqrt(std::max(0.0, res.cov(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a)))) <
-                e_.parameters[static_cast<std::size_t>(fr[a])].prior_width()))
+        for (std::size_t a = 1; a < fr.size(); ++a) {
+          const double var = res.cov(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a));
+          if (cov_never_definite_ || !(var > 0) ||
+              !(std::sqrt(var) < e_.parameters[static_cast<std::size_t>(fr[a])].prior_width()))
             loose.push_back(fr[a]);
+        }
         if (!loose.empty()) {
           for (int j : loose) fr.erase(std::find(fr.begin(), fr.end(), j));
           continue;
         }
         for (std::size_t a = 0; a < fr.size(); ++a) {
           res.status[static_cast<std::size_t>(fr[a])] = "fitted";
-          res.sigma[static_cast<std::size_t>(fr[a])] = std::sqrt(std::max(0.0, res.cov(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a))));
+          const double var = res.cov(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a));
+          res.sigma[static_cast<std::size_t>(fr[a])] = var > 0 ? std::sqrt(var) : std::numeric_limits<double>::quiet_NaN();
         }
         return true;
       }
@@ -727,7 +733,9 @@ class EffectFitter {
   Eigen::MatrixXd covariance_at(const Data& d, const std::vector<int>& idx, const std::vector<double>& v,
                                 const std::vector<int>& free, const Eigen::MatrixXd& slopes) const {
     const Eigen::Index k = static_cast<Eigen::Index>(free.size());
-    const Eigen::MatrixXd fallback = last_info_.rows() == k ? Eigen::MatrixXd(last_info_.inverse()) : Eigen::MatrixXd::Zero(k, k);
+    cov_never_definite_ = false;
+    const Eigen::MatrixXd fallback = last_info_.rows() == k ? Eigen::MatrixXd(last_info_.inverse())
+                                                            : Eigen::MatrixXd::Constant(k, k, std::numeric_limits<double>::quiet_NaN());
     Eigen::MatrixXd A;
     try {
       const Table t = at(v);
@@ -786,6 +794,7 @@ class EffectFitter {
       const Eigen::LLT<Eigen::MatrixXd> llt(H / 2);
       if (llt.info() == Eigen::Success) return llt.solve(Eigen::MatrixXd::Identity(k, k));
     }
+    cov_never_definite_ = true;
     return fallback;
   }
   // Levenberg-Marquardt on -2 ln L + the further parameters' priors over `free`, from v.
@@ -965,6 +974,7 @@ class EffectFitter {
   mutable std::map<double, Table> extra_;
   std::vector<double> nominal_values_;
   mutable std::map<std::vector<double>, Table> tables_;
+  mutable bool cov_never_definite_ = false;  // covariance_at's Hessian never positive definite
   mutable Eigen::MatrixXd last_info_;  // levenberg_marquardt's information matrix at its last point
 };
 
