@@ -800,19 +800,7 @@ class EffectFitter {
   // Levenberg-Marquardt on -2 ln L + the further parameters' priors over `free`, from v.
   std::vector<double> levenberg_marquardt(const Data& d, const std::vector<int>& idx, std::vector<double> v,
                                           const std::vector<int>& free) const {
-    const auto objective = [&](const std::vector<double>& w) {
-      try {
-        const Table t = at(w);
-        double f = likelihood(d, t.pred, t.G, idx).m2logl;
-        for (std::size_t a = 1; a < free.size(); ++a) {
-          const EffectParameter& q = e_.parameters[static_cast<std::size_t>(free[a])];
-          f += prior_weight(free[a]) * std::pow(w[static_cast<std::size_t>(free[a])] - q.nominal, 2);
-        }
-        return f;
-      } catch (const std::invalid_argument&) {
-        return static_cast<double>(INFINITY);
-      }
-    };
+    const auto objective = [&](const std::vector<double>& w) { return objective_at(d, idx, w, free); };
     const Eigen::Index k = static_cast<Eigen::Index>(free.size());
     double f = objective(v), lambda = 1e-3;
     for (int it = 0; it < 15; ++it) {
