@@ -24,6 +24,7 @@
 
 #include "plant/effects/effects.hpp"
 #include "rectification/simulation/shake.hpp"
+#include "bench/gevs.hpp"
 #include "vibration/sampled.hpp"
 
 using namespace vrelab;
@@ -74,12 +75,7 @@ BENCHMARK(SineConditionLogSweep)->Arg(1)->Arg(0)->Iterations(3)->Unit(benchmark:
 // 0 = CVODE (the path before); state.range(1): seconds measured.
 void RandomGevs20kHz(benchmark::State& state) {
   const plant::PlantConfig cfg = default_plant();
-  vibration::RandomProfile p;
-  vibration::PsdTable t;
-  t.rows = {vibration::PsdRow::level(20, 0.026), vibration::PsdRow::level(50, 0.16),
-            vibration::PsdRow::level(800, 0.16), vibration::PsdRow::level(2000, 0.026)};
-  p.psd[IA] = t;
-  const vibration::RandomExcitation ex(p, 16000, 1);
+  const vibration::RandomExcitation ex(bench::gevs_along_ia(), 16000, 1);
   rectification::ShakeSettings s;
   s.relative_tolerance = 1e-4;
   s.readout.sample_rate_Hz = 20000;
@@ -114,12 +110,7 @@ void CvodeJacobian(benchmark::State& state) {
   s.analytic_jacobian = state.range(1) != 0;
   s.periodic_steady_state = false;
   double cpu_ms = 0, rhs = 0, steps = 0, runs = 0;
-  vibration::RandomProfile p;
-  vibration::PsdTable t;
-  t.rows = {vibration::PsdRow::level(20, 0.026), vibration::PsdRow::level(50, 0.16),
-            vibration::PsdRow::level(800, 0.16), vibration::PsdRow::level(2000, 0.026)};
-  p.psd[IA] = t;
-  const vibration::RandomExcitation ex(p, 16000, 1);
+  const vibration::RandomExcitation ex(bench::gevs_along_ia(), 16000, 1);
   for (auto _ : state) {
     const double t0 = thread_cpu_ms();
     rectification::ShakeResult r;

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "rectification/simulation/shake.hpp"
+#include "bench/gevs.hpp"
 #include "vibration/sampled.hpp"
 
 using namespace vrelab;
@@ -33,12 +34,7 @@ int main(int argc, char** argv) {
   const int idx[] = {plant::K1, plant::k0, plant::k1_asym, plant::k2, plant::k3, plant::k4, plant::delta_OA,
                      plant::delta_PA, plant::k_IP, plant::k_IO, plant::k_PO, plant::k_PP, plant::k_OO};
   for (int i = 0; i < 13; ++i) cfg.coefficients[idx[i]] = c[i];
-  vibration::RandomProfile p;
-  vibration::PsdTable t;
-  t.rows = {vibration::PsdRow::level(20, 0.026), vibration::PsdRow::level(50, 0.16),
-            vibration::PsdRow::level(800, 0.16), vibration::PsdRow::level(2000, 0.026)};
-  p.psd[IA] = t;
-  const vibration::RandomExcitation ex(p, 16000, 1);
+  const vibration::RandomExcitation ex(bench::gevs_along_ia(), 16000, 1);
   const Vec3 a(0.5, std::sqrt(0.75), 0);
   auto run = [&](bool exponential, double rtol) {
     rectification::ShakeSettings s;
