@@ -83,3 +83,35 @@ TEST(NaturalMisses, AThirdHarmonicsPhaseIsFoundFromEveryStartOnEveryFold) {
   EXPECT_EQ(d.chosen, "shaker_third_harmonic");
   EXPECT_EQ(r.scores.families.at("natural").right, 1);
 }
+
+// Seed 8801, campaign 7: a 3rd harmonic, ratio 0.1322 at 2.327 rad, fitted 0.1445 at 1.940 rad
+// (the Hessian's sigma 0.0064 and 0.27 rad) but reported +- 0.033 and +- 11.7 rad: the
+// hypothesis' accuracy term was the first-order shift C J^T V^-1 f Delta, whose Gauss-Newton
+// slopes J overstate the phase's curvature hundredfold against the Hessian's C. Two refits of
+// the data shifted by +-f Delta move the phase by ~0.01 rad and the ratio by ~0.006 (the
+// effect's change is not linear in the ratio at this phase): the sigma claims something (3
+// sigma of the phase below pi, the ratio's sigma below its prior width) and the truth lies
+// within 3 sigma (1.4 sigma each, printed while developing this).
+TEST(NaturalMisses, AThirdHarmonicsSigmaWithTheHypothesisAccuracyClaimsSomething) {
+  const BlindResult r = replay(8801, 7);
+  const BlindCampaign& k = r.campaigns.at(7);
+  ASSERT_EQ(k.category, "natural");
+  ASSERT_EQ(k.hidden.at(0).name, "shaker_third_harmonic");
+  const Diagnosis& d = k.diagnosis;
+  std::printf("  %s\n", d.verdict.c_str());
+  ASSERT_EQ(d.effects.front().name, "shaker_third_harmonic");
+  const FittedParameter& ratio = parameter(d.effects.front(), "third_harmonic_ratio");
+  const FittedParameter& phase = parameter(d.effects.front(), "third_harmonic_phase_rad");
+  const double ratio_truth = k.hidden[0].parameter, phase_truth = k.hidden[0].form.at(0);
+  std::printf("  ratio %.4f +- %.4f (truth %.4f), phase %.4f +- %.4f rad (truth %.4f)\n", ratio.value, ratio.sigma,
+              ratio_truth, phase.value, phase.sigma, phase_truth);
+  ASSERT_EQ(phase.status, "fitted");
+  EXPECT_LT(3 * phase.sigma, std::numbers::pi);
+  EXPECT_LE(std::abs(std::remainder(phase.value - phase_truth, 2 * std::numbers::pi)), 3 * phase.sigma);
+  // The ratio (the first parameter) has no prior: a quarter of its grid (0 to 0.5) is what a
+  // further parameter's width would be, 0.125; the bar is tighter (the Hessian's sigma 0.0064).
+  EXPECT_LT(ratio.sigma, 0.05);
+  EXPECT_LE(std::abs(ratio.value - ratio_truth), 3 * ratio.sigma);
+  // The hypothesis' 1 % is in the ratio's sigma: at least f times the ratio.
+  EXPECT_GE(ratio.sigma, 0.01 * ratio.value);
+}
