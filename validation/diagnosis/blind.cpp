@@ -263,6 +263,9 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
     key += fmt::format(" {} = {:.4g}", h.name, h.parameter);
     for (double x : h.form) key += fmt::format(", {:.4g}", x);
   }
+  if (k.category == "single" || k.category == "natural")
+    key += fmt::format(" (its gap {:.1f} sigma as the nominal model sees it, {:.1f} in the largest run)", k.effect_gap_sigma,
+                       k.effect_max_sigma);
   if (k.category == "sigma_understated") key += fmt::format(" (scatter x{:.2f})", k.noise_scale);
   if (k.category == "dynamics_off")
     key += fmt::format(" (manifest: crossover x{:.3f}, pendulum x{:.3f}, margin {:+.1f} deg)", k.manifest_crossover_ratio,
