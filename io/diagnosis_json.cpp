@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <string>
 
 #include <fmt/format.h>
 
@@ -107,7 +109,12 @@ json campaign_row(const validation::BlindCampaign& k) {
   }
   json row = {{"index", k.index}, {"seed", k.seed},           {"category", k.category}, {"hidden", h},
               {"called", k.called}, {"simulate_s", k.simulate_s}, {"wall_s", k.wall_s}};
-  if (k.category == "single" || k.category == "natural") row["effect_max_sigma"] = k.effect_max_sigma;
+  if (k.category == "single" || k.category == "natural") {
+    row["effect_gap_sigma"] = finite_or_null(k.effect_gap_sigma);  // the scored size
+    row["effect_max_sigma"] = k.effect_max_sigma;                   // the old size, beside
+  }
+  row["gap_rms_before_g"] = finite_or_null(k.gap_rms_before_g);  // held out, the lab's noise removed
+  row["gap_rms_after_g"] = finite_or_null(k.gap_rms_after_g);
   if (k.category == "sigma_understated") row["noise_scale"] = k.noise_scale;
   if (k.category == "drift") row["drift_ug_per_h"] = k.drift_g_per_h * 1e6;
   if (k.category == "dynamics_off")
@@ -132,9 +139,9 @@ json campaign_row(const validation::BlindCampaign& k) {
   return row;
 }
 
-json families_json(const validation::BlindScores& s) {
+json families_json(const std::map<std::string, validation::FamilyScore>& families) {
   json j = json::object();
-  for (const auto& [name, f] : s.families)
+  for (const auto& [name, f] : families)
     j[name] = {{"n", f.n},         {"right", f.right},         {"right_physics", f.family}, {"unexplained", f.unexplained},
                {"no_gap", f.no_gap}, {"confidently_wrong", f.wrong}, {"ambiguous", f.ambiguous},   {"ambiguous_right_among", f.right_among},
                {"error", f.error}, {"right_effect_parameters_off", f.parameters_off}};
@@ -368,9 +375,22 @@ json to_json(const validation::BlindResult& r) {
           {"two_effect_explained_by_one_of_them", BlindScores::rate(s.two_by_one, s.two)},
           {"two_effect_explained_by_both", BlindScores::rate(s.two_by_both, s.two)},
           {"two_effect_campaigns", s.two},
+          {"family_size", "effect_gap_sigma: sqrt(g^T V^-1 g), the effect's gap as the nominal model sees it against the "
+                          "diagnosis' covariance (static-test coefficient uncertainty included); scored when >= 5"},
+          {"median_gap_shrinkage_noise_removed", s.median_gap_shrinkage},
+          {"gap_shrinkage_campaigns", s.gap_shrinkage_campaigns},
           {"median_shrinkage", s.median_shrinkage},
           {"median_shrinkage_in_sigma", s.median_shrinkage_in_sigma},
-          {"families", families_json(s)},
+          {"families", families_json(s.families)},
+          {"old_family_size_max_run_sigma",
+           {{"family_size", "effect_max_sigma: the largest |with - without| of any run over its sigma; scored when >= 5"},
+            {"top1_accuracy", BlindScores::rate(s.by_max_run_sigma.single_right, s.by_max_run_sigma.single)},
+            {"single_effect_campaigns", s.by_max_run_sigma.single},
+            {"single_effect_campaigns_below_5_sigma", s.by_max_run_sigma.small},
+            {"single_below_5_sigma_explained_right", s.by_max_run_sigma.small_right},
+            {"median_shrinkage", s.by_max_run_sigma.median_shrinkage},
+            {"median_shrinkage_in_sigma", s.by_max_run_sigma.median_shrinkage_in_sigma},
+            {"families", families_json(s.by_max_run_sigma.families)}}},
           {"wrong", r.wrong},
           {"confusion", r.confusion},
           {"campaigns", rows}};
@@ -434,7 +454,39 @@ std::string blind_html(const validation::BlindResult& r) {
                      "<td class=\"{}\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
                      html_escape(name), f.n, f.right, f.family, f.unexplained, f.no_gap, f.wrong ? "bad" : "", f.wrong,
                      f.ambiguous, f.right_among, f.error, f.parameters_off);
-  h += "</table>\n<h2>Confusion matrix</h2>\n<p>Rows: the hidden truth; columns: what diagnose called it (without the key).</p>\n";
+  h += "</table>\n";
+  {
+    // The two family sizes and the two shrinkages side by side (docs/diagnose.md, "Blind scoring").
+    const validation::BlindScores& s = r.scores;
+    const validation::OldSizeScores& o = s.by_max_run_sigma;
+    const auto fam = [](const std::map<std::string, validation::FamilyScore>& m, const std::string& name) {
+      const auto it = m.find(name);
+      return it == m.end() ? std::string("0/0") : fmt::format("{}/{}", it->second.right, it->second.n);
+    };
+    const auto n_of = [](const std::map<std::string, validation::FamilyScore>& m, const std::string& name) {
+      const auto it = m.find(name);
+      return it == m.end() ? 0 : it->second.n;
+    };
+    h += "<h2>Family size and shrinkage: the scored measures and the old ones</h2>\n<p>A single or natural campaign is "
+         "scored when the gap its effect makes is &ge; 5&sigma; as the diagnosis' nominal model sees it: sqrt(g<sup>T</sup> "
+         "V<sup>-1</sup> g), g the nominal gap with the effect less without it (the virtual lab, the same noise draws), V the "
+         "diagnosis' covariance of the runs with the static test's coefficient uncertainty (<code>effect_gap_sigma</code>). "
+         "The old size was the largest run's |with - without| over its &sigma; (<code>effect_max_sigma</code>). The "
+         "shrinkage of the gap is of the held-out residuals with each run's noise draw (and the lab log's drift and "
+         "scatter, less the drift line removed) taken out; the old one kept the noise.</p>\n";
+    h += "<table><tr><th class=\"l\">measure</th><th>scored (gap as the lab sees it)</th><th>old (largest run)</th></tr>\n";
+    h += fmt::format("<tr><td class=\"l\">single, right effect</td><td>{}</td><td>{}</td></tr>\n", fam(s.families, "single"),
+                     fam(o.families, "single"));
+    h += fmt::format("<tr><td class=\"l\">natural, right effect (parameters within 3&sigma;)</td><td>{}</td><td>{}</td></tr>\n",
+                     fam(s.families, "natural"), fam(o.families, "natural"));
+    h += fmt::format("<tr><td class=\"l\">single / natural below 5&sigma; (not scored)</td><td>{} / {}</td><td>{} / {}</td></tr>\n",
+                     n_of(s.families, "single_below_5_sigma"), n_of(s.families, "natural_below_5_sigma"),
+                     n_of(o.families, "single_below_5_sigma"), n_of(o.families, "natural_below_5_sigma"));
+    h += fmt::format("<tr><td class=\"l\">median held-out shrinkage, single</td><td>{:.0f} % of the gap (noise removed; "
+                     "with the noise {:.0f} %)</td><td>{:.0f} % of the residuals with the noise</td></tr>\n</table>\n",
+                     100 * s.median_gap_shrinkage, 100 * s.median_shrinkage, 100 * o.median_shrinkage);
+  }
+  h += "<h2>Confusion matrix</h2>\n<p>Rows: the hidden truth; columns: what diagnose called it (without the key).</p>\n";
   std::vector<std::string> called;
   for (const auto& [t, row] : r.confusion)
     for (const auto& [c, k] : row)

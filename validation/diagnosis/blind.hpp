@@ -18,14 +18,18 @@
 // (3 min a run, in the design's order) and a rest reading before each (sigma 0.3 ug), as a
 // lab's log would. The nuisances are the lab's data acquisition's: applied to the runs'
 // summaries, not to the physics (which stays the ODE's).
-// A single effect whose own gap (the first-order simulation with it - without it, on the
-// truth's coefficients) stays below 5 sigma in every run is reported, not scored.
+// A single effect (or a natural form) whose gap, as the diagnosis' nominal model sees it, is
+// below 5 sigma (effect_gap_sigma) is reported, not scored; the old size (the largest run's
+// gap in its own sigma, effect_max_sigma) is scored beside it (BlindScores::by_max_run_sigma).
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <map>
 #include <random>
+#include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "validation/diagnosis/campaign.hpp"
@@ -57,12 +61,22 @@ struct BlindCampaign {
   std::string called;    // clean, <effect>, "<A> + <B>", unexplained, or error
   std::string top;       // the effect ranked first ("" on error)
   double simulate_s = 0, wall_s = 0;  // the campaign's simulation; with its diagnosis
-  // A single effect's own gap: the largest |simulation with it - without it| over the runs
-  // (the first-order model on the truth's coefficients), in that run's sigma. Top-1 is scored
-  // on those >= 5 sigma somewhere. (The static test's coefficient errors can still take up
-  // most of such a gap; V's diagonal is the wrong yardstick for it: the diagnosis sees effects
-  // through the runs' correlations.)
+  // A single effect's (or natural form's) size, through the ODE (the virtual lab with the
+  // effect and without it, the same noise draws), never through the diagnosis' hypotheses.
+  // effect_gap_sigma (the scored size): sqrt(g^T V^-1 g), the gap g as the diagnosis' nominal
+  // model sees it (less what the static test takes up) against the covariance V it judges the
+  // runs by (nominal_gap_significance): the separation of the best test of a known-shape gap.
+  // Scored (single, natural) when >= 5. NaN: not computed (other families; an error).
+  // effect_max_sigma (the old size, reported beside it): the largest |with - without| over
+  // the runs in that run's sigma; it ignores what the coefficients' uncertainty can absorb.
   double effect_max_sigma = 0;
+  double effect_gap_sigma = NAN;
+  // The held-out gap rms without the lab's noise (the noise-free shrinkage's two terms, g):
+  // the diagnosis' held-out residuals before (nominal) and after (the chosen effect) less
+  // what the virtual lab added to each run beyond the ODE (its noise draw; the drift and the
+  // extra scatter of the lab log) plus the drift line the diagnosis removed. NaN: not known
+  // (an error; a result line without them).
+  double gap_rms_before_g = NAN, gap_rms_after_g = NAN;
 };
 
 // One family's outcomes (a campaign counts in exactly one of right .. wrong, error apart):
@@ -82,14 +96,28 @@ struct FamilyScore {
   int parameters_off = 0;
 };
 
+// The families sized the old way (a single or natural campaign below 5 sigma in every run,
+// effect_max_sigma, is "_below_5_sigma"), kept beside the scored ones (effect_gap_sigma).
+struct OldSizeScores {
+  int single = 0, single_right = 0, small = 0, small_right = 0;
+  double median_shrinkage = 0, median_shrinkage_in_sigma = 0;  // with the runs' noise, its single family
+  std::map<std::string, FamilyScore> families;
+};
+
 struct BlindScores {
-  int single = 0, single_right = 0;  // scored single in-library effects; called right ("explained by" it)
+  int single = 0, single_right = 0;  // scored single in-library effects (gap >= 5 sigma); called right ("explained by" it)
   int single_top_right = 0;          // ... ranked first whatever the verdict
-  int small = 0, small_right = 0;    // single effects below 5 sigma in every run (not scored); called right anyway
+  int small = 0, small_right = 0;    // single effects with a gap below 5 sigma (not scored); called right anyway
   int clean = 0, false_alarms = 0;
   int out_of_library = 0, out_of_library_unexplained = 0;
   int two = 0, two_by_one = 0, two_by_both = 0;
-  double median_shrinkage = 0, median_shrinkage_in_sigma = 0;  // held-out gap rms, single effects
+  // The held-out shrinkage 1 - rms_after / rms_before, median over the scored single family:
+  // of the gap itself (the lab's noise removed: gap_rms_*_g), the measure, and of the
+  // residuals as the diagnosis sees them (with each run's noise; in g and in each run's sigma).
+  double median_gap_shrinkage = 0;
+  int gap_shrinkage_campaigns = 0;  // single campaigns it is the median of
+  double median_shrinkage = 0, median_shrinkage_in_sigma = 0;
+  OldSizeScores by_max_run_sigma;  // the old family size, beside
   std::map<std::string, FamilyScore> families;  // per family (category)
   static double rate(int k, int of) { return of ? static_cast<double>(k) / of : 0.0; }
 };
@@ -129,6 +157,17 @@ BlindCampaign blind_key(int index, std::uint64_t seed);
 // lists the held ones.
 bool parameters_match(const HiddenEffect& truth, const Diagnosis& d, std::string* why);
 
+// The held-out gap's rms before (nominal) and after (the chosen effect), g, without the lab's
+// noise. gap_before_g: each run's held-out nominal residual of the campaign with what the
+// virtual lab added beyond the ODE taken out (heldout_nominal_gap_g of it: its noise draw,
+// simulate_campaign's run_noise_g; the lab log's drift and extra scatter). That residual is
+// affine in the measured values, so d.runs[k].heldout_before_g - gap_before_g[k] is the noise's
+// held-out image (the run's own noise and what the other runs' noise moved the coefficients'
+// correction by); it is taken out of the residual after the effect too. What the noise moved
+// the effect's fitted parameters by stays in (the diagnosis' own error, part of the gap it
+// leaves). Throws std::invalid_argument when the sizes differ or there are no runs.
+std::pair<double, double> gap_rms_without_lab_noise(const Diagnosis& d, const std::vector<double>& gap_before_g);
+
 // Invalid settings throw std::invalid_argument naming the key. A campaign whose simulation or
 // diagnosis fails is kept with its error (called "error").
 BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progress = {});
@@ -145,6 +184,12 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
 // What the diagnosis found for campaign k (not its key, which the draw gives), as one line of
 // text (no newline; numbers to 17 digits: read back exactly), and back into a drawn campaign.
 // read_campaign_result throws std::invalid_argument for a line it cannot read.
+// A line written before the gap's size and noise-free rms were stored (effect_gap_sigma,
+// gap_rms_*_g) throws OutdatedCampaignResult: run_blind diagnoses that campaign again rather
+// than score it without them.
+struct OutdatedCampaignResult : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
 std::string campaign_result_text(const BlindCampaign& k);
 void read_campaign_result(const std::string& text, BlindCampaign& k);
 

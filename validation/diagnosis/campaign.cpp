@@ -83,7 +83,7 @@ VirtualLab truth_lab(const plant::PlantConfig& truth, const std::vector<HiddenEf
 
 Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
                            const CampaignDesign& design, std::uint64_t seed, int threads,
-                           const std::function<void()>& run_done) {
+                           const std::function<void()>& run_done, std::vector<double>* run_noise_g) {
   for (const auto& h : hidden) validate(h);
   Campaign c;
   c.dynamics = truth.dynamics;
@@ -166,6 +166,10 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
   });
   for (std::size_t k = 0; k < failures.size(); ++k)
     if (!failures[k].empty()) throw std::runtime_error("campaign: " + c.runs[k].id + ": " + failures[k]);
+  if (run_noise_g) {
+    run_noise_g->resize(c.runs.size());
+    for (std::size_t k = 0; k < c.runs.size(); ++k) (*run_noise_g)[k] = raw ? NAN : c.runs[k].sigma_g * noise[k];
+  }
   return c;
 }
 

@@ -72,8 +72,11 @@ bool is_out_of_library(const std::string& name);
 void validate(const HiddenEffect& h);
 
 // threads: 0 all cores. run_done, when given, is called (under a lock) after each shaker run.
+// run_noise_g, when given, receives each run's added noise (g, sigma_g x its normal draw:
+// measured_g is the ODE's plus it), the virtual lab's own knowledge (blind's noise-free
+// shrinkage); NaN for runs recorded raw (their noise is the readout's, per sample).
 Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
                            const CampaignDesign& design, std::uint64_t seed, int threads = 1,
-                           const std::function<void()>& run_done = {});
+                           const std::function<void()>& run_done = {}, std::vector<double>* run_noise_g = nullptr);
 
 }  // namespace vrelab::validation

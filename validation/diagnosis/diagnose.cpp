@@ -1966,3 +1966,163 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
 }  // namespace
 
 }  // namespace vrelab::validation
+
+// ---------------------------------------------------------------------------------------------
+// Blind's family size and its shrinkage's drift line (validation/diagnosis/blind.cpp): the
+// nominal model only, never an effect hypothesis.
+namespace vrelab::validation {
+namespace {
+
+// A campaign as diagnose sees it before any hypothesis: the nominal simulation's gap
+// r = measured - predicted and the covariance V its runs are judged by.
+struct NominalView {
+  Eigen::VectorXd r;
+  Eigen::MatrixXd V;
+};
+
+// The same steps as diagnose (the drift line removed; the identification from the static
+// readings weighted by their sigma, with its first-order covariance; the nominal tabulation;
+// V = diag(sigma_run^2 + (model_accuracy pred)^2) + G Sigma G^T), the stated sigma taken as
+// it is (no sigma_scale: a family's size is judged with the runs' stated sigma).
+NominalView nominal_view(const Campaign& c0, const DiagnoseSettings& s) {
+  if (c0.statics.empty()) throw std::invalid_argument("nominal_gap_significance: the campaign has no static readings");
+  if (c0.runs.empty()) throw std::invalid_argument("nominal_gap_significance: the campaign has no shaker runs");
+  Campaign c = c0;
+  remove_drift(c);
+  std::vector<Position> positions;
+  std::vector<Reading> readings;
+  std::vector<double> weights;
+  ReadingBudget budget;
+  for (std::size_t i = 0; i < c.statics.size(); ++i) {
+    positions.push_back(vector_position(c.statics[i].orientation_g.normalized()));
+    readings.push_back({static_cast<int>(i), c.statics[i].output});
+    const double var = std::max(c.statics[i].sigma_output * c.statics[i].sigma_output, 1e-30);
+    weights.push_back(1 / var);
+    budget.variance.push_back(var);
+    budget.bias.push_back(0.0);
+  }
+  const LeastSquaresResult ls = least_squares(positions, readings, weights, c.fixed);
+  if (!ls.identifiability.full_rank())
+    throw std::invalid_argument("nominal_gap_significance: the static readings do not determine the free coefficients");
+  const Estimator est = [&](const std::vector<Reading>& r) { return least_squares(positions, r, weights, c.fixed).estimate; };
+  const Propagation unc = propagate_first_order(est, readings, budget);
+  PlantConfig plant;
+  plant.coefficients = ls.estimate.value;
+  plant.dynamics = c.dynamics;
+  ResponseCache cache;
+  const Table t = tabulate(plant, c.runs, nullptr, 0, cache, Absorbed{});
+  const int n = static_cast<int>(c.runs.size());
+  Data data;
+  data.measured.resize(n), data.sigma2.resize(n);
+  for (int k = 0; k < n; ++k) {
+    data.measured(k) = c.runs[static_cast<std::size_t>(k)].measured_g;
+    data.sigma2(k) = std::pow(c.runs[static_cast<std::size_t>(k)].sigma_g, 2) + std::pow(s.model_accuracy * t.pred(k), 2);
+  }
+  data.Sigma.resize(plant::kNumCoefficients, plant::kNumCoefficients);
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    for (int j = 0; j < plant::kNumCoefficients; ++j) data.Sigma(i, j) = unc.covariance[i][j];
+  std::vector<int> all(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) all[static_cast<std::size_t>(k)] = k;
+  return {data.measured - t.pred, covariance(data, t.G, all)};
+}
+
+}  // namespace
+
+// Why sqrt(g^T V^-1 g) >= 5 is the "a gap >= 5 sigma": with Gaussian errors of
+// covariance V, the most powerful test of "no gap" against "the gap g" (known shape and size,
+// Neyman-Pearson) is the statistic g^T V^-1 y / sqrt(g^T V^-1 g), distributed N(0, 1) without
+// the gap and N(sqrt(g^T V^-1 g), 1) with it: sqrt(g^T V^-1 g) is the gap's separation from
+// none in sigma of the best test there is, with the runs' correlations through the static
+// test's coefficients counted (a gap the coefficients can take up is no gap to any test).
+// The diagnosis' targeted test asks an effect's held-out evidence, the fall of -2 ln L it
+// brings, for more than significance_sigma^2 = 25; for a one-parameter effect of the true
+// shape that fall is (g^T V^-1 y)^2 / g^T V^-1 g, expected g^T V^-1 g + 1: a gap at 5 is the
+// one the diagnosis' own test finds about half the time, no yardstick asks for more. The
+// largest |g_k| / sigma_k of any one run (the old size) counts neither the take-up nor the
+// runs' joint power: a squeeze film 55 sigma in one run whose shape trades with k2/k3 is a few
+// sigma here; an effect below 5 sigma in every run but present in all is more.
+double nominal_gap_significance(const Campaign& with, const Campaign& without, const DiagnoseSettings& s) {
+  if (with.runs.size() != without.runs.size())
+    throw std::invalid_argument("nominal_gap_significance: the campaigns have different runs");
+  for (std::size_t k = 0; k < with.runs.size(); ++k) {
+    const RunRecord &a = with.runs[k], &b = without.runs[k];
+    if (a.frequency_Hz != b.frequency_Hz || a.amplitude_g != b.amplitude_g || a.direction != b.direction ||
+        a.orientation_g != b.orientation_g || a.sigma_g != b.sigma_g)
+      throw std::invalid_argument("nominal_gap_significance: run " + a.id + " differs between the campaigns");
+  }
+  const NominalView w = nominal_view(with, s), o = nominal_view(without, s);
+  const Eigen::VectorXd g = w.r - o.r;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(w.V);
+  return std::sqrt(std::max(0.0, g.dot(ldlt.solve(g))));
+}
+
+std::vector<double> heldout_nominal_gap_g(const Campaign& c0, const DiagnoseSettings& s, double sigma_scale) {
+  Campaign c = c0;
+  remove_drift(c);
+  for (RunRecord& r : c.runs) r.sigma_g *= sigma_scale;
+  const int n = static_cast<int>(c.runs.size());
+  // The nominal data again, as nominal_view builds them (V is the diagnosis').
+  std::vector<Position> positions;
+  std::vector<Reading> readings;
+  std::vector<double> weights;
+  ReadingBudget budget;
+  for (std::size_t i = 0; i < c.statics.size(); ++i) {
+    positions.push_back(vector_position(c.statics[i].orientation_g.normalized()));
+    readings.push_back({static_cast<int>(i), c.statics[i].output});
+    const double var = std::max(c.statics[i].sigma_output * c.statics[i].sigma_output, 1e-30);
+    weights.push_back(1 / var);
+    budget.variance.push_back(var);
+    budget.bias.push_back(0.0);
+  }
+  if (c.statics.empty() || c.runs.empty()) throw std::invalid_argument("heldout_nominal_gap_g: no static readings or no runs");
+  const LeastSquaresResult ls = least_squares(positions, readings, weights, c.fixed);
+  if (!ls.identifiability.full_rank())
+    throw std::invalid_argument("heldout_nominal_gap_g: the static readings do not determine the free coefficients");
+  const Estimator est = [&](const std::vector<Reading>& r) { return least_squares(positions, r, weights, c.fixed).estimate; };
+  const Propagation unc = propagate_first_order(est, readings, budget);
+  PlantConfig plant;
+  plant.coefficients = ls.estimate.value;
+  plant.dynamics = c.dynamics;
+  ResponseCache cache;
+  const Table t = tabulate(plant, c.runs, nullptr, 0, cache, Absorbed{});
+  Data data;
+  data.measured.resize(n), data.sigma2.resize(n);
+  for (int k = 0; k < n; ++k) {
+    data.measured(k) = c.runs[static_cast<std::size_t>(k)].measured_g;
+    data.sigma2(k) = std::pow(c.runs[static_cast<std::size_t>(k)].sigma_g, 2) + std::pow(s.model_accuracy * t.pred(k), 2);
+  }
+  data.Sigma.resize(plant::kNumCoefficients, plant::kNumCoefficients);
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    for (int j = 0; j < plant::kNumCoefficients; ++j) data.Sigma(i, j) = unc.covariance[i][j];
+  // diagnose's folds: leave one amplitude out; with one amplitude, one frequency; else none.
+  std::set<double> amplitudes, frequencies;
+  for (const auto& run : c.runs) amplitudes.insert(run.amplitude_g), frequencies.insert(run.frequency_Hz);
+  const bool by_amplitude = amplitudes.size() >= 2, by_frequency = !by_amplitude && frequencies.size() >= 2;
+  const auto fold_key = [&](int k) {
+    const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
+    return by_amplitude ? run.amplitude_g : by_frequency ? run.frequency_Hz : 0.0;
+  };
+  std::map<double, std::vector<int>> folds;
+  for (int k = 0; k < n; ++k) folds[fold_key(k)].push_back(k);
+  std::vector<double> h(static_cast<std::size_t>(n));
+  for (const auto& [key, test] : folds) {
+    std::vector<int> train;
+    for (int k = 0; k < n; ++k)
+      if (fold_key(k) != key) train.push_back(k);
+    if (train.empty())
+      for (int k = 0; k < n; ++k) train.push_back(k);
+    const Eigen::VectorXd a = adjusted_residual(data, t.pred, t.G, train, test);
+    for (std::size_t i = 0; i < test.size(); ++i) h[static_cast<std::size_t>(test[i])] = a(static_cast<Eigen::Index>(i));
+  }
+  return h;
+}
+
+std::vector<double> drift_line_removed_g(const Campaign& c0) {
+  Campaign c = c0;
+  remove_drift(c);
+  std::vector<double> line(c.runs.size());
+  for (std::size_t k = 0; k < c.runs.size(); ++k) line[k] = c0.runs[k].measured_g - c.runs[k].measured_g;
+  return line;
+}
+
+}  // namespace vrelab::validation

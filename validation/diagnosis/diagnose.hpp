@@ -244,4 +244,32 @@ struct Diagnosis {
 
 Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {});
 
+// The gap a hidden effect makes, as the diagnosis' nominal model sees it (blind's family size;
+// docs/diagnose.md, "Blind scoring"). `with` and `without` are one virtual-lab campaign
+// simulated with and without the effect from the same seed (the same noise draws, in the
+// static readings and in the runs). Each is seen as diagnose sees a campaign before any
+// effect hypothesis: its drift line removed, the coefficients identified from its own static
+// readings, the nominal simulation's gap r = measured - predicted. The effect's gap is
+// g = r_with - r_without (the noise cancels; what the static test took up of an effect that
+// acts at rest is out of it, as it is out of the gap the diagnosis sees), and its
+// significance sqrt(g^T V^-1 g), V the covariance diagnose judges `with`'s runs by
+// (each run's sigma^2 and (model_accuracy x prediction)^2, plus G Sigma G^T: the static
+// test's coefficient uncertainty through the nominal prediction). No effect hypothesis is
+// used. Throws std::invalid_argument when the campaigns' runs differ or the static readings
+// do not determine the coefficients.
+double nominal_gap_significance(const Campaign& with, const Campaign& without, const DiagnoseSettings& s = {});
+
+// Each run's held-out nominal residual as diagnose computes it (RunDiagnosis::heldout_before_g:
+// measured - predicted less the coefficients' correction from the other folds' runs; its
+// folds), for the campaign as given: its drift line removed as diagnose removes it, then each
+// run's sigma times sigma_scale (diagnose's sigma_scale when it applied one). The residual is
+// affine in the measured values: blind takes it of the campaign with the lab's noise taken out
+// (the gap's own held-out residual) and the difference from the diagnosis' is the noise's
+// held-out image, its own and through the coefficients' correction (docs/diagnose.md).
+std::vector<double> heldout_nominal_gap_g(const Campaign& c, const DiagnoseSettings& s = {}, double sigma_scale = 1);
+
+// What diagnose subtracts from each run's measured_g as the bias drift (the rest readings'
+// line at the run's time; 0 for a run without a time or when the line is not estimable), g.
+std::vector<double> drift_line_removed_g(const Campaign& c);
+
 }  // namespace vrelab::validation
