@@ -342,7 +342,14 @@ std::string film_balance_key(const PlantConfig& config, const vibration::SineVib
     return {};
   std::string key;
   const auto put = [&key](const auto& x) { key.append(reinterpret_cast<const char*>(&x), sizeof x); };
+  // Every part of variable length after its length (its count of items, each item of a fixed
+  // size for its tag): the bytes then say where each part ends, so that two different inputs
+  // cannot give the same bytes (e.g. 9 tones and no loop tone against no tone and 13 loop
+  // tones, 468 bytes each without the counts).
+  const auto count = [&put](std::size_t n) { put(static_cast<std::uint64_t>(n)); };
+  count(config.coefficients.v.size());
   for (double c : config.coefficients.v) put(c);
+  count(config.location.size());
   for (const Location l : config.location) put(static_cast<int>(l));
   const Dynamics& d = config.dynamics;
   for (double x : {d.pendulum_frequency_Hz, d.pendulum_damping_ratio, d.angle_gain_rad_per_s2_per_g, d.loop_bandwidth_Hz,
@@ -355,6 +362,7 @@ std::string film_balance_key(const PlantConfig& config, const vibration::SineVib
                      config.servo->integrator_rad_per_s})
       put(x);
   put(config.torquer_c2_per_g), put(config.torquer_c3_per_g2);
+  count(config.effects.size());
   for (const auto& e : config.effects) {
     if (const auto* f = dynamic_cast<const plant::SqueezeFilmDamping*>(e.get())) {
       put(1);
@@ -368,10 +376,12 @@ std::string film_balance_key(const PlantConfig& config, const vibration::SineVib
   put(v.frequency_Hz);
   put(in.frequency_Hz);
   for (int i = 0; i < 3; ++i) put(in.mean_g[i]);
+  count(in.tones.size());
   for (const auto& [h, W] : in.tones) {
     put(h);
     for (int i = 0; i < 3; ++i) put(W[i].real()), put(W[i].imag());
   }
+  count(in.loop.size());
   for (const PeriodicInput::LoopTone& l : in.loop) put(l.h), put(l.current_g.real()), put(l.current_g.imag()), put(l.angle_rad.real()), put(l.angle_rad.imag());
   return key;
 }

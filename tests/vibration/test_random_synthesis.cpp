@@ -6,6 +6,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <utility>
+#include <vector>
 
 #include "vibration/detail.hpp"
 #include "vibration/sampled.hpp"
@@ -80,17 +82,37 @@ TEST(RandomExcitation, WantedAxesDrawTheSamePhases) {
   }
 }
 
+// samples_into writes into storage a previous window left behind: windows that grow, shrink
+// and move (across block edges and back before 0) into one SampledSignal whose vectors start
+// full of another window's values (and longer, and with a value on the axis without a PSD).
+// Each window is checked against random_phase_block's overlap-add (reference_sample, which
+// shares no storage or cache with the stream) on a spread of samples, every sample of the axis
+// without a PSD is +0, and the lengths are the window's: stale samples or a stale length fail.
 TEST(RandomExcitation, SamplesIntoReusedStorageEqualSamples) {
   RandomProfile p;
+  p.psd[IA] = PsdTable{{PsdRow::level(20, 0.04), PsdRow::level(500, 0.04)}};
   p.psd[OA] = PsdTable{{PsdRow::level(50, 0.01), PsdRow::level(400, 0.02)}};
-  const RandomExcitation r(p, 4000, 7, 1024);
+  const double fs = 4000;
+  const std::size_t m = 1024;
+  const RandomExcitation r(p, fs, 7, m);
   SampledSignal reused;
-  for (std::int64_t first : {0L, 900L, -300L}) {
-    r.samples_into(first, 1500, reused);
-    const SampledSignal fresh = r.samples(first, 1500);
-    for (int a = 0; a < 3; ++a) EXPECT_EQ(reused.samples_g[a], fresh.samples_g[a]) << first << " axis " << a;
-    EXPECT_EQ(reused.sample_rate_Hz, 4000.0);
-    EXPECT_NE(reused.samples_g[OA][100], 0.0);
-    EXPECT_EQ(reused.samples_g[IA], std::vector<double>(1500, 0.0));
+  reused.sample_rate_Hz = 1.0;
+  for (auto& axis : reused.samples_g) axis.assign(3000, 0.125);  // stale: not a stream value
+  const std::vector<std::pair<std::int64_t, std::size_t>> windows = {{0, 1500}, {900, 700}, {-300, 2600}, {5000, 1}, {-1200, 1100}};
+  for (const auto& [first, count] : windows) {
+    r.samples_into(first, count, reused);
+    EXPECT_EQ(reused.sample_rate_Hz, fs);
+    for (int a = 0; a < 3; ++a) ASSERT_EQ(reused.samples_g[a].size(), count) << first << " axis " << a;
+    // Every 97th sample, the first and the last: across both blocks' halves of each window.
+    std::vector<std::size_t> at = {0, count - 1};
+    for (std::size_t i = 97; i < count; i += 97) at.push_back(i);
+    for (std::size_t i : at) {
+      const std::int64_t n = first + static_cast<std::int64_t>(i);
+      for (int a : {IA, OA}) EXPECT_EQ(reused.samples_g[a][i], reference_sample(p, fs, 7, m, n, a)) << "sample " << n << " axis " << a;
+    }
+    EXPECT_EQ(reused.samples_g[PA], std::vector<double>(count, 0.0)) << first;
+    if (count > 100) {
+      EXPECT_NE(reused.samples_g[OA][100], 0.0);
+    }
   }
 }
