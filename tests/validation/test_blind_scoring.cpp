@@ -14,23 +14,15 @@
 #include <string>
 
 #include "validation/diagnosis/blind.hpp"
+#include "support/small_design.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 
 using namespace vrelab;
 using namespace vrelab::validation;
+using vrelab::test::small_design;
 
 namespace {
-
-// 4 frequencies x 3 amplitudes x 3 directions x 2 orientations = 72 runs, the default static
-// test: the default design's kinds of run, fewer of them.
-CampaignDesign small_design() {
-  CampaignDesign d = default_design();
-  d.frequencies_Hz = {10, 100, 400, 1000};
-  d.amplitudes_g = {1, 2, 4};
-  d.directions = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0).normalized()};
-  return d;
-}
 
 DiagnoseSettings quick() {
   DiagnoseSettings s;

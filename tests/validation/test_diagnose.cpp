@@ -23,12 +23,14 @@
 #include "app/commands.hpp"
 #include "io/lab_data.hpp"
 #include "rectification/simulation/shake.hpp"
+#include "support/small_design.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "vibration/excitation.hpp"
 
 using namespace vrelab;
 using namespace vrelab::validation;
+using vrelab::test::small_design;
 namespace fs = std::filesystem;
 using vrelab::test::read_file;
 using vrelab::test::TempDir;
@@ -36,15 +38,6 @@ using vrelab::test::TempDir;
 namespace {
 
 plant::PlantConfig truth() { return test::paper_like_plant(); }
-
-// A smaller design than the default (36 runs), for test time.
-CampaignDesign small_design() {
-  CampaignDesign d = default_design();
-  d.frequencies_Hz = {10, 100, 400, 1000};
-  d.amplitudes_g = {1, 2, 4};
-  d.directions = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0).normalized()};
-  return d;
-}
 
 }  // namespace
 

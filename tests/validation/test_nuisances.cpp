@@ -15,21 +15,15 @@
 #include "io/diagnosis_json.hpp"
 #include "support/instrument.hpp"
 #include "validation/diagnosis/blind.hpp"
+#include "support/small_design.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 
 using namespace vrelab;
 using namespace vrelab::validation;
+using vrelab::test::small_design;
 
 namespace {
-
-CampaignDesign small_design() {
-  CampaignDesign d = default_design();
-  d.frequencies_Hz = {10, 100, 400, 1000};
-  d.amplitudes_g = {1, 2, 4};
-  d.directions = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(1, 1, 0).normalized()};
-  return d;
-}
 
 // The same clean campaign for every test here (simulated once).
 const Campaign& clean_campaign() {

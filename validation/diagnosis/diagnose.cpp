@@ -1386,9 +1386,87 @@ Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s) {
 
 namespace {
 
-Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCache& cache) {
+// 1. What diagnose and blind's family size start from: the identification from the static
+// readings, weighted by their sigma, with its first-order covariance, and the runs' data (sigma2
+// the runs' own variance: the model accuracy is added at the nominal prediction).
+struct Identified {
+  std::vector<Position> positions;
+  std::vector<double> weights;
+  Propagation uncertainty;
+  PlantConfig plant;  // the identified coefficients, the manifest's dynamics
+  Data data;
+};
+
+Identified identify(const Campaign& c) {
   if (c.statics.empty()) throw std::invalid_argument("diagnose: the campaign has no static readings");
   if (c.runs.empty()) throw std::invalid_argument("diagnose: the campaign has no usable shaker runs");
+  Identified id;
+  std::vector<Reading> readings;
+  ReadingBudget budget;
+  for (std::size_t i = 0; i < c.statics.size(); ++i) {
+    id.positions.push_back(vector_position(c.statics[i].orientation_g.normalized()));
+    readings.push_back({static_cast<int>(i), c.statics[i].output});
+    const double var = std::max(c.statics[i].sigma_output * c.statics[i].sigma_output, 1e-30);
+    id.weights.push_back(1 / var);
+    budget.variance.push_back(var);
+    budget.bias.push_back(0.0);
+  }
+  const LeastSquaresResult ls = least_squares(id.positions, readings, id.weights, c.fixed);
+  if (!ls.identifiability.full_rank()) {
+    std::string msg = "the static readings do not determine the free coefficients (rank " +
+                      std::to_string(ls.identifiability.rank) + " of " + std::to_string(ls.identifiability.parameters) + ")";
+    for (const auto& w : ls.identifiability.confounded) msg += "; " + w;
+    throw std::invalid_argument(msg + ": hold more coefficients in the manifest's [identification] fixed, or add positions");
+  }
+  const Estimator est = [&](const std::vector<Reading>& r) { return least_squares(id.positions, r, id.weights, c.fixed).estimate; };
+  id.uncertainty = propagate_first_order(est, readings, budget);
+  id.plant.coefficients = ls.estimate.value;
+  id.plant.dynamics = c.dynamics;
+  const int n = static_cast<int>(c.runs.size());
+  Data& data = id.data;
+  data.measured.resize(n), data.sigma2.resize(n);
+  for (int k = 0; k < n; ++k) {
+    data.measured(k) = c.runs[static_cast<std::size_t>(k)].measured_g;
+    data.sigma2(k) = std::pow(c.runs[static_cast<std::size_t>(k)].sigma_g, 2);
+  }
+  data.Sigma.resize(plant::kNumCoefficients, plant::kNumCoefficients);
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    for (int j = 0; j < plant::kNumCoefficients; ++j) data.Sigma(i, j) = id.uncertainty.covariance[i][j];
+  return id;
+}
+
+// The held-out folds: leave one amplitude out, so every frequency and direction stays in
+// training (a resonance cannot be located from the other frequencies) and the held-out runs
+// test the effect's scaling with amplitude, which tells most effects apart; with one amplitude,
+// leave one frequency out; with neither, no cross-validation (in-sample).
+struct Folds {
+  std::string description;
+  std::vector<double> key;                   // each run's fold
+  std::map<double, std::vector<int>> test;   // each fold's held-out runs
+  std::vector<int> train(double k) const {  // the other folds' runs (every run when none is left)
+    std::vector<int> t;
+    for (std::size_t j = 0; j < key.size(); ++j)
+      if (key[j] != k) t.push_back(static_cast<int>(j));
+    if (t.empty())
+      for (std::size_t j = 0; j < key.size(); ++j) t.push_back(static_cast<int>(j));
+    return t;
+  }
+};
+
+Folds folds_of(const std::vector<RunRecord>& runs) {
+  std::set<double> amplitudes, frequencies;
+  for (const auto& run : runs) amplitudes.insert(run.amplitude_g), frequencies.insert(run.frequency_Hz);
+  const bool by_amplitude = amplitudes.size() >= 2, by_frequency = !by_amplitude && frequencies.size() >= 2;
+  Folds f;
+  f.description = by_amplitude ? "leave one amplitude out" : by_frequency ? "leave one frequency out" : "none (in-sample: one amplitude, one frequency)";
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    f.key.push_back(by_amplitude ? runs[k].amplitude_g : by_frequency ? runs[k].frequency_Hz : 0.0);
+    f.test[f.key.back()].push_back(static_cast<int>(k));
+  }
+  return f;
+}
+
+Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCache& cache) {
   Diagnosis d;
   // Reference channels: when every sine run's motion is measured, the table-motion effects
   // have nothing left to explain (docs/data-format.md, "Reference channels").
@@ -1402,43 +1480,14 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
       for (const Effect& e : effect_library())
         if (e.acts_on == ActsOn::table_motion) d.measured_effects.push_back(e.name);
   }
-  // 1. Identification from the static readings, weighted by their sigma.
-  std::vector<Position> positions;
-  std::vector<Reading> readings;
-  std::vector<double> weights;
-  ReadingBudget budget;
-  for (std::size_t i = 0; i < c.statics.size(); ++i) {
-    positions.push_back(vector_position(c.statics[i].orientation_g.normalized()));
-    readings.push_back({static_cast<int>(i), c.statics[i].output});
-    const double var = std::max(c.statics[i].sigma_output * c.statics[i].sigma_output, 1e-30);
-    weights.push_back(1 / var);
-    budget.variance.push_back(var);
-    budget.bias.push_back(0.0);
-  }
-  const LeastSquaresResult ls = least_squares(positions, readings, weights, c.fixed);
-  if (!ls.identifiability.full_rank()) {
-    std::string msg = "the static readings do not determine the free coefficients (rank " +
-                      std::to_string(ls.identifiability.rank) + " of " + std::to_string(ls.identifiability.parameters) + ")";
-    for (const auto& w : ls.identifiability.confounded) msg += "; " + w;
-    throw std::invalid_argument(msg + ": hold more coefficients in the manifest's [identification] fixed, or add positions");
-  }
-  d.identified = ls.estimate.value;
-  const Estimator est = [&](const std::vector<Reading>& r) { return least_squares(positions, r, weights, c.fixed).estimate; };
-  d.identified_uncertainty = propagate_first_order(est, readings, budget);
-
-  PlantConfig plant;
-  plant.coefficients = d.identified;
-  plant.dynamics = c.dynamics;
+  const Identified id = identify(c);
+  const std::vector<Position>& positions = id.positions;
+  const std::vector<double>& weights = id.weights;
+  d.identified = id.plant.coefficients;
+  d.identified_uncertainty = id.uncertainty;
+  const PlantConfig& plant = id.plant;
   const int n = static_cast<int>(c.runs.size());
-  Data data;
-  data.measured.resize(n), data.sigma2.resize(n);
-  for (int k = 0; k < n; ++k) {
-    data.measured(k) = c.runs[static_cast<std::size_t>(k)].measured_g;
-    data.sigma2(k) = std::pow(c.runs[static_cast<std::size_t>(k)].sigma_g, 2);
-  }
-  data.Sigma.resize(plant::kNumCoefficients, plant::kNumCoefficients);
-  for (int i = 0; i < plant::kNumCoefficients; ++i)
-    for (int j = 0; j < plant::kNumCoefficients; ++j) data.Sigma(i, j) = d.identified_uncertainty.covariance[i][j];
+  Data data = id.data;
 
   // What the static test takes up of each effect that acts at rest: the identification of the
   // change the effect (at its unit value) makes to the readings, at the campaign's own
@@ -1564,27 +1613,12 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
     d.where = w.str();
   }
 
-  // 3. Each effect: fits on training runs and the evidence on the held-out ones. Folds: leave
-  // one amplitude out, so every frequency and direction stays in training (a resonance cannot
-  // be located from the other frequencies) and the held-out runs test the effect's scaling
-  // with amplitude, which tells most effects apart; with one amplitude, leave one frequency
-  // out; with neither, no cross-validation (said in d.folds).
-  std::set<double> amplitudes, frequencies;
-  for (const auto& run : c.runs) amplitudes.insert(run.amplitude_g), frequencies.insert(run.frequency_Hz);
-  const bool by_amplitude = amplitudes.size() >= 2, by_frequency = !by_amplitude && frequencies.size() >= 2;
-  d.folds = by_amplitude ? "leave one amplitude out" : by_frequency ? "leave one frequency out" : "none (in-sample: one amplitude, one frequency)";
-  const auto fold_key = [&](int k) {
-    const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
-    return by_amplitude ? run.amplitude_g : by_frequency ? run.frequency_Hz : 0.0;
-  };
-  std::map<double, std::vector<int>> folds;
-  for (int k = 0; k < n; ++k) folds[fold_key(k)].push_back(k);
-  const auto train_of = [&](double key) {
-    std::vector<int> train;
-    for (int k = 0; k < n; ++k)
-      if (fold_key(k) != key) train.push_back(k);
-    return train.empty() ? all : train;
-  };
+  // 3. Each effect: fits on training runs and the evidence on the held-out ones (folds_of: by
+  // amplitude, else by frequency, else in-sample; said in d.folds).
+  const Folds fold_set = folds_of(c.runs);
+  d.folds = fold_set.description;
+  const std::map<double, std::vector<int>>& folds = fold_set.test;
+  const auto train_of = [&](double key) { return fold_set.train(key); };
   struct Scored {
     EffectFit fit;
     Eigen::VectorXd heldout;  // held-out adjusted residual per run
@@ -1864,7 +1898,8 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
     for (const RunRecord& run : c.runs) sig.push_back(run.sigma_g);
     std::nth_element(sig.begin(), sig.begin() + static_cast<std::ptrdiff_t>(sig.size() / 2), sig.end());
     const double sigma_run = sig[sig.size() / 2];
-    const double amax = *std::max_element(amplitudes.begin(), amplitudes.end());
+    double amax = 0;
+    for (const RunRecord& run : c.runs) amax = std::max(amax, run.amplitude_g);
     std::vector<NextRun> options;
     const std::vector<Vec3> next_dirs = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 0).normalized(),
                                     Vec3(1, 0, 1).normalized(), Vec3(0, 1, 1).normalized()};
@@ -1980,50 +2015,32 @@ struct NominalView {
   Eigen::MatrixXd V;
 };
 
-// The same steps as diagnose (the drift line removed; the identification from the static
-// readings weighted by their sigma, with its first-order covariance; the nominal tabulation;
-// V = diag(sigma_run^2 + (model_accuracy pred)^2) + G Sigma G^T), the stated sigma taken as
-// it is (no sigma_scale: a family's size is judged with the runs' stated sigma).
-NominalView nominal_view(const Campaign& c0, const DiagnoseSettings& s) {
-  if (c0.statics.empty()) throw std::invalid_argument("nominal_gap_significance: the campaign has no static readings");
-  if (c0.runs.empty()) throw std::invalid_argument("nominal_gap_significance: the campaign has no shaker runs");
+// The nominal simulation of a campaign as diagnose sees it before any hypothesis: the drift line
+// removed (each run's sigma scaled by sigma_scale), identified from its static readings,
+// tabulated, V's model accuracy at the nominal prediction.
+struct Nominal {
+  Data data;
+  Table t;
+};
+
+Nominal nominal_of(const Campaign& c0, const DiagnoseSettings& s, double sigma_scale) {
   Campaign c = c0;
   remove_drift(c);
-  std::vector<Position> positions;
-  std::vector<Reading> readings;
-  std::vector<double> weights;
-  ReadingBudget budget;
-  for (std::size_t i = 0; i < c.statics.size(); ++i) {
-    positions.push_back(vector_position(c.statics[i].orientation_g.normalized()));
-    readings.push_back({static_cast<int>(i), c.statics[i].output});
-    const double var = std::max(c.statics[i].sigma_output * c.statics[i].sigma_output, 1e-30);
-    weights.push_back(1 / var);
-    budget.variance.push_back(var);
-    budget.bias.push_back(0.0);
-  }
-  const LeastSquaresResult ls = least_squares(positions, readings, weights, c.fixed);
-  if (!ls.identifiability.full_rank())
-    throw std::invalid_argument("nominal_gap_significance: the static readings do not determine the free coefficients");
-  const Estimator est = [&](const std::vector<Reading>& r) { return least_squares(positions, r, weights, c.fixed).estimate; };
-  const Propagation unc = propagate_first_order(est, readings, budget);
-  PlantConfig plant;
-  plant.coefficients = ls.estimate.value;
-  plant.dynamics = c.dynamics;
+  for (RunRecord& r : c.runs) r.sigma_g *= sigma_scale;
+  Identified id = identify(c);
   ResponseCache cache;
-  const Table t = tabulate(plant, c.runs, nullptr, 0, cache, Absorbed{});
-  const int n = static_cast<int>(c.runs.size());
-  Data data;
-  data.measured.resize(n), data.sigma2.resize(n);
-  for (int k = 0; k < n; ++k) {
-    data.measured(k) = c.runs[static_cast<std::size_t>(k)].measured_g;
-    data.sigma2(k) = std::pow(c.runs[static_cast<std::size_t>(k)].sigma_g, 2) + std::pow(s.model_accuracy * t.pred(k), 2);
-  }
-  data.Sigma.resize(plant::kNumCoefficients, plant::kNumCoefficients);
-  for (int i = 0; i < plant::kNumCoefficients; ++i)
-    for (int j = 0; j < plant::kNumCoefficients; ++j) data.Sigma(i, j) = unc.covariance[i][j];
-  std::vector<int> all(static_cast<std::size_t>(n));
-  for (int k = 0; k < n; ++k) all[static_cast<std::size_t>(k)] = k;
-  return {data.measured - t.pred, covariance(data, t.G, all)};
+  Nominal nm{std::move(id.data), tabulate(id.plant, c.runs, nullptr, 0, cache, Absorbed{})};
+  for (Eigen::Index k = 0; k < nm.t.pred.size(); ++k) nm.data.sigma2(k) += std::pow(s.model_accuracy * nm.t.pred(k), 2);
+  return nm;
+}
+
+// The gap r = measured - predicted and the covariance V its runs are judged by, the stated
+// sigma taken as it is (no sigma_scale: a family's size is judged with the runs' stated sigma).
+NominalView nominal_view(const Campaign& c, const DiagnoseSettings& s) {
+  const Nominal nm = nominal_of(c, s, 1);
+  std::vector<int> all(static_cast<std::size_t>(nm.t.pred.size()));
+  for (std::size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
+  return {nm.data.measured - nm.t.pred, covariance(nm.data, nm.t.G, all)};
 }
 
 }  // namespace
@@ -2056,62 +2073,12 @@ double nominal_gap_significance(const Campaign& with, const Campaign& without, c
   return std::sqrt(std::max(0.0, g.dot(ldlt.solve(g))));
 }
 
-std::vector<double> heldout_nominal_gap_g(const Campaign& c0, const DiagnoseSettings& s, double sigma_scale) {
-  Campaign c = c0;
-  remove_drift(c);
-  for (RunRecord& r : c.runs) r.sigma_g *= sigma_scale;
-  const int n = static_cast<int>(c.runs.size());
-  // The nominal data again, as nominal_view builds them (V is the diagnosis').
-  std::vector<Position> positions;
-  std::vector<Reading> readings;
-  std::vector<double> weights;
-  ReadingBudget budget;
-  for (std::size_t i = 0; i < c.statics.size(); ++i) {
-    positions.push_back(vector_position(c.statics[i].orientation_g.normalized()));
-    readings.push_back({static_cast<int>(i), c.statics[i].output});
-    const double var = std::max(c.statics[i].sigma_output * c.statics[i].sigma_output, 1e-30);
-    weights.push_back(1 / var);
-    budget.variance.push_back(var);
-    budget.bias.push_back(0.0);
-  }
-  if (c.statics.empty() || c.runs.empty()) throw std::invalid_argument("heldout_nominal_gap_g: no static readings or no runs");
-  const LeastSquaresResult ls = least_squares(positions, readings, weights, c.fixed);
-  if (!ls.identifiability.full_rank())
-    throw std::invalid_argument("heldout_nominal_gap_g: the static readings do not determine the free coefficients");
-  const Estimator est = [&](const std::vector<Reading>& r) { return least_squares(positions, r, weights, c.fixed).estimate; };
-  const Propagation unc = propagate_first_order(est, readings, budget);
-  PlantConfig plant;
-  plant.coefficients = ls.estimate.value;
-  plant.dynamics = c.dynamics;
-  ResponseCache cache;
-  const Table t = tabulate(plant, c.runs, nullptr, 0, cache, Absorbed{});
-  Data data;
-  data.measured.resize(n), data.sigma2.resize(n);
-  for (int k = 0; k < n; ++k) {
-    data.measured(k) = c.runs[static_cast<std::size_t>(k)].measured_g;
-    data.sigma2(k) = std::pow(c.runs[static_cast<std::size_t>(k)].sigma_g, 2) + std::pow(s.model_accuracy * t.pred(k), 2);
-  }
-  data.Sigma.resize(plant::kNumCoefficients, plant::kNumCoefficients);
-  for (int i = 0; i < plant::kNumCoefficients; ++i)
-    for (int j = 0; j < plant::kNumCoefficients; ++j) data.Sigma(i, j) = unc.covariance[i][j];
-  // diagnose's folds: leave one amplitude out; with one amplitude, one frequency; else none.
-  std::set<double> amplitudes, frequencies;
-  for (const auto& run : c.runs) amplitudes.insert(run.amplitude_g), frequencies.insert(run.frequency_Hz);
-  const bool by_amplitude = amplitudes.size() >= 2, by_frequency = !by_amplitude && frequencies.size() >= 2;
-  const auto fold_key = [&](int k) {
-    const RunRecord& run = c.runs[static_cast<std::size_t>(k)];
-    return by_amplitude ? run.amplitude_g : by_frequency ? run.frequency_Hz : 0.0;
-  };
-  std::map<double, std::vector<int>> folds;
-  for (int k = 0; k < n; ++k) folds[fold_key(k)].push_back(k);
-  std::vector<double> h(static_cast<std::size_t>(n));
-  for (const auto& [key, test] : folds) {
-    std::vector<int> train;
-    for (int k = 0; k < n; ++k)
-      if (fold_key(k) != key) train.push_back(k);
-    if (train.empty())
-      for (int k = 0; k < n; ++k) train.push_back(k);
-    const Eigen::VectorXd a = adjusted_residual(data, t.pred, t.G, train, test);
+std::vector<double> heldout_nominal_gap_g(const Campaign& c, const DiagnoseSettings& s, double sigma_scale) {
+  const Nominal nm = nominal_of(c, s, sigma_scale);
+  const Folds folds = folds_of(c.runs);
+  std::vector<double> h(c.runs.size());
+  for (const auto& [key, test] : folds.test) {
+    const Eigen::VectorXd a = adjusted_residual(nm.data, nm.t.pred, nm.t.G, folds.train(key), test);
     for (std::size_t i = 0; i < test.size(); ++i) h[static_cast<std::size_t>(test[i])] = a(static_cast<Eigen::Index>(i));
   }
   return h;
