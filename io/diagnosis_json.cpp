@@ -456,7 +456,7 @@ std::string blind_html(const validation::BlindResult& r) {
                      f.ambiguous, f.right_among, f.error, f.parameters_off);
   h += "</table>\n";
   {
-    // The two family sizes and the two shrinkages side by side (docs/diagnose.md, "Blind scoring").
+    // The two family sizes and the two shrinkages side by side (docs/diagnose.md, "Blind's measures").
     const validation::BlindScores& s = r.scores;
     const validation::OldSizeScores& o = s.by_max_run_sigma;
     const auto fam = [](const std::map<std::string, validation::FamilyScore>& m, const std::string& name) {

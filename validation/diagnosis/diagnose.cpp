@@ -575,7 +575,7 @@ class EffectFitter {
   // b b^T. b comes from two refits: the fit repeated on the data shifted by +f Delta and by
   // -f Delta (the effect's change scaled by 1 -+ f), each a Levenberg-Marquardt descent from the
   // fitted values over the same free parameters (not the multi-start: the shift is small), and
-  // b = (v+ - v-) / 2 (a phase's difference wrapped into (-pi, pi]). For a linear one-parameter
+  // b = (v+ - v-) / 2 (each refit's shift of a phase wrapped into (-pi, pi]). For a linear one-parameter
   // effect b = f p (the parameter known to f of itself); errors independent run by run would
   // give f p / sqrt(N) of N like runs, which a systematic error does not average down. A large
   // effect seen at hundreds of sigma had sigma from the noise only (a harmonic's phase 4 sigma
@@ -642,13 +642,7 @@ class EffectFitter {
       const auto ua = static_cast<std::size_t>(a);
       const bool u = up && !edge_up[ua], w = down && !edge_down[ua];
       if (u && w) {
-        double dx = (*up)(a) - (*down)(a);
-        const int j = which[ua];
-        if (j > 0 && e_.parameters[static_cast<std::size_t>(j)].periodic) {
-          const auto [lo, hi] = range(j);
-          dx = std::remainder(dx, hi - lo);
-        }
-        b(a) = dx / 2;
+        b(a) = ((*up)(a) - (*down)(a)) / 2;  // (each shift already wrapped: a spread is not folded back)
       } else if (u) {
         b(a) = (*up)(a);
       } else if (w) {
@@ -2070,7 +2064,11 @@ double nominal_gap_significance(const Campaign& with, const Campaign& without, c
   const NominalView w = nominal_view(with, s), o = nominal_view(without, s);
   const Eigen::VectorXd g = w.r - o.r;
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(w.V);
-  return std::sqrt(std::max(0.0, g.dot(ldlt.solve(g))));
+  const double q = g.dot(ldlt.solve(g));
+  // (A NaN would be size 0: the campaign out of its scored family without a word.)
+  if (ldlt.info() != Eigen::Success || !std::isfinite(q))
+    throw std::invalid_argument("nominal_gap_significance: the gap's chi^2 is not a number (V not positive definite or a prediction not finite)");
+  return std::sqrt(std::max(0.0, q));
 }
 
 std::vector<double> heldout_nominal_gap_g(const Campaign& c, const DiagnoseSettings& s, double sigma_scale) {
