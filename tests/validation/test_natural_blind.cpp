@@ -12,6 +12,7 @@
 #include "plant/effects/mechanical_mode.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/instrument.hpp"
+#include "support/result_line.hpp"
 #include "validation/diagnosis/blind.hpp"
 
 namespace vrelab::validation {
@@ -137,19 +138,7 @@ TEST(NaturalBlind, TheResultLineCarriesTheTopEffectsParameters) {
   EXPECT_EQ(p[2].name, "axis");
   EXPECT_EQ(p[2].value, 2);
   EXPECT_TRUE(std::isnan(p[2].sigma));
-  // (The field cut is the last before the gap's part, which stays: a line cut at its very end
-  // would be refused by the gap's check alone, or read as outdated.)
-  const std::string text = campaign_result_text(k);
-  const std::size_t gap = text.rfind("\tgap\t");
-  ASSERT_NE(gap, std::string::npos);
-  const std::string cut = text.substr(0, text.rfind('\t', gap - 1)) + text.substr(gap);
-  try {
-    read_campaign_result(cut, back);
-    ADD_FAILURE() << "a line cut short was read";
-  } catch (const OutdatedCampaignResult&) {
-    ADD_FAILURE() << "a line cut short was called outdated";
-  } catch (const std::invalid_argument&) {
-  }
+  test::expect_refused_not_outdated(test::cut_before_gap(campaign_result_text(k)), "a line cut short");
 }
 
 }  // namespace
