@@ -128,7 +128,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   std::ofstream append;
   if (writer) append.open(done_path, std::ios::app);
   std::size_t resumed = 0;
-  for (const auto& [i, t] : done) resumed += i < o.settings.n;
+  for (const auto& [i, t] : done) resumed += i < o.settings.n;  // (an outdated line among them is diagnosed again)
   core::Progress bar(std::cerr, "blind", static_cast<std::size_t>(o.settings.n) - resumed, o.progress && writer);
   const validation::BlindResult r = validation::run_blind(
       o.settings, [&bar](std::size_t, std::size_t) { bar.tick(); }, done,
@@ -142,7 +142,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   io::write_atomic(o.out_dir + "/confusion.csv", io::confusion_csv(r));
   io::write_atomic(o.out_dir + "/report.html", io::blind_html(r));
   out << program() << r.FullReport();
-  if (resumed > 0) out << fmt::format("  {} campaign(s) read back from {} (an earlier run)\n", resumed, done_path);
+  if (r.resumed > 0) out << fmt::format("  {} campaign(s) read back from {} (an earlier run)\n", r.resumed, done_path);
   const std::string plot = io::run_plot_script("confusion.py", o.out_dir);
   out << "Wrote " << o.out_dir << "/scores.json, report.html and confusion.csv"
       << (plot.empty() ? ", confusion.png/svg" : "; figure skipped: " + plot) << "\n";

@@ -148,6 +148,21 @@ json families_json(const std::map<std::string, validation::FamilyScore>& familie
   return j;
 }
 
+json criteria_json(const std::vector<validation::BlindCriterion>& criteria) {
+  json j = json::array();
+  for (const auto& c : criteria)
+    j.push_back({{"name", c.name},
+                 {"k", c.k},
+                 {"n", c.n},
+                 {"rate", c.rate()},
+                 {"ci95", {c.ci95.lo, c.ci95.hi}},
+                 {"ci95_method", "Clopper-Pearson (exact binomial)"},
+                 {"target", c.target},
+                 {"target_is", c.at_least ? "at_least" : "at_most"},
+                 {"met", c.met()}});
+  return j;
+}
+
 }  // namespace
 
 json to_json(const validation::DiagnoseSettings& s) {
@@ -382,6 +397,7 @@ json to_json(const validation::BlindResult& r) {
           {"median_shrinkage", s.median_shrinkage},
           {"median_shrinkage_in_sigma", s.median_shrinkage_in_sigma},
           {"families", families_json(s.families)},
+          {"criteria", criteria_json(r.Criteria())},
           {"old_family_size_max_run_sigma",
            {{"family_size", "effect_max_sigma: the largest |with - without| of any run over its sigma; scored when >= 5"},
             {"top1_accuracy", BlindScores::rate(s.by_max_run_sigma.single_right, s.by_max_run_sigma.single)},
@@ -446,6 +462,15 @@ std::string blind_html(const validation::BlindResult& r) {
                    "right physics, not the right effect; unexplained; no gap; confidently wrong (explained by an effect of "
                    "another physics); ambiguous (the truth among them).</p>\n",
                    r.settings.n, r.settings.seed, r.wall_s, r.threads);
+  h += "<h2>Issue 15's rates</h2>\n<p>The 95 % interval is Clopper-Pearson's (exact binomial): what a run of this size "
+       "can tell. \"met\" compares the rate itself with the target.</p>\n<table><tr><th class=\"l\">criterion</th><th>k/n</th>"
+       "<th>rate</th><th>95 % interval</th><th>target</th><th></th></tr>\n";
+  for (const auto& c : r.Criteria())
+    h += fmt::format("<tr><td class=\"l\">{}</td><td>{}/{}</td><td>{:.1f} %</td><td>{:.1f} &ndash; {:.1f} %</td><td>{} {:.0f} %</td>"
+                     "<td class=\"{}\">{}</td></tr>\n",
+                     html_escape(c.name), c.k, c.n, 100 * c.rate(), 100 * c.ci95.lo, 100 * c.ci95.hi, c.at_least ? "&ge;" : "&le;",
+                     100 * c.target, c.n == 0 ? "" : c.met() ? "ok" : "bad", c.n == 0 ? "no campaigns" : c.met() ? "met" : "not met");
+  h += "</table>\n";
   h += "<h2>Per family</h2>\n<table><tr><th class=\"l\">family</th><th>n</th><th>right</th><th>right physics</th>"
        "<th>unexplained</th><th>no gap</th><th>confidently wrong</th><th>ambiguous</th><th>(right among)</th><th>error</th>"
        "<th>right effect, a parameter beyond 3&sigma;</th></tr>\n";

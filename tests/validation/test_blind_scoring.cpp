@@ -12,6 +12,8 @@
 #include <map>
 #include <random>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "validation/diagnosis/blind.hpp"
 #include "support/result_line.hpp"
@@ -242,4 +244,60 @@ TEST(BlindScoring, SinglesAreScoredByTheGapAsTheLabSeesItTheOldSizeBeside) {
   const std::string brief = r.BriefReport();
   EXPECT_NE(brief.find("shrinkage of the gap rms (the lab's noise removed; 2 single campaigns): 90 %"), std::string::npos) << brief;
   EXPECT_NE(brief.find("sized the old way, >= 5 sigma in some run: 1/2 = 50 %"), std::string::npos) << brief;
+}
+
+namespace {
+// P(X >= k) and P(X <= k) for X ~ Binomial(n, p), summed term by term (not through the beta
+// function Boost's bounds invert).
+double tail_at_least(int k, int n, double p) {
+  double s = 0;
+  for (int j = k; j <= n; ++j)
+    s += std::exp(std::lgamma(n + 1.0) - std::lgamma(j + 1.0) - std::lgamma(n - j + 1.0) + j * std::log(p) + (n - j) * std::log1p(-p));
+  return s;
+}
+double tail_at_most(int k, int n, double p) { return 1 - tail_at_least(k + 1, n, p); }
+}  // namespace
+
+// The exact interval's bounds are where the binomial tails are 2.5 % each; at k = 0 and k = n
+// the bound is closed-form, (alpha/2)^(1/n).
+TEST(BlindScoring, ClopperPearsonBoundsAreWhereTheBinomialTailsAreTwoAndAHalfPercent) {
+  for (const auto& [k, n] : std::vector<std::pair<int, int>>{{22, 23}, {14, 16}, {1, 18}, {5, 100}, {47, 47}, {0, 24}, {12, 24}}) {
+    const RateInterval ci = clopper_pearson(k, n);
+    EXPECT_LE(ci.lo, static_cast<double>(k) / n);
+    EXPECT_GE(ci.hi, static_cast<double>(k) / n);
+    if (k > 0) EXPECT_NEAR(tail_at_least(k, n, ci.lo), 0.025, 1e-9) << k << "/" << n;
+    else EXPECT_EQ(ci.lo, 0.0);
+    if (k < n) EXPECT_NEAR(tail_at_most(k, n, ci.hi), 0.025, 1e-9) << k << "/" << n;
+    else EXPECT_EQ(ci.hi, 1.0);
+  }
+  EXPECT_NEAR(clopper_pearson(0, 24).hi, 1 - std::pow(0.025, 1.0 / 24), 1e-12);
+  EXPECT_NEAR(clopper_pearson(47, 47).lo, std::pow(0.025, 1.0 / 47), 1e-12);
+  const RateInterval none = clopper_pearson(0, 0);
+  EXPECT_EQ(none.lo, 0.0);
+  EXPECT_EQ(none.hi, 1.0);
+  EXPECT_THROW(clopper_pearson(3, 2), std::invalid_argument);
+}
+
+// The criteria count what the families hold: a clean campaign's false alarm is the family's
+// not-right, confidently wrong is summed over every family, and "met" compares the rate.
+TEST(BlindScoring, TheIssuesCriteriaAreCountedFromTheFamilies) {
+  BlindResult r;
+  r.scores.families["single"] = {.n = 23, .right = 22, .wrong = 1};
+  r.scores.families["natural"] = {.n = 16, .right = 14};
+  r.scores.families["clean"] = {.n = 18, .right = 17};
+  r.scores.families["two"] = {.n = 9, .wrong = 1};
+  r.scores.clean = 18, r.scores.false_alarms = 1;
+  std::map<std::string, BlindCriterion> by;
+  for (const BlindCriterion& c : r.Criteria()) by[c.name.substr(0, c.name.find(':'))] = c;
+  ASSERT_TRUE(by.count("single, gap >= 5 sigma") && by.count("natural form, gap >= 5 sigma") &&
+              by.count("clean") && by.count("all families") && by.count("drift"));
+  EXPECT_EQ(by["single, gap >= 5 sigma"].k, 22);
+  EXPECT_TRUE(by["single, gap >= 5 sigma"].met());  // 95.7 % >= 95 %
+  EXPECT_FALSE(by["natural form, gap >= 5 sigma"].met());  // 87.5 % < 90 %
+  EXPECT_FALSE(by["clean"].met());  // 1/18 = 5.6 % > 2 %
+  EXPECT_EQ(by["all families"].k, 2);
+  EXPECT_EQ(by["all families"].n, 23 + 16 + 18 + 9);
+  EXPECT_FALSE(by["all families"].met());  // 3.0 % > 1 %
+  EXPECT_EQ(by["drift"].n, 0);
+  EXPECT_FALSE(by["drift"].met());  // no campaigns: nothing shown
 }

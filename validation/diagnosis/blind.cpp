@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include <boost/math/distributions/binomial.hpp>
 #include <fmt/format.h>
 
 #include "core/dispatch.hpp"
@@ -639,6 +640,7 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
     }
     if (!got) todo.push_back(static_cast<std::size_t>(i));
   }
+  r.resumed = static_cast<int>(finished);
   const auto start = Clock::now();
   const auto n = static_cast<std::size_t>(settings.n);
   // A campaign's result travels as its text (from another rank under MPI) and is read back
@@ -666,6 +668,37 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
   r.scores.by_max_run_sigma.median_shrinkage = median(sh.old_residual_g);
   r.scores.by_max_run_sigma.median_shrinkage_in_sigma = median(sh.old_residual_sigma);
   return r;
+}
+
+RateInterval clopper_pearson(int k, int n, double confidence) {
+  if (n < 0 || k < 0 || k > n || !(confidence > 0 && confidence < 1))
+    throw std::invalid_argument(fmt::format("clopper_pearson: {} of {} at confidence {}", k, n, confidence));
+  if (n == 0) return {};
+  using B = boost::math::binomial_distribution<double>;
+  const double tail = (1 - confidence) / 2;
+  return {B::find_lower_bound_on_p(n, k, tail, B::clopper_pearson_exact_interval),
+          B::find_upper_bound_on_p(n, k, tail, B::clopper_pearson_exact_interval)};
+}
+
+std::vector<BlindCriterion> BlindResult::Criteria() const {
+  const auto right = [this](const std::string& family) {
+    const auto it = scores.families.find(family);
+    return it == scores.families.end() ? std::pair{0, 0} : std::pair{it->second.right, it->second.n};
+  };
+  std::vector<BlindCriterion> v;
+  const auto add = [&v](std::string name, std::pair<int, int> kn, double target, bool at_least) {
+    v.push_back({std::move(name), kn.first, kn.second, target, at_least, clopper_pearson(kn.first, kn.second)});
+  };
+  add("single, gap >= 5 sigma: right effect", right("single"), 0.95, true);
+  add("natural form, gap >= 5 sigma: right effect, parameters within 3 sigma", right("natural"), 0.90, true);
+  add("out of library: unexplained", right("out_of_library"), 0.90, true);
+  add("sigma understated: flagged, no effect called", right("sigma_understated"), 0.90, true);
+  add("drift: reported as drift", right("drift"), 0.90, true);
+  add("clean: false alarm (a gap or a nuisance flagged)", {scores.false_alarms, scores.clean}, 0.02, false);
+  int confidently_wrong = 0, all = 0;
+  for (const auto& [name, f] : scores.families) confidently_wrong += f.wrong, all += f.n;
+  add("all families: confidently wrong", {confidently_wrong, all}, 0.01, false);
+  return v;
 }
 
 namespace {
@@ -709,6 +742,11 @@ std::string BlindResult::BriefReport() const {
                    "{:.0f} % (the old measure, on the old size's single family: {:.0f} %, {:.0f} %)\n",
                    100 * s.median_shrinkage, 100 * s.median_shrinkage_in_sigma, 100 * o.median_shrinkage,
                    100 * o.median_shrinkage_in_sigma);
+  t += "Issue 15's rates (the 95 % interval is Clopper-Pearson's: what a run of this size can tell):\n";
+  for (const BlindCriterion& c : Criteria())
+    t += fmt::format("  {:<72} {:>4}/{:<4} {:>5.1f} %  [{:5.1f}, {:5.1f}] %  target {} {:.0f} %: {}\n", c.name, c.k, c.n,
+                     100 * c.rate(), 100 * c.ci95.lo, 100 * c.ci95.hi, c.at_least ? ">=" : "<=", 100 * c.target,
+                     c.n == 0 ? "no campaigns" : c.met() ? "met" : "not met");
   t += "Per family (right; right physics, not the right effect; unexplained; no gap; WRONG: explained by another physics):\n";
   t += FamilyTable();
   t += "The single and natural families sized the old way (the largest run's gap in its sigma):\n";

@@ -60,7 +60,7 @@ struct BlindCampaign {
   std::string error;     // the simulation or diagnosis failed: why ("" otherwise)
   std::string called;    // clean, <effect>, "<A> + <B>", unexplained, or error
   std::string top;       // the effect ranked first ("" on error)
-  double simulate_s = 0, wall_s = 0;  // the campaign's simulation; with its diagnosis
+  double simulate_s = 0, wall_s = 0;  // the campaign's simulation (with its effect-free twin and the gap size); with its diagnosis
   // A single effect's (or natural form's) size, through the ODE (the virtual lab with the
   // effect and without it, the same noise draws), never through the diagnosis' hypotheses.
   // effect_gap_sigma (the scored size): sqrt(g^T V^-1 g), the gap g as the diagnosis' nominal
@@ -122,11 +122,33 @@ struct BlindScores {
   static double rate(int k, int of) { return of ? static_cast<double>(k) / of : 0.0; }
 };
 
+// The exact (Clopper-Pearson) two-sided interval of a rate k/n at `confidence`: the p at which
+// seeing k or more (lo), or k or fewer (hi), has probability (1 - confidence)/2. [0, 1] when
+// n = 0. A family of ~24 campaigns pins its rate only to about +-10 %.
+struct RateInterval {
+  double lo = 0, hi = 1;
+};
+RateInterval clopper_pearson(int k, int n, double confidence = 0.95);
+
+// One of issue 15's must-show criteria read off a blind run: `k` of `n` campaigns, the target
+// rate and whether it is a floor (at_least) or a ceiling; `met` compares the rate itself, and
+// the interval says what the run's size allows.
+struct BlindCriterion {
+  std::string name;
+  int k = 0, n = 0;
+  double target = 0;
+  bool at_least = true;
+  RateInterval ci95;
+  double rate() const { return n ? static_cast<double>(k) / n : 0.0; }
+  bool met() const { return n > 0 && (at_least ? rate() >= target : rate() <= target); }
+};
+
 struct BlindResult {
   BlindSettings settings;
   int threads = 1;    // used (per rank)
   int ranks = 1;      // MPI ranks (1 without mpirun)
   double wall_s = 0;
+  int resumed = 0;    // campaigns read back from an earlier run's results (not an outdated line)
   std::vector<std::string> library;  // the effect library's names (the confusion matrix's order)
   std::vector<BlindCampaign> campaigns;
   BlindScores scores;
@@ -138,6 +160,9 @@ struct BlindResult {
   std::string BriefReport() const;
   std::string FullReport() const;
   std::string FamilyTable() const;  // the per-family outcomes, one line each
+  // Issue 15's rate criteria (single, natural, out of library, sigma understated, drift, clean,
+  // confidently wrong over all families), each with its 95 % interval.
+  std::vector<BlindCriterion> Criteria() const;
 };
 
 // Called after each campaign (under the pool's lock): campaigns done, of total.
