@@ -132,6 +132,14 @@ TEST(NaturalForm, ACleanCampaignIsNotExplainedByTheRicherEffects) {
       std::printf("  %s %s: %s %.6g (evidence %.2f)\n", e.name.c_str(), e.parameters[j].name.c_str(), e.parameters[j].status.c_str(),
                   e.parameters[j].value, e.evidence);
   }
+  // The top effect's fitted parameters carry its held ones' spread over their ranges (the held
+  // parameters marginalised): still a claim, sigma below half the parameter's range.
+  for (const FittedParameter& q : d.effects.front().parameters) {
+    std::printf("  top %s %s: %s %.6g +- %.3g\n", d.effects.front().name.c_str(), q.name.c_str(), q.status.c_str(), q.value, q.sigma);
+    if (q.status == "fitted" && std::isfinite(q.upper - q.lower) && !q.at_bound) {
+      EXPECT_LT(q.sigma, (q.upper - q.lower) / 2) << q.name;
+    }
+  }
 }
 
 // Transverse motion in its natural form: 6.6 % at 1 kHz in phase and 4.5 % in quadrature (8 %

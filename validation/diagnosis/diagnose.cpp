@@ -684,6 +684,100 @@ class EffectFitter {
     if (mf.cov.size() > 0) mf.cov += extra;
   }
 
+  // What a held further parameter's uncertainty does to the fitted parameters (docs/diagnose.md,
+  // "Natural forms"). Held at its nominal because the data do not pin it there, it is
+  // not known to be there: the fitted parameters' values depend on where it is (a 2nd
+  // harmonic's ratio fitted with its phase held at 0 came out 0.072 +- 0.015 for a truth of
+  // 0.142 at 0.97 rad: seed 8901, campaign 90, before the descent's trust step). It is
+  // marginalised over its range: at kHeldPoints values x spread evenly across the range (a
+  // phase's round the circle, its nominal 0 among them), the fitted parameters are refitted
+  // with it held at x (the first by its one-parameter fit, then the others with it by
+  // Levenberg-Marquardt from there), and each x is weighted by its likelihood exp(-(F(x) -
+  // F_min)/2), F the objective with the fitted parameters' and its own prior (a phase has none:
+  // uniform round the circle) -- a quadrature of the marginal posterior, the Laplace factor
+  // det C(x)^(1/2) left out. The weighted second moment of the refitted values about the
+  // reported ones joins their covariance (a phase's differences taken round the circle). The
+  // grid resolves what it marginalises: a held parameter's sigma from the data is at least its
+  // prior width, a quarter of its range, and the grid's step is an eighth of it; a narrow
+  // valley elsewhere that the grid misses weighs too little (a fit that missed it is the
+  // descent's to find). Each held continuous parameter on its own, the others at their nominals,
+  // their shares added; a discrete one held at its nominal is a choice (the Bayes factor of
+  // step 2), not profiled. Reported only, as the hypothesis' accuracy: the folds, the evidence
+  // and the verdict do not use it.
+  static constexpr int kHeldPoints = 8;
+  void add_held_spread(const Data& d, const std::vector<int>& idx, Multi& mf) const {
+    std::vector<int> which = mf.cov.size() > 0 ? mf.free : std::vector<int>{0};
+    if (!std::isfinite(mf.sigma.front())) return;  // the first at its bound: no sigma to widen
+    const Eigen::Index k = static_cast<Eigen::Index>(which.size());
+    Eigen::MatrixXd spread = Eigen::MatrixXd::Zero(k, k);
+    for (std::size_t j = 1; j < e_.parameters.size(); ++j) {
+      const EffectParameter& q = e_.parameters[j];
+      if (q.discrete || mf.status[j] != "held" || !(std::isfinite(q.lower) && std::isfinite(q.upper))) continue;
+      std::vector<double> xs;
+      for (int i = 0; i < kHeldPoints; ++i)
+        xs.push_back(q.periodic ? q.lower + (q.upper - q.lower) * i / kHeldPoints
+                                : q.lower + (q.upper - q.lower) * i / (kHeldPoints - 1));
+      const std::vector<ProfilePoint> pts = profile(d, idx, mf, static_cast<int>(j), xs);
+      double fmin = INFINITY;
+      for (const ProfilePoint& p : pts) fmin = std::min(fmin, p.objective);
+      if (!std::isfinite(fmin)) continue;
+      double wsum = 0;
+      Eigen::MatrixXd m = Eigen::MatrixXd::Zero(k, k);
+      for (const ProfilePoint& p : pts) {
+        if (!std::isfinite(p.objective)) continue;
+        const double w = std::exp(-(p.objective - fmin) / 2);
+        Eigen::VectorXd dv(k);
+        for (Eigen::Index a = 0; a < k; ++a) {
+          const int i = which[static_cast<std::size_t>(a)];
+          const double dx = p.values[static_cast<std::size_t>(i)] - mf.values[static_cast<std::size_t>(i)];
+          dv(a) = wraps(i) ? std::remainder(dx, range(i).second - range(i).first) : dx;
+        }
+        m += w * dv * dv.transpose(), wsum += w;
+      }
+      spread += m / wsum;
+    }
+    for (std::size_t a = 0; a < which.size(); ++a) {
+      const auto i = static_cast<std::size_t>(which[a]);
+      const double s2 = spread(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a));
+      if (std::isfinite(mf.sigma[i]) && s2 > 0) mf.sigma[i] = std::sqrt(mf.sigma[i] * mf.sigma[i] + s2);
+    }
+    if (mf.cov.size() > 0) mf.cov += spread;
+  }
+
+  // -2 ln L's profile over parameter j: at each x of xs, the other parameters of mf's fit
+  // refitted with j held at x (the first by its one-parameter fit, robust to a far valley; the
+  // further ones of mf's free set with it by Levenberg-Marquardt from there); the objective
+  // with the priors of every further parameter among them and j's.
+  struct ProfilePoint {
+    double x = 0, objective = INFINITY;
+    std::vector<double> values;
+  };
+  std::vector<ProfilePoint> profile(const Data& d, const std::vector<int>& idx, const Multi& mf, int j,
+                                    const std::vector<double>& xs) const {
+    std::vector<int> which = mf.cov.size() > 0 ? mf.free : std::vector<int>{0};
+    which.erase(std::remove(which.begin(), which.end(), j), which.end());
+    std::vector<int> with_j = which;
+    with_j.push_back(j);
+    const Eigen::MatrixXd info = last_info_;
+    std::vector<ProfilePoint> out;
+    for (double x : xs) {
+      ProfilePoint p;
+      p.x = x;
+      std::vector<double> v = mf.values;
+      v[static_cast<std::size_t>(j)] = x;
+      try {
+        v.front() = fit_first(d, idx, v).first;
+        p.values = which.size() > 1 ? levenberg_marquardt(d, idx, v, which) : v;
+        p.objective = objective_at(d, idx, p.values, with_j);
+      } catch (const std::invalid_argument&) {
+        p.values = v;
+      }
+      out.push_back(p);
+    }
+    last_info_ = info;
+    return out;
+  }
+
  private:
   bool further_nominal(const std::vector<double>& v) const {
     for (std::size_t j = 1; j < v.size(); ++j)
@@ -711,6 +805,14 @@ class EffectFitter {
     if (j == 0 && !e_.fitted().linear && !values_.empty()) return {values_.front(), values_.back()};
     return {e_.parameters[static_cast<std::size_t>(j)].lower, e_.parameters[static_cast<std::size_t>(j)].upper};
   }
+  // A periodic further parameter (a phase) has no bound: x outside its range taken round into
+  // it (a value inside is kept as it is, to the bit).
+  bool wraps(int j) const { return j > 0 && e_.parameters[static_cast<std::size_t>(j)].periodic; }
+  double wrapped(int j, double x) const {
+    const auto [lo, hi] = range(j);
+    if (x >= lo && x <= hi) return x;
+    return lo + std::fmod(std::fmod(x - lo, hi - lo) + (hi - lo), hi - lo);
+  }
   double step(const std::vector<double>& v, int j) const {
     if (j > 0) return e_.parameters[static_cast<std::size_t>(j)].fd_step();
     if (e_.fitted().linear) return std::max(1e-3 * std::abs(v[0]), std::abs(e_.fitted().unit_value - e_.fitted().nominal) * 1e-2);
@@ -718,7 +820,7 @@ class EffectFitter {
     return std::max(1e-3 * std::abs(v[0]), 1e-4 * (hi - lo));
   }
   // d pred / d v_j over every run for j in `free`: central differences (one-sided at a bound
-  // or where the plant refuses a value).
+  // or where the plant refuses a value; a phase's taken round the circle: it has no bound).
   Eigen::MatrixXd jacobian(const std::vector<double>& v, const std::vector<int>& free) const {
     const Eigen::Index n = nominal_.pred.size();
     Eigen::MatrixXd J = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(free.size()));
@@ -728,7 +830,8 @@ class EffectFitter {
       const std::pair<double, double> bounds = range(j);
       const double lo = bounds.first, hi = bounds.second;  // (named: a lambda captures them)
       const auto pred_at = [&](double x) -> std::optional<Eigen::VectorXd> {
-        if (x < lo || x > hi) return std::nullopt;
+        if (wraps(j)) x = wrapped(j, x);
+        else if (x < lo || x > hi) return std::nullopt;
         try {
           std::vector<double> w = v;
           w[static_cast<std::size_t>(j)] = x;
@@ -893,17 +996,34 @@ class EffectFitter {
         const double h = step(v, j);
         const auto [lo, hi] = range(j);
         std::vector<double> up = v, down = v;
-        up[static_cast<std::size_t>(j)] = std::min(v[static_cast<std::size_t>(j)] + h, hi);
-        down[static_cast<std::size_t>(j)] = std::max(v[static_cast<std::size_t>(j)] - h, lo);
-        const double span = up[static_cast<std::size_t>(j)] - down[static_cast<std::size_t>(j)];
+        const double x = v[static_cast<std::size_t>(j)];
+        // A phase's differences are taken round the circle (central at +-pi too): clamped at
+        // the range's ends, they were one-sided there and without the curvature's rescaling,
+        // so steps of Gauss-Newton's hundredfold curvature crept along (seed 9301, campaign
+        // 54: from the start at -pi, 15 steps ended at 3.13 rad, 63 above the valley at 2.55).
+        const double x_up = wraps(j) ? x + h : std::min(x + h, hi), x_down = wraps(j) ? x - h : std::max(x - h, lo);
+        up[static_cast<std::size_t>(j)] = wraps(j) ? wrapped(j, x_up) : x_up;
+        down[static_cast<std::size_t>(j)] = wraps(j) ? wrapped(j, x_down) : x_down;
+        const double span = x_up - x_down;
         const double fu = objective(up), fd = objective(down);
         if (span > 0 && std::isfinite(fu) && std::isfinite(fd)) {
           g(a) = -(fu - fd) / (2 * span);
           // The objective's own curvature along j (half its second difference, central only):
           // the row and column of A rescaled to it, the correlations kept from J^T V^-1 J.
-          if (up[static_cast<std::size_t>(j)] - v[static_cast<std::size_t>(j)] == v[static_cast<std::size_t>(j)] - down[static_cast<std::size_t>(j)]) {
+          if (x_up - x == x - x_down) {
             const double hh = span / 2, c = (fu - 2 * f + fd) / (hh * hh) / 2;
-            if (c > 0 && A(a, a) > 0) scale(a) = std::sqrt(c / A(a, a));
+            if (c > 0 && A(a, a) > 0) {
+              scale(a) = std::sqrt(c / A(a, a));
+            } else if (A(a, a) > 0 && std::isfinite(hi - lo)) {
+              // Not convex along j here (the flank of a valley, past its inflection): no
+              // curvature to step by, and J^T V^-1 J's (hundredfold a phase's) crept along
+              // (seed 8901, campaign 90: from pi/2 the phase stopped at 1.52 rad on a slope of
+              // 50 per rad, its valley at 0.9 rad 24 lower). The curvature that makes the step
+              // along j a sixteenth of its range (a quarter of its prior width), when that is
+              // less than J^T V^-1 J's; the steps' acceptance (and lambda) judges it.
+              const double trust = (hi - lo) / 16, target = std::abs(g(a)) / trust;
+              if (target > 0 && target < A(a, a)) scale(a) = std::sqrt(target / A(a, a));
+            }
           }
         }
       }
@@ -1616,6 +1736,7 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
   struct Scored {
     EffectFit fit;
     Eigen::VectorXd heldout;  // held-out adjusted residual per run
+    EffectFitter::Multi all;  // the fit on all runs (its sigma with the hypothesis' accuracy)
   };
   std::vector<Scored> scored;
   Eigen::VectorXd heldout_nominal = Eigen::VectorXd::Zero(n);
@@ -1728,6 +1849,7 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
       else if (fp.status == "fitted" && !q.periodic) fp.at_bound = fp.value <= q.lower || fp.value >= q.upper;
       sc.fit.parameters.push_back(fp);
     }
+    sc.all = std::move(mf);
     scored.push_back(std::move(sc));
   }
   std::sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
@@ -1871,6 +1993,18 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
       d.verdict = "ambiguous between " + tied[0];
       for (std::size_t i = 1; i < tied.size(); ++i) d.verdict += (i + 1 == tied.size() ? " and " : ", ") + tied[i];
     }
+  }
+  // The reported effects' held parameters in their fitted parameters' sigma (add_held_spread):
+  // the top effect's (the one a verdict names or that stands first) and the ambiguous ones'.
+  for (EffectFit& f : d.effects) {
+    if (&f != &d.effects.front() && std::find(d.ambiguous_with.begin(), d.ambiguous_with.end(), f.name) == d.ambiguous_with.end())
+      continue;
+    const auto sc = std::find_if(scored.begin(), scored.end(), [&](const Scored& x) { return x.fit.name == f.name; });
+    if (sc == scored.end() || sc->all.values.empty()) continue;
+    EffectFitter::Multi mf = sc->all;
+    fitters.at(f.name)->add_held_spread(data, all, mf);
+    f.sigma = mf.sigma.front();
+    for (std::size_t j = 0; j < f.parameters.size(); ++j) f.parameters[j].sigma = mf.sigma[j];
   }
   // Advice on the next runs: for an ambiguous or unexplained gap, the runs (direction,
   // frequency, amplitude, static orientation) where the candidates' predictions differ most,
