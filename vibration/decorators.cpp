@@ -146,6 +146,12 @@ Vec3 HarmonicDistortion::acceleration_g(double t) const {
   const Vec3 amp = tone_->amplitude_g(), ph = tone_->phase_rad();
   Vec3 a;
   for (int i = 0; i < 3; ++i) {
+    // An axis the tone does not move stays at rest (its sines are not evaluated: most runs
+    // shake along one axis). +0 where amp * s gave a zero of s's sign.
+    if (amp[i] == 0) {
+      a[i] = 0.0;
+      continue;
+    }
     const double psi = theta + ph[i];
     double s = std::sin(psi);
     for (const Harmonic& h : harmonics_) s += h.ratio * std::sin(h.order * psi + h.phase_rad);

@@ -89,6 +89,8 @@ LoopResponse LoopResponder::operator()(double frequency_Hz) const {
 }
 
 PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::SineVibration& v) {
+  if (std::none_of(config.effects.begin(), config.effects.end(), [](const auto& e) { return e->amplitude_dependent_damping(); }))
+    return config;  // (without a film: not copied twice on the way)
   std::vector<const Effect*> films;  // amplitude-dependent damping (squeeze films)
   PlantConfig out = config;
   out.effects.clear();
@@ -470,6 +472,10 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
   PeriodicInput p;
   p.frequency_Hz = frequency_Hz;
   for (const Vec3& x : a) p.mean_g += x / kN;
+  // The axes whose samples are not all zero (a run along one axis moves one).
+  std::array<bool, 3> moves{false, false, false};
+  for (const Vec3& x : a)
+    for (int i = 0; i < 3; ++i) moves[static_cast<std::size_t>(i)] = moves[static_cast<std::size_t>(i)] || x[i] != 0;
   for (int i = 0; i < 3; ++i)
     if (std::abs(p.mean_g[i]) <= floor_g) p.mean_g[i] = 0.0;
   for (int h = 1; h <= kMaxHarmonic; ++h) {
@@ -480,10 +486,12 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
     // product's NaN checks.)
     double xr[3] = {0, 0, 0}, xi[3] = {0, 0, 0};
     const std::complex<double>* tw = twiddle.data() + static_cast<std::ptrdiff_t>(h - 1) * kN;
-    for (int k = 0; k < kN; ++k) {
-      const double c = tw[k].real(), sn = tw[k].imag();
-      const Vec3& ak = a[static_cast<std::size_t>(k)];
-      for (int i = 0; i < 3; ++i) xr[i] += ak[i] * c, xi[i] += ak[i] * sn;
+    for (int i = 0; i < 3; ++i) {
+      if (!moves[i]) continue;  // 0 + 0 c + 0 c + ... is 0: an axis at rest adds nothing
+      for (int k = 0; k < kN; ++k) {
+        const double ak = a[static_cast<std::size_t>(k)][i];
+        xr[i] += ak * tw[k].real(), xi[i] += ak * tw[k].imag();
+      }
     }
     Eigen::Vector3cd x;
     for (int i = 0; i < 3; ++i) x[i] = std::complex<double>(xr[i], xi[i]);

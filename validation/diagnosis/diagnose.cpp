@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
+#include <cstdint>
 #include <complex>
 #include <cstdio>
 #include <numbers>
@@ -106,16 +108,18 @@ class ResponseCache {
   // loop_response would compute it; the plant is linearised once for every frequency asked of
   // a linear part alike (rectification::LoopResponder: the same numbers).)
   const rectification::LoopResponse& get(const PlantConfig& cfg, const std::string& key, double f) {
-    auto k = std::make_pair(key, f);
-    auto it = cache_.find(k);
-    if (it == cache_.end()) {
+    // (By key, then frequency: the key is not copied for every look-up.)
+    auto by_key = cache_.find(key);
+    if (by_key == cache_.end()) by_key = cache_.emplace(key, std::map<double, rectification::LoopResponse>()).first;
+    auto it = by_key->second.find(f);
+    if (it == by_key->second.end()) {
       if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
       if (cfg.servo) {
-        it = cache_.emplace(k, responder(cfg, key)(f)).first;
+        it = by_key->second.emplace(f, responder(cfg, key)(f)).first;
       } else {
         PlantConfig with_servo = cfg;
         with_servo.servo = servo(cfg.dynamics);
-        it = cache_.emplace(k, responder(with_servo, key)(f)).first;
+        it = by_key->second.emplace(f, responder(with_servo, key)(f)).first;
       }
     }
     return it->second;
@@ -161,7 +165,7 @@ class ResponseCache {
     if (it == responders_.end()) it = responders_.emplace(k, std::make_unique<rectification::LoopResponder>(cfg)).first;
     return *it->second;
   }
-  std::map<std::pair<std::string, double>, rectification::LoopResponse> cache_;
+  std::map<std::string, std::map<double, rectification::LoopResponse>, std::less<>> cache_;
   std::map<std::pair<std::string, std::vector<double>>, std::unique_ptr<rectification::LoopResponder>> responders_;
   std::map<DynamicsKey, plant::Servo> servos_;
   PlantConfig plant_;
@@ -214,15 +218,15 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     else if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
     // The loop responses depend on the effect's value and, for an amplitude-dependent one,
     // on the run: the key says both.
+    // (The name, a NUL and the numbers' bytes: the same numbers give the same key, as their
+    // %.17g text did, without formatting them for every run of every table.)
     std::string key;
     if (e && e->changes_dynamics) {
-      char buf[64];
-      std::snprintf(buf, sizeof buf, "=%.17g|%.17g", p, cfg.dynamics.pendulum_damping_ratio);
-      key = e->name + buf;
-      for (std::size_t j = 1; j < values.size(); ++j) {
-        std::snprintf(buf, sizeof buf, "|%.17g", values[j]);
-        key += buf;
-      }
+      key = e->name;
+      key += '\0';
+      const auto put = [&key](double x) { key.append(reinterpret_cast<const char*>(&x), sizeof x); };
+      put(p), put(cfg.dynamics.pendulum_damping_ratio);
+      for (std::size_t j = 1; j < values.size(); ++j) put(values[j]);
     }
     // A squeeze film's linearised plant is this run's own (its damping is in the key): its
     // responses are kept for the run only, not in the cache (the same numbers: the plant
@@ -300,9 +304,17 @@ struct Data {
 
 // The model-accuracy part is fixed at the nominal prediction: were it taken at each effect's
 // prediction, an effect could lower chi^2 by inflating its predictions.
+// (Only the lower triangle is a product, the upper its mirror: every use factorises V, which
+// reads the lower triangle, or takes its diagonal. Each entry is the same sum in the same
+// order as the full product's, so the factorisations are bit for bit as before, at half the
+// product's work.)
 Eigen::MatrixXd covariance(const Data& d, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
   const Eigen::MatrixXd Gi = rows(G, idx);
-  Eigen::MatrixXd V = Gi * d.Sigma * Gi.transpose();
+  const Eigen::MatrixXd GS = Gi * d.Sigma;
+  const auto n = static_cast<Eigen::Index>(idx.size());
+  Eigen::MatrixXd V(n, n);
+  V.triangularView<Eigen::Lower>() = GS * Gi.transpose();
+  V.triangularView<Eigen::StrictlyUpper>() = V.transpose();
   for (std::size_t i = 0; i < idx.size(); ++i) V(i, i) += d.sigma2(idx[i]);
   return V;
 }
@@ -1059,8 +1071,26 @@ class EffectFitter {
     }
     return v;
   }
-  // The first parameter's fit with the others at base's values.
+  // The first parameter's fit with the others at base's values. A function of its inputs
+  // alone: kept per (data, runs, base), bit for bit (the folds' fits, the final fit, the
+  // pairs' and the natural forms' starts ask for the same fits again).
   std::pair<double, double> fit_first(const Data& d, const std::vector<int>& idx, const std::vector<double>& base) const {
+    std::vector<std::uint64_t> key;
+    key.reserve(4 + idx.size() + base.size() + static_cast<std::size_t>(d.measured.size() + d.sigma2.size() + d.Sigma.size()));
+    const auto put = [&key](double x) { key.push_back(std::bit_cast<std::uint64_t>(x)); };
+    key.push_back(idx.size()), key.push_back(base.size());
+    for (int i : idx) key.push_back(static_cast<std::uint64_t>(i));
+    for (double x : base) put(x);
+    key.push_back(static_cast<std::uint64_t>(d.measured.size())), key.push_back(static_cast<std::uint64_t>(d.Sigma.rows()));
+    for (Eigen::Index i = 0; i < d.measured.size(); ++i) put(d.measured(i)), put(d.sigma2(i));
+    for (Eigen::Index i = 0; i < d.Sigma.size(); ++i) put(d.Sigma.data()[i]);
+    const auto it = fits_.find(key);
+    if (it != fits_.end()) return it->second;
+    const std::pair<double, double> f = fit_first_uncached(d, idx, base);
+    fits_.emplace(std::move(key), f);
+    return f;
+  }
+  std::pair<double, double> fit_first_uncached(const Data& d, const std::vector<int>& idx, const std::vector<double>& base) const {
     const bool nominal_base = further_nominal(base);
     const auto at_p = [&](double p) { return nominal_base ? at(p) : at(with_first(base, p)); };
     auto L = [&](double p) {  // a value the plant refuses (a servo the design cannot build) is no fit
@@ -1156,6 +1186,7 @@ class EffectFitter {
   mutable std::map<std::vector<double>, Table> tables_;
   mutable bool cov_never_definite_ = false;  // covariance_at's Hessian never positive definite
   mutable Eigen::MatrixXd last_info_;  // levenberg_marquardt's information matrix at its last point
+  mutable std::map<std::vector<std::uint64_t>, std::pair<double, double>> fits_;  // fit_first's, by its inputs' bits
 };
 
 std::string fmt_peak(const RunRecord& run, const std::string& dir, const std::string& orient, double z) {
@@ -1766,6 +1797,8 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
     Eigen::MatrixXd slopes;    // n x k; k = 0 when a parameter ended on a bound
     Eigen::MatrixXd cov;       // k x k: the fitted parameters' covariance
   };
+  // The nominal's held-out -2 ln L per fold (the same for every candidate).
+  std::map<double, Likelihood> nominal_heldout;
   const auto score = [&](const std::function<Fitted(const std::vector<int>&)>& fit_on, Scored& sc) {
     sc.heldout = Eigen::VectorXd::Zero(n);
     for (const auto& [key, test] : folds) {
@@ -1784,8 +1817,12 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
         Ga << f.t.G, f.slopes;
         with = conditional_on(da, f.t.pred, Ga, train);
       }
-      const Likelihood without =
-          train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all) : conditional(nominal, train);
+      auto known = nominal_heldout.find(key);
+      if (known == nominal_heldout.end())
+        known = nominal_heldout
+                    .emplace(key, train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all) : conditional(nominal, train))
+                    .first;
+      const Likelihood without = known->second;
       sc.fit.evidence += without.m2logl - with.m2logl;
       sc.fit.heldout_chi2 += with.chi2;
       const Eigen::VectorXd a = adjusted_residual(data, f.t.pred, f.t.G, train, test);
