@@ -3,24 +3,40 @@
 # kept findings (fuzz/regressions/<target>/) and the seeds (cases/, fuzz/corpus/<target>/).
 # Prints each target's executions per second and total executions; exits 1 on a finding (its
 # input is in BUILD/fuzz-findings/: keep it in fuzz/regressions/<target>/ with the fix).
+# The targets run side by side, as many at a time as there are cores (FUZZ_JOBS to change it),
+# each for SECONDS of wall time on a core of its own.
 # Usage: fuzz/run.sh BUILD_DIR [SECONDS]   (BUILD_DIR configured with -DVRELAB_FUZZ=ON)
 set -u
 build=$1
 seconds=${2:-60}
+jobs=${FUZZ_JOBS:-$(nproc)}
 src=$(cd "$(dirname "$0")/.." && pwd)
 findings="$build/fuzz-findings"
 mkdir -p "$findings"
-status=0
-for t in case_file lab_data series; do
-  work="$build/fuzz-corpus/$t"  # grows as the fuzzer finds new coverage; kept between runs
+targets=(case_file lab_data series)
+fuzz_one() {  # target: runs it, its exit code into $build/fuzz-$t.rc
+  local t=$1 work="$build/fuzz-corpus/$1"  # grows as the fuzzer finds new coverage; kept between runs
   mkdir -p "$work"
-  seeds=("$src/fuzz/regressions/$t")
+  local seeds=("$src/fuzz/regressions/$t")
   if [ "$t" = case_file ]; then seeds+=("$src/cases"); else seeds+=("$src/fuzz/corpus/$t"); fi
-  log="$build/fuzz-$t.log"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
     "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 \
-    -artifact_prefix="$findings/$t-" "$work" "${seeds[@]}" >"$log" 2>&1
-  rc=$?
+    -artifact_prefix="$findings/$t-" "$work" "${seeds[@]}" >"$build/fuzz-$t.log" 2>&1
+  echo $? >"$build/fuzz-$t.rc"
+}
+running=0
+for t in "${targets[@]}"; do
+  if [ "$running" -ge "$jobs" ]; then wait -n; running=$((running - 1)); fi
+  rm -f "$build/fuzz-$t.rc"
+  fuzz_one "$t" &
+  running=$((running + 1))
+done
+wait
+status=0
+for t in "${targets[@]}"; do
+  work="$build/fuzz-corpus/$t"
+  log="$build/fuzz-$t.log"
+  rc=$(cat "$build/fuzz-$t.rc" 2>/dev/null || echo 99)
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
   cov=$(grep -Eo 'cov: [0-9]+' "$log" | tail -1)
