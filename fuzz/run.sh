@@ -10,6 +10,7 @@ set -u
 build=$1
 seconds=${2:-60}
 jobs=${FUZZ_JOBS:-$(nproc)}
+if ! [[ "$jobs" =~ ^[1-9][0-9]*$ ]]; then echo "fuzz/run.sh: FUZZ_JOBS must be a positive integer, not '$jobs'" >&2; exit 2; fi
 src=$(cd "$(dirname "$0")/.." && pwd)
 findings="$build/fuzz-findings"
 mkdir -p "$findings"

@@ -1001,7 +1001,9 @@ class EffectFitter {
       // its optimum (seen: every step rejected).
       Eigen::MatrixXd A = Ji.transpose() * ldlt.solve(Ji);
       Eigen::VectorXd g = Ji.transpose() * ldlt.solve(r);
-      Eigen::VectorXd scale = Eigen::VectorXd::Ones(k);
+      // scale: the objective's curvature (reported through last_info_); step: that, or where
+      // the objective is not convex along a further parameter, the trust step's.
+      Eigen::VectorXd scale = Eigen::VectorXd::Ones(k), step_scale = Eigen::VectorXd::Ones(k);
       for (Eigen::Index a = 0; a < k; ++a) {
         const int j = free[static_cast<std::size_t>(a)];
         if (a > 0) A(a, a) += prior_weight(j);
@@ -1022,25 +1024,29 @@ class EffectFitter {
           g(a) = -(fu - fd) / (2 * span);
           // The objective's own curvature along j (half its second difference, central only):
           // the row and column of A rescaled to it, the correlations kept from J^T V^-1 J.
-          if (x_up - x == x - x_down) {
-            const double hh = span / 2, c = (fu - 2 * f + fd) / (hh * hh) / 2;
+          // (Central: both sides h away, not clipped by the range; tested on the bounds, not by
+          // comparing x_up - x with x - x_down, which rounding makes unequal for some x.)
+          if (wraps(j) || (x + h <= hi && x - h >= lo)) {
+            const double c = (fu - 2 * f + fd) / (h * h) / 2;
             if (c > 0 && A(a, a) > 0) {
-              scale(a) = std::sqrt(c / A(a, a));
-            } else if (A(a, a) > 0 && std::isfinite(hi - lo)) {
+              scale(a) = step_scale(a) = std::sqrt(c / A(a, a));
+            } else if (j > 0 && A(a, a) > 0 && std::isfinite(hi - lo)) {
               // Not convex along j here (the flank of a valley, past its inflection): no
               // curvature to step by, and J^T V^-1 J's (hundredfold a phase's) crept along
               // (seed 8901, campaign 90: from pi/2 the phase stopped at 1.52 rad on a slope of
               // 50 per rad, its valley at 0.9 rad 24 lower). The curvature that makes the step
               // along j a sixteenth of its range (a quarter of its prior width), when that is
-              // less than J^T V^-1 J's; the steps' acceptance (and lambda) judges it.
+              // less than J^T V^-1 J's; the steps' acceptance (and lambda) judges it. A further
+              // parameter only (the first one's fit starts from its grid's best). Not information:
+              // the covariance (last_info_) keeps J^T V^-1 J along j.
               const double trust = (hi - lo) / 16, target = std::abs(g(a)) / trust;
-              if (target > 0 && target < A(a, a)) scale(a) = std::sqrt(target / A(a, a));
+              if (target > 0 && target < A(a, a)) step_scale(a) = std::sqrt(target / A(a, a));
             }
           }
         }
       }
-      A = scale.asDiagonal() * A * scale.asDiagonal();
-      last_info_ = A;
+      last_info_ = scale.asDiagonal() * A * scale.asDiagonal();
+      A = step_scale.asDiagonal() * A * step_scale.asDiagonal();
       bool accepted = false, converged = false;
       for (int tries = 0; tries < 8 && !accepted; ++tries) {
         Eigen::MatrixXd Al = A;
@@ -1058,10 +1064,13 @@ class EffectFitter {
         const double fw = objective(w);
         if (fw < f) {
           converged = true;
-          for (Eigen::Index a = 0; a < k; ++a)
-            if (std::abs(w[static_cast<std::size_t>(free[static_cast<std::size_t>(a)])] -
-                         v[static_cast<std::size_t>(free[static_cast<std::size_t>(a)])]) > 1e-3 / std::sqrt(std::max(A(a, a), 1e-300)))
-              converged = false;
+          for (Eigen::Index a = 0; a < k; ++a) {
+            const int j = free[static_cast<std::size_t>(a)];
+            const double moved = w[static_cast<std::size_t>(j)] - v[static_cast<std::size_t>(j)];
+            // (a phase's move across +-pi is its short way round)
+            const double by = wraps(j) ? std::remainder(moved, range(j).second - range(j).first) : moved;
+            if (std::abs(by) > 1e-3 / std::sqrt(std::max(A(a, a), 1e-300))) converged = false;
+          }
           v = w, f = fw, lambda = std::max(lambda / 3, 1e-6), accepted = true;
         } else {
           lambda *= 10;
