@@ -154,3 +154,35 @@ TEST(Nuisances, ASqueezeFilmWithTheStatedSigmaRightIsNotCalledSigmaUnderstated) 
   EXPECT_EQ(d.verdict.find("sigma understated"), std::string::npos) << d.verdict;
   EXPECT_TRUE(d.gap_significant) << d.verdict;  // the film is seen (the test can fail)
 }
+
+// The drift test's false-alarm rate, by Monte Carlo: rest readings that are independent normal
+// draws (blind's lab log: 3 min a run, sigma 0.3 ug) with no drift are flagged at the
+// nuisances' level, 2 (1 - Phi(3)) = 0.270 % two-sided, at any number of readings. 40 000 logs
+// each: 108 flags expected, a binomial sd of 10.4; the window is +-4.5 sd (a false failure
+// once in 1.5e5 runs). A threshold from the normal quantile (3.0) instead of Student's t (4.28
+// for 8 degrees of freedom) would flag 1.7 % of 10-reading logs (683 expected: fails; seen 635)
+// and 0.31 % of 168-reading ones (125: inside the window, t(166) being nearly normal).
+TEST(Nuisances, TheDriftTestFlagsNoDriftAtItsStatedRate) {
+  const double level = std::erfc(3 / std::sqrt(2.0));  // 2 (1 - Phi(3)), not the code's constant
+  constexpr int kTrials = 40000;
+  for (const int readings : {10, 168}) {
+    Campaign c;
+    c.runs.resize(static_cast<std::size_t>(readings));
+    std::mt19937_64 rng(153 + static_cast<std::uint64_t>(readings));
+    std::normal_distribution<double> n01;
+    int flagged = 0;
+    for (int trial = 0; trial < kTrials; ++trial) {
+      for (std::size_t j = 0; j < c.runs.size(); ++j) {
+        RunRecord& r = c.runs[j];
+        r.time_h = 0.05 * static_cast<double>(j);
+        r.rest_g = 0.3e-6 * n01(rng);
+        r.measured_g = 0, r.sigma_g = 1e-6;
+      }
+      const Nuisance x = remove_drift(c);
+      ASSERT_TRUE(x.estimated);
+      flagged += x.significant;
+    }
+    const double expected = level * kTrials, sd = std::sqrt(expected * (1 - level));
+    EXPECT_NEAR(flagged, expected, 4.5 * sd) << readings << " readings: " << flagged << " of " << kTrials << " flagged";
+  }
+}

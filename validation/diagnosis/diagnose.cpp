@@ -1352,6 +1352,8 @@ namespace {
 // statistic's distribution under "no nuisance", not values tuned on campaigns.
 constexpr double kNuisanceTail = 1.3498980316300946e-3;
 
+}  // namespace
+
 // Bias drift: a line through the rest readings over the campaign's time (unweighted least
 // squares; its scatter gives the readings' sigma), removed from every run with a time, the
 // line's own variance added to the run's. The runs without time are left as they are.
@@ -1382,7 +1384,7 @@ Nuisance remove_drift(Campaign& c) {
   nu.value = b * 1e6, nu.sigma = std::sqrt(s2 / stt) * 1e6;
   // Without a drift, b / sigma_b is Student's t with m - 2 degrees of freedom (a line fit to m
   // readings with Gaussian noise of unknown sigma): significant beyond its two-sided quantile
-  // at the 3-sigma level (3.05 for 168 readings; 4.9 for 10).
+  // at the 3-sigma level (3.05 for 168 readings; 4.28 for 10).
   double t_crit = INFINITY;
   if (rest.size() > 2) t_crit = boost::math::quantile(boost::math::students_t(m - 2), 1 - kNuisanceTail);
   nu.significant = s2 > 0 ? std::abs(b) > t_crit * std::sqrt(s2 / stt) : b != 0;
@@ -1397,6 +1399,8 @@ Nuisance remove_drift(Campaign& c) {
   nu.note = buf;
   return nu;
 }
+
+namespace {
 
 // Runs alike but for one step of frequency or of amplitude (same direction, orientation and
 // the other): how alike their gaps z are, as the correlation of neighbours, and how many pairs.

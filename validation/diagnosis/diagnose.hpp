@@ -242,6 +242,11 @@ struct Diagnosis {
   std::string FullReport(double wall_s = -1) const;
 };
 
+// The bias drift (diagnose's first step): the rest readings' line over the runs' time (rate in
+// ug/h, its sigma, significant beyond Student's t at the nuisances' 3-sigma level, two-sided),
+// removed from every run with a time. Fewer than 3 rest readings: not estimated, c unchanged.
+Nuisance remove_drift(Campaign& c);
+
 Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {});
 
 // The gap a hidden effect makes, as the diagnosis' nominal model sees it (blind's family size;
