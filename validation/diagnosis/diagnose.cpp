@@ -587,7 +587,7 @@ class EffectFitter {
   // b b^T. b comes from two refits: the fit repeated on the data shifted by +f Delta and by
   // -f Delta (the effect's change scaled by 1 -+ f), each a Levenberg-Marquardt descent from the
   // fitted values over the same free parameters (not the multi-start: the shift is small), and
-  // b = (v+ - v-) / 2 (each refit's shift of a phase wrapped into (-pi, pi]). For a linear one-parameter
+  // b = (v+ - v-) / 2 (each refit's shift of a phase taken the short way round, within +-pi). For a linear one-parameter
   // effect b = f p (the parameter known to f of itself); errors independent run by run would
   // give f p / sqrt(N) of N like runs, which a systematic error does not average down. A large
   // effect seen at hundreds of sigma had sigma from the noise only (a harmonic's phase 4 sigma
@@ -718,7 +718,7 @@ class EffectFitter {
   // and the verdict do not use it.
   static constexpr int kHeldPoints = 8;
   void add_held_spread(const Data& d, const std::vector<int>& idx, Multi& mf) const {
-    std::vector<int> which = mf.cov.size() > 0 ? mf.free : std::vector<int>{0};
+    const std::vector<int> which = fitted_set(mf);
     if (!std::isfinite(mf.sigma.front())) return;  // the first at its bound: no sigma to widen
     const Eigen::Index k = static_cast<Eigen::Index>(which.size());
     Eigen::MatrixXd spread = Eigen::MatrixXd::Zero(k, k);
@@ -766,7 +766,7 @@ class EffectFitter {
   };
   std::vector<ProfilePoint> profile(const Data& d, const std::vector<int>& idx, const Multi& mf, int j,
                                     const std::vector<double>& xs) const {
-    std::vector<int> which = mf.cov.size() > 0 ? mf.free : std::vector<int>{0};
+    std::vector<int> which = fitted_set(mf);
     which.erase(std::remove(which.begin(), which.end(), j), which.end());
     std::vector<int> with_j = which;
     with_j.push_back(j);
@@ -791,6 +791,8 @@ class EffectFitter {
   }
 
  private:
+  // The parameters mf fitted: its free set, or the first alone (the one-parameter fit).
+  static std::vector<int> fitted_set(const Multi& mf) { return mf.cov.size() > 0 ? mf.free : std::vector<int>{0}; }
   bool further_nominal(const std::vector<double>& v) const {
     for (std::size_t j = 1; j < v.size(); ++j)
       if (v[j] != nominal_values_[j]) return false;
@@ -817,13 +819,14 @@ class EffectFitter {
     if (j == 0 && !e_.fitted().linear && !values_.empty()) return {values_.front(), values_.back()};
     return {e_.parameters[static_cast<std::size_t>(j)].lower, e_.parameters[static_cast<std::size_t>(j)].upper};
   }
-  // A periodic further parameter (a phase) has no bound: x outside its range taken round into
-  // it (a value inside is kept as it is, to the bit).
+  // A periodic further parameter (a phase) has no bound: x taken round into [lo, hi) (a phase
+  // in [-pi, pi): +pi is -pi; a value inside is kept as it is, to the bit).
   bool wraps(int j) const { return j > 0 && e_.parameters[static_cast<std::size_t>(j)].periodic; }
   double wrapped(int j, double x) const {
     const auto [lo, hi] = range(j);
-    if (x >= lo && x <= hi) return x;
-    return lo + std::fmod(std::fmod(x - lo, hi - lo) + (hi - lo), hi - lo);
+    if (x >= lo && x < hi) return x;
+    const double w = lo + std::fmod(std::fmod(x - lo, hi - lo) + (hi - lo), hi - lo);
+    return w < hi ? w : lo;  // (lo + a remainder just below the period can round to hi)
   }
   double step(const std::vector<double>& v, int j) const {
     if (j > 0) return e_.parameters[static_cast<std::size_t>(j)].fd_step();
@@ -984,6 +987,76 @@ class EffectFitter {
     cov_never_definite_ = true;
     return fallback;
   }
+  // One descent step in a valley narrower than the differences (docs/diagnose.md, "Natural
+  // forms", step 3): where a parameter's difference step spans more than kNarrowSigmas of its
+  // conditional sigma 1/sqrt(c) (c the objective's curvature along it over that step: -2 ln L
+  // rises by more than kNarrowSigmas^2 across the step), the differences straddle a curved
+  // valley's walls and their slope can have the wrong sign (seed 9601, campaign 30: a mode's
+  // frequency and damping, correlation -0.998, differences 50 and 10 conditional sigma wide;
+  // the descent stopped 23.6 of -2 ln L above the truth). The gradient and the whole Hessian
+  // (the mixed terms too: Gauss-Newton's correlations miss what the parameters do to V and the
+  // prediction's curvature, and a valley's direction is the small difference of two large
+  // numbers) are then taken by central differences over kLocalSigmas of each parameter's
+  // conditional sigma (at most its usual step), and the step is Newton's, halved until the
+  // objective falls (a backtracking line search: the descent stays monotone and follows the
+  // valley instead of zig-zagging across it as Levenberg-Marquardt's damping towards the
+  // gradient makes it). Over 0.3 sigma the differences' -2 ln L changes by ~0.1, far above its
+  // rounding. v and f move to the accepted point. Returns nothing where the valley is not
+  // narrow or the local Hessian is not positive definite (Levenberg-Marquardt's step then),
+  // else whether the descent stops (no decrease, or every move below 1e-3 conditional sigma).
+  static constexpr double kNarrowSigmas = 1, kLocalSigmas = 0.3;
+  std::optional<bool> valley_step(const Data& d, const std::vector<int>& idx, const std::vector<int>& free,
+                                  std::vector<double>& v, double& f, const Eigen::VectorXd& steps,
+                                  const Eigen::VectorXd& curv) const {
+    const Eigen::Index k = static_cast<Eigen::Index>(free.size());
+    bool narrow = false;
+    Eigen::VectorXd h(k);
+    for (Eigen::Index a = 0; a < k; ++a) {
+      if (!(curv(a) > 0)) return std::nullopt;  // one-sided or not convex: the trust step's case
+      const double sigma = 1 / std::sqrt(curv(a));
+      narrow = narrow || steps(a) > kNarrowSigmas * sigma;
+      h(a) = std::min(steps(a), kLocalSigmas * sigma);
+    }
+    if (!narrow) return std::nullopt;
+    const auto moved = [&](std::vector<double> w, Eigen::Index a, double by) {
+      const int j = free[static_cast<std::size_t>(a)];
+      const double x = w[static_cast<std::size_t>(j)] + by;
+      w[static_cast<std::size_t>(j)] = wraps(j) ? wrapped(j, x) : std::clamp(x, range(j).first, range(j).second);
+      return w;
+    };
+    const auto f_at = [&](Eigen::Index a, double sa, Eigen::Index b, double sb) {
+      std::vector<double> w = moved(v, a, sa * h(a));
+      if (b >= 0) w = moved(w, b, sb * h(b));
+      return objective_at(d, idx, w, free);
+    };
+    Eigen::VectorXd g(k);
+    Eigen::MatrixXd H(k, k);  // half the objective's Hessian, as J^T V^-1 J
+    for (Eigen::Index a = 0; a < k; ++a) {
+      const double fu = f_at(a, 1, -1, 0), fd = f_at(a, -1, -1, 0);
+      g(a) = -(fu - fd) / (4 * h(a));
+      H(a, a) = (fu - 2 * f + fd) / (h(a) * h(a)) / 2;
+      for (Eigen::Index b = 0; b < a; ++b)
+        H(a, b) = H(b, a) = (f_at(a, 1, b, 1) - f_at(a, 1, b, -1) - f_at(a, -1, b, 1) + f_at(a, -1, b, -1)) / (8 * h(a) * h(b));
+    }
+    if (!H.allFinite() || !g.allFinite()) return std::nullopt;
+    const Eigen::LLT<Eigen::MatrixXd> llt(H);
+    if (llt.info() != Eigen::Success) return std::nullopt;
+    last_info_ = H;
+    const Eigen::VectorXd newton = llt.solve(g);
+    double t = 1;
+    for (int tries = 0; tries < 10; ++tries, t /= 2) {
+      std::vector<double> w = v;
+      for (Eigen::Index a = 0; a < k; ++a) w = moved(w, a, t * newton(a));
+      const double fw = objective_at(d, idx, w, free);
+      if (!(fw < f)) continue;
+      bool converged = true;
+      for (Eigen::Index a = 0; a < k; ++a)
+        if (std::abs(t * newton(a)) > 1e-3 / std::sqrt(H(a, a))) converged = false;
+      v = w, f = fw;
+      return converged;
+    }
+    return true;
+  }
   // Levenberg-Marquardt on -2 ln L + the further parameters' priors over `free`, from v.
   std::vector<double> levenberg_marquardt(const Data& d, const std::vector<int>& idx, std::vector<double> v,
                                           const std::vector<int>& free) const {
@@ -1004,10 +1077,14 @@ class EffectFitter {
       // scale: the objective's curvature (reported through last_info_); step: that, or where
       // the objective is not convex along a further parameter, the trust step's.
       Eigen::VectorXd scale = Eigen::VectorXd::Ones(k), step_scale = Eigen::VectorXd::Ones(k);
+      // Each parameter's difference step and the objective's curvature along it over that step
+      // (half the second difference; NaN where the difference is not central).
+      Eigen::VectorXd steps(k), curv = Eigen::VectorXd::Constant(k, std::numeric_limits<double>::quiet_NaN());
       for (Eigen::Index a = 0; a < k; ++a) {
         const int j = free[static_cast<std::size_t>(a)];
         if (a > 0) A(a, a) += prior_weight(j);
         const double h = step(v, j);
+        steps(a) = h;
         const auto [lo, hi] = range(j);
         std::vector<double> up = v, down = v;
         const double x = v[static_cast<std::size_t>(j)];
@@ -1028,6 +1105,7 @@ class EffectFitter {
           // comparing x_up - x with x - x_down, which rounding makes unequal for some x.)
           if (wraps(j) || (x + h <= hi && x - h >= lo)) {
             const double c = (fu - 2 * f + fd) / (h * h) / 2;
+            curv(a) = c;
             if (c > 0 && A(a, a) > 0) {
               scale(a) = step_scale(a) = std::sqrt(c / A(a, a));
             } else if (j > 0 && A(a, a) > 0 && std::isfinite(hi - lo)) {
@@ -1045,6 +1123,10 @@ class EffectFitter {
           }
         }
       }
+      if (const std::optional<bool> stop = valley_step(d, idx, free, v, f, steps, curv)) {
+        if (*stop) break;
+        continue;
+      }
       last_info_ = scale.asDiagonal() * A * scale.asDiagonal();
       A = step_scale.asDiagonal() * A * step_scale.asDiagonal();
       bool accepted = false, converged = false;
@@ -1057,9 +1139,7 @@ class EffectFitter {
           const int j = free[static_cast<std::size_t>(a)];
           const auto [lo, hi] = range(j);
           double x = w[static_cast<std::size_t>(j)] + delta(a);
-          const EffectParameter& q = e_.parameters[static_cast<std::size_t>(j)];
-          if (j > 0 && q.periodic) x = lo + std::fmod(std::fmod(x - lo, hi - lo) + (hi - lo), hi - lo);
-          w[static_cast<std::size_t>(j)] = std::clamp(x, lo, hi);
+          w[static_cast<std::size_t>(j)] = wraps(j) ? wrapped(j, x) : std::clamp(x, lo, hi);
         }
         const double fw = objective(w);
         if (fw < f) {
