@@ -1002,8 +1002,9 @@ class EffectFitter {
   // valley instead of zig-zagging across it as Levenberg-Marquardt's damping towards the
   // gradient makes it). Over 0.3 sigma the differences' -2 ln L changes by ~0.1, far above its
   // rounding. v and f move to the accepted point. Returns nothing where the valley is not
-  // narrow or the local Hessian is not positive definite (Levenberg-Marquardt's step then),
-  // else whether the descent stops (no decrease, or every move below 1e-3 conditional sigma).
+  // narrow, the local Hessian is not positive definite or its step finds no decrease
+  // (Levenberg-Marquardt's step then), else whether the descent stops (every move below 1e-3
+  // conditional sigma).
   static constexpr double kNarrowSigmas = 1, kLocalSigmas = 0.3;
   std::optional<bool> valley_step(const Data& d, const std::vector<int>& idx, const std::vector<int>& free,
                                   std::vector<double>& v, double& f, const Eigen::VectorXd& steps,
@@ -1055,7 +1056,7 @@ class EffectFitter {
       v = w, f = fw;
       return converged;
     }
-    return true;
+    return std::nullopt;  // no decrease along Newton's direction: Levenberg-Marquardt's step
   }
   // Levenberg-Marquardt on -2 ln L + the further parameters' priors over `free`, from v.
   std::vector<double> levenberg_marquardt(const Data& d, const std::vector<int>& idx, std::vector<double> v,
