@@ -35,6 +35,7 @@ class FactoredCovariance {
   Eigen::MatrixXd whitened(const Eigen::MatrixXd& y) const;
   double chi2(const Eigen::VectorXd& y) const;   // y^T V^-1 y
   Eigen::MatrixXd solve(const Eigen::MatrixXd& y) const;  // V^-1 y
+  Eigen::VectorXd solve(const Eigen::VectorXd& y) const { return solve(Eigen::MatrixXd(y)).col(0); }
   // The coefficients' conditional mean given y: Sigma G^T V^-1 y (= B z*, z* the least-squares
   // solution above), m entries.
   Eigen::VectorXd conditional_mean(const Eigen::VectorXd& y) const;
