@@ -37,7 +37,7 @@ json parameters_json(const validation::EffectFit& e) {
 
 json effects_json(const validation::Diagnosis& d) {
   json effects = json::array();
-  for (const auto& e : d.effects)
+  for (const auto& e : d.effects) {
     effects.push_back({{"name", e.name},
                        {"parameter", e.value},
                        {"parameter_name", e.parameter},
@@ -47,6 +47,8 @@ json effects_json(const validation::Diagnosis& d) {
                        {"heldout_chi2", e.heldout_chi2},
                        {"at_bound", e.at_bound},
                        {"parameters", parameters_json(e)}});
+    if (!e.not_ranked.empty()) effects.back()["not_ranked"] = e.not_ranked;  // why it is no candidate
+  }
   return effects;
 }
 

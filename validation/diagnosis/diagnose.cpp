@@ -25,6 +25,7 @@
 #include "rectification/prediction/random.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "vibration/excitation.hpp"
+#include "validation/diagnosis/gaussian_likelihood.hpp"
 #include "validation/reproduce/reproduce.hpp"
 
 namespace vrelab::validation {
@@ -319,12 +320,18 @@ Eigen::MatrixXd covariance(const Data& d, const Eigen::MatrixXd& G, const std::v
   return V;
 }
 
+// V of the runs idx factored without forming it (gaussian_likelihood.hpp: an LDLT of V met
+// negative pivots where a slope column puts V's entries 1e20 above the runs' variances).
+FactoredCovariance factored(const Data& d, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
+  return FactoredCovariance(sub(d.sigma2, idx), rows(G, idx), d.Sigma);
+}
+
 Likelihood likelihood(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, G, idx));
+  const FactoredCovariance v = factored(d, G, idx);
   const Eigen::VectorXd r = sub(d.measured, idx) - sub(pred, idx);
   Likelihood l;
-  l.chi2 = r.dot(ldlt.solve(r));
-  l.m2logl = l.chi2 + ldlt.vectorD().array().abs().log().sum();
+  l.chi2 = v.chi2(r);
+  l.m2logl = l.chi2 + v.log_det();
   return l;
 }
 
@@ -332,9 +339,8 @@ Likelihood likelihood(const Data& d, const Eigen::VectorXd& pred, const Eigen::M
 // coefficients' correction estimated from the runs `from` (and the static test's prior).
 Eigen::VectorXd adjusted_residual(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G,
                                   const std::vector<int>& from, const std::vector<int>& at) {
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, G, from));
   const Eigen::VectorXd rf = sub(d.measured, from) - sub(pred, from);
-  const Eigen::VectorXd dc = d.Sigma * rows(G, from).transpose() * ldlt.solve(rf);
+  const Eigen::VectorXd dc = factored(d, G, from).conditional_mean(rf);
   return sub(d.measured, at) - sub(pred, at) - rows(G, at) * dc;
 }
 
@@ -1596,7 +1602,7 @@ Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s) {
     for (RunRecord& r : scaled.runs) r.sigma_g *= scale.value;
     Diagnosis ds = diagnose_once(scaled, s, cache);
     const double level = s.significance_sigma * s.significance_sigma;
-    if (!from_repeats && !ds.effects.empty() && ds.effects.front().evidence > level) {
+    if (!from_repeats && !ds.effects.empty() && ds.effects.front().not_ranked.empty() && ds.effects.front().evidence > level) {
       char buf[240];
       std::snprintf(buf, sizeof buf,
                     "; not applied: with the corrected sigma %s's held-out evidence %.1f still exceeds %.0f (a physical gap, "
@@ -1751,11 +1757,9 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
   for (int k = 0; k < n; ++k) data.sigma2(k) += std::pow(s.model_accuracy * nominal.pred(k), 2);
   std::vector<int> all(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) all[static_cast<std::size_t>(k)] = k;
-  const Eigen::MatrixXd V = covariance(data, nominal.G, all);
-  const Eigen::LDLT<Eigen::MatrixXd> Vl(V);
+  const Eigen::MatrixXd V = covariance(data, nominal.G, all);  // (its diagonal: each run's sigma)
   const Eigen::VectorXd r = data.measured - nominal.pred;
-  const Eigen::MatrixXd Vinv = Vl.solve(Eigen::MatrixXd::Identity(n, n));
-  d.chi2_nominal = r.dot(Vinv * r);
+  d.chi2_nominal = factored(data, nominal.G, all).chi2(r);
   const double chi2_sigma = chi2_as_sigma(d.chi2_nominal, n);
   d.runs.resize(static_cast<std::size_t>(n));
   // Where: each run's gap that the static test's coefficient errors cannot take up (r - G dc*,
@@ -1983,14 +1987,20 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
     sc.all = std::move(mf);
     scored.push_back(std::move(sc));
   }
-  std::sort(scored.begin(), scored.end(), [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
+  // An effect whose held-out evidence or chi^2 is not a finite number (a fold's -2 ln L not
+  // finite) is no candidate: listed after the ranked ones with why, never chosen.
+  for (Scored& sc : scored)
+    if (!std::isfinite(sc.fit.evidence) || !std::isfinite(sc.fit.heldout_chi2))
+      sc.fit.not_ranked = "its held-out evidence or chi^2 is not a finite number";
+  const auto ranked_end = std::stable_partition(scored.begin(), scored.end(), [](const Scored& a) { return a.fit.not_ranked.empty(); });
+  std::sort(scored.begin(), ranked_end, [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
   for (const auto& sc : scored) d.effects.push_back(sc.fit);
 
   // 4. The verdict and the held-out shrinkage of the chosen effect(s). The held-out gap rms
   // need not shrink for "explained": the adjusted residuals leave out the runs' correlations
   // and can grow while chi^2 falls (docs/diagnose.md).
   const auto explains = [&](const Scored& sc, double rms_after) {
-    return sc.fit.evidence > s.significance_sigma * s.significance_sigma &&
+    return sc.fit.not_ranked.empty() && sc.fit.evidence > s.significance_sigma * s.significance_sigma &&
            (chi2_as_sigma(sc.fit.heldout_chi2, n) < s.significance_sigma ||
             rms_after <= (1 - s.explained_shrinkage) * d.rms_before_g);
   };
@@ -2001,7 +2011,7 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
   // z miss it because most of its shape trades with the coefficients' errors (a squeeze film,
   // ~ amplitude^4 like k4). 30 clean campaigns (blind's random truths, seeds 5000-5029) gave
   // at most 7.
-  if (!d.gap_significant && best->fit.evidence > s.significance_sigma * s.significance_sigma) {
+  if (!d.gap_significant && best->fit.not_ranked.empty() && best->fit.evidence > s.significance_sigma * s.significance_sigma) {
     d.gap_significant = true;
     std::ostringstream w;
     w.precision(3);
@@ -2024,7 +2034,7 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
   // scored on the held-out runs like a single effect. A pair is chosen only when its evidence
   // beats A's by significance_sigma^2 and it explains the gap.
   Scored pair_best;
-  if (d.gap_significant && !explains(*best, rms(best->heldout)) && s.try_pairs) {
+  if (d.gap_significant && best->fit.not_ranked.empty() && !explains(*best, rms(best->heldout)) && s.try_pairs) {
     // (The two parameters' variances: each conditional on the other, their correlation left out.)
     const auto fit_pair = [&](const EffectFitter& A, const EffectFitter& B, double pB, const std::vector<int>& idx) {
       double pA = A.fit(data, idx).first;  // (pB: B's nominal, the start)
@@ -2063,7 +2073,8 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
         if (eb.name == ea.name || !fitters.count(eb.name)) continue;
         const EffectFitter& B = *fitters.at(eb.name);
         const Table tb = B.at(B.fit(rest, idx).first);
-        drop.emplace_back(l_rest - likelihood(rest, tb.pred, tb.G, idx).m2logl, &eb);
+        const double fall = l_rest - likelihood(rest, tb.pred, tb.G, idx).m2logl;
+        drop.emplace_back(std::isfinite(fall) ? fall : -INFINITY, &eb);  // (not finite: last)
       }
       std::stable_sort(drop.begin(), drop.end(), [](const auto& x, const auto& y) { return x.first > y.first; });
       std::vector<const Effect*> v;
@@ -2083,9 +2094,12 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
       const auto [pa, pb, t] = fit_pair(A, *fitters.at(eb.name), eb.fitted().nominal, all);
       const PairFit pf{ea.name, eb.name, pa, pb, sc.fit.evidence, sc.fit.heldout_chi2};
       d.pairs.push_back(pf);
-      if (pair_best.fit.name.empty() || sc.fit.evidence > pair_best.fit.evidence) pair_best = sc, chosen_pair = pf;
+      // (A pair whose evidence or chi^2 is not a finite number is listed, last, never chosen.)
+      const bool finite = std::isfinite(sc.fit.evidence) && std::isfinite(sc.fit.heldout_chi2);
+      if (finite && (pair_best.fit.name.empty() || sc.fit.evidence > pair_best.fit.evidence)) pair_best = sc, chosen_pair = pf;
     }
-    std::stable_sort(d.pairs.begin(), d.pairs.end(), [](const PairFit& a, const PairFit& b) { return a.evidence > b.evidence; });
+    const auto pair_key = [](const PairFit& p) { return std::isfinite(p.evidence) && std::isfinite(p.heldout_chi2) ? p.evidence : -INFINITY; };
+    std::stable_sort(d.pairs.begin(), d.pairs.end(), [&](const PairFit& a, const PairFit& b) { return pair_key(a) > pair_key(b); });
     // A pair is the more flexible model: it must also remove at least half of the held-out gap
     // rms (a pair whose parameters the training runs leave loose can pass chi^2 without
     // predicting anything).
@@ -2219,8 +2233,7 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
       const Table u = tabulate(plant, c.runs, chosen[q].first, chosen[q].second, cache, absorbed);
       t.pred += u.pred - nominal.pred, t.G += u.G - nominal.G;
     }
-    const Eigen::LDLT<Eigen::MatrixXd> vl(covariance(data, t.G, all));
-    const Eigen::VectorXd dc = data.Sigma * t.G.transpose() * vl.solve(data.measured - t.pred);
+    const Eigen::VectorXd dc = factored(data, t.G, all).conditional_mean(data.measured - t.pred);
     PlantConfig corrected = plant;
     for (int i = 0; i < plant::kNumCoefficients; ++i) corrected.coefficients[i] += dc(i);
     std::vector<int> order = all;
@@ -2271,7 +2284,7 @@ namespace {
 // r = measured - predicted and the covariance V its runs are judged by.
 struct NominalView {
   Eigen::VectorXd r;
-  Eigen::MatrixXd V;
+  FactoredCovariance V;
 };
 
 // The nominal simulation of a campaign as diagnose sees it before any hypothesis: the drift line
@@ -2299,7 +2312,7 @@ NominalView nominal_view(const Campaign& c, const DiagnoseSettings& s) {
   const Nominal nm = nominal_of(c, s, 1);
   std::vector<int> all(static_cast<std::size_t>(nm.t.pred.size()));
   for (std::size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
-  return {nm.data.measured - nm.t.pred, covariance(nm.data, nm.t.G, all)};
+  return {nm.data.measured - nm.t.pred, factored(nm.data, nm.t.G, all)};
 }
 
 }  // namespace
@@ -2328,10 +2341,9 @@ double nominal_gap_significance(const Campaign& with, const Campaign& without, c
   }
   const NominalView w = nominal_view(with, s), o = nominal_view(without, s);
   const Eigen::VectorXd g = w.r - o.r;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(w.V);
-  const double q = g.dot(ldlt.solve(g));
+  const double q = w.V.chi2(g);
   // (A NaN would be size 0: the campaign out of its scored family without a word.)
-  if (ldlt.info() != Eigen::Success || !std::isfinite(q))
+  if (!w.V.ok() || !std::isfinite(q))
     throw std::invalid_argument("nominal_gap_significance: the gap's chi^2 is not a number (V not positive definite or a prediction not finite)");
   return std::sqrt(std::max(0.0, q));
 }

@@ -147,6 +147,7 @@ struct EffectFit {
   double evidence = 0;           // held-out chi^2 reduction, summed over folds
   double heldout_chi2 = 0;       // held-out chi^2 with the effect (given the training runs), summed over folds
   bool at_bound = false;         // the fit ended on the edge of its range (no curvature: no sigma)
+  std::string not_ranked;        // why the effect is no candidate (listed after the ranked ones); empty: ranked
 };
 
 // Two effects fitted together (additive to first order), when no one effect explains the gap.

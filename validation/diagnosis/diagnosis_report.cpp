@@ -93,6 +93,8 @@ std::string Diagnosis::FullReport(double wall_s) const {
   for (const auto& p : d.pairs)
     t += fmt::format("  pair {:<40}{:>12.5g},{:<12.5g}{:>12.1f}{:>14.1f}\n", p.a + " + " + p.b, p.pa, p.pb, p.evidence,
                      p.heldout_chi2);
+  for (const auto& e : d.effects)
+    if (!e.not_ranked.empty()) t += fmt::format("  {} is not ranked: {}\n", e.name, e.not_ranked);
   t += heldout_line(d, wall_s);
   if (d.resimulated_runs > 0)
     t += fmt::format("Re-simulated on the ODE plant ({} runs with the largest gaps): rms {:.4g} ug without {}, {:.4g} ug "
