@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <string>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -24,14 +25,17 @@ json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr
 // nominal (sigma null), with its unit and prior range.
 json parameters_json(const validation::EffectFit& e) {
   json ps = json::array();
-  for (const auto& q : e.parameters)
-    ps.push_back({{"name", q.name},
-                  {"unit", q.unit},
-                  {"value", q.value},
-                  {"sigma", finite_or_null(q.sigma)},
-                  {"status", q.status},
-                  {"at_bound", q.at_bound},
-                  {"range", json::array({finite_or_null(q.lower), finite_or_null(q.upper)})}});
+  for (const auto& q : e.parameters) {
+    json p = {{"name", q.name},
+              {"unit", q.unit},
+              {"value", q.value},
+              {"sigma", finite_or_null(q.sigma)},
+              {"status", q.status},
+              {"at_bound", q.at_bound},
+              {"range", json::array({finite_or_null(q.lower), finite_or_null(q.upper)})}};
+    if (!q.sign_identifiable) p["sign_identifiable"] = false;  // the value is a magnitude
+    ps.push_back(std::move(p));
+  }
   return ps;
 }
 

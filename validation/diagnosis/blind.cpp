@@ -187,7 +187,8 @@ std::string physics_of(const std::string& name) {
 // Whether the diagnosis' top effect (the one called) has every fitted parameter within 3 sigma
 // of the hidden truth's (a phase's difference wrapped to [-pi, pi)) and every discrete one
 // (chosen, or held at its nominal: either is a claim) equal to it; a held continuous parameter
-// (the data do not pin it: reported at its nominal) is not judged. `off` says which parameter failed, or lists the held ones.
+// (the data do not pin it: reported at its nominal) is not judged; one whose sign is not
+// identifiable (a magnitude) is judged against the truth's magnitude. `off` says which parameter failed, or lists the held ones.
 bool match_parameters(const HiddenEffect& h, const Diagnosis& d, std::string* off) {
   const Effect* e = find_effect(h.name);
   if (!e || d.effects.empty() || d.effects.front().name != h.name) {
@@ -205,6 +206,7 @@ bool match_parameters(const HiddenEffect& h, const Diagnosis& d, std::string* of
     const FittedParameter& q = fit[i];
     double diff = q.value - truth[i];
     if (e->parameters[i].periodic) diff = std::remainder(diff, 2 * std::numbers::pi);
+    if (!e->parameters[i].sign_identifiable) diff = std::abs(q.value) - std::abs(truth[i]);
     if (e->parameters[i].discrete) {  // held at its nominal or chosen, it is a claim (the mode's axis)
       if (diff != 0) {
         *off = fmt::format("{} {} {:.4g}, truth {:.4g}", q.name, q.status, q.value, truth[i]);
@@ -222,8 +224,8 @@ bool match_parameters(const HiddenEffect& h, const Diagnosis& d, std::string* of
         return false;
       }
     } else if (!(std::abs(diff) <= 3 * q.sigma)) {
-      *off = fmt::format("{} = {:.4g} +- {:.2g}, truth {:.4g}: {:.1f} sigma", q.name, q.value, q.sigma, truth[i],
-                         std::abs(diff) / q.sigma);
+      *off = fmt::format("{} = {:.4g} +- {:.2g}, truth {:.4g}{}: {:.1f} sigma", q.name, q.value, q.sigma, truth[i],
+                         e->parameters[i].sign_identifiable ? "" : " (magnitudes compared)", std::abs(diff) / q.sigma);
       return false;
     }
   }

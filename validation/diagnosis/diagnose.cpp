@@ -1979,6 +1979,7 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
     for (std::size_t j = 0; j < e.parameters.size(); ++j) {
       const EffectParameter& q = e.parameters[j];
       FittedParameter fp{q.name, q.unit, mf.values[j], mf.sigma[j], mf.status[j], q.lower, q.upper};
+      fp.sign_identifiable = q.sign_identifiable;
       if (j == 0 && !q.linear && !q.grid.empty()) fp.lower = q.grid.front(), fp.upper = q.grid.back();
       if (j == 0) fp.at_bound = sc.fit.at_bound || fp.value <= fp.lower || fp.value >= fp.upper;
       else if (fp.status == "fitted" && !q.periodic) fp.at_bound = fp.value <= q.lower || fp.value >= q.upper;

@@ -137,6 +137,7 @@ struct FittedParameter {
   std::string status;  // "fitted", "chosen" (a discrete parameter: one of its values), "held"
   double lower = -INFINITY, upper = INFINITY;  // the prior range
   bool at_bound = false;  // fitted, but ended on the edge of its range (its sigma ignores the edge)
+  bool sign_identifiable = true;  // false: the value is a magnitude (EffectParameter::sign_identifiable)
 };
 
 struct EffectFit {

@@ -82,12 +82,13 @@ std::string Diagnosis::FullReport(double wall_s) const {
     // The natural form's further parameters: fitted with sigma, chosen, or held at nominal.
     for (std::size_t j = 1; j < e.parameters.size(); ++j) {
       const auto& q = e.parameters[j];
+      const char* magnitude = q.sign_identifiable ? "" : ", its magnitude: the sign is not identifiable";
       if (q.status == "fitted")
-        t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}  fitted{}: {} ({})\n", "", q.value, q.sigma, q.at_bound ? " at its bound" : "",
-                         q.name, q.unit);
+        t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}  fitted{}: {} ({}{})\n", "", q.value, q.sigma, q.at_bound ? " at its bound" : "",
+                         q.name, q.unit, magnitude);
       else
-        t += fmt::format("  {:<26}{:>16.5g}{:>12}  {}: {} ({}; range {:.3g} .. {:.3g})\n", "", q.value, "", q.status, q.name,
-                         q.unit, q.lower, q.upper);
+        t += fmt::format("  {:<26}{:>16.5g}{:>12}  {}: {} ({}; range {:.3g} .. {:.3g}{})\n", "", q.value, "", q.status, q.name,
+                         q.unit, q.lower, q.upper, magnitude);
     }
   }
   for (const auto& p : d.pairs)

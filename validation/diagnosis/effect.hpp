@@ -99,6 +99,12 @@ struct EffectParameter {
   //  - step: the finite-difference step of its slope (NaN: 1e-3 (upper - lower)).
   bool discrete = false;
   bool periodic = false;  // an angle: [lower, upper) wraps round
+  // False: the hypothesis' prediction is even in this parameter for every run it is applied to
+  // (tests/validation/test_transverse_quadrature.cpp checks it), so the runs cannot tell +x
+  // from -x. The fit takes its magnitude (range from 0); the truth hook takes it signed (the
+  // virtual lab acts with either sign); reports say the sign is not identifiable and blind
+  // compares the magnitudes.
+  bool sign_identifiable = true;
   std::vector<double> starts;
   double prior_sigma = NAN, step = NAN;
   double prior_width() const { return std::isfinite(prior_sigma) ? prior_sigma : (upper - lower) / 4; }
