@@ -190,6 +190,10 @@ TEST(GaussianLikelihood, InputsThatAreNoCovarianceGiveNaN) {
   EXPECT_TRUE(std::isnan(gaussian_likelihood(bad.r, bad.s2, bad.G, bad.Sigma).m2logl));
   bad = c, bad.s2(0) = 0;
   EXPECT_TRUE(std::isnan(gaussian_likelihood(bad.r, bad.s2, bad.G, bad.Sigma).m2logl));
+  // A positive diagonal but a correlation of 2 between two coefficients: an eigenvalue of -1 of
+  // their correlation matrix, far beyond rounding; no covariance.
+  bad = c, bad.Sigma(0, 1) = bad.Sigma(1, 0) = 2 * std::sqrt(c.Sigma(0, 0) * c.Sigma(1, 1));
+  EXPECT_TRUE(std::isnan(gaussian_likelihood(bad.r, bad.s2, bad.G, bad.Sigma).m2logl));
 }
 
 // Seed 9501, campaign 21: a pickoff nonlinearity of 16.3 /rad (a 1458-sigma gap), replayed as

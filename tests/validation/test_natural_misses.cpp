@@ -1,4 +1,4 @@
-// The natural-form misses of blind's seeds 8601, 8701, 8801, 8901, 9301 and 9601 (sessions 7-11), each campaign
+// The natural-form misses of blind's seeds 8601, 8701, 8801, 8901, 9301 and 9601, each campaign
 // replayed exactly as `blind` makes it (run_blind with every other campaign of the draw read
 // back from a result line, so only this one is simulated on the ODE plant through the effects'
 // truth hooks and diagnosed): the truth is the key's, never the diagnosis' hypothesis.

@@ -170,7 +170,7 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
              : !d.gap_significant        ? "clean"
              : d.explained               ? d.chosen
                                          : "unexplained";
-  k.top = k.error.empty() ? d.effects.front().name : "";
+  k.top = k.error.empty() && d.effects.front().not_ranked.empty() ? d.effects.front().name : "";
 }
 
 double median(std::vector<double> v) {

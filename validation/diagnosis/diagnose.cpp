@@ -320,19 +320,15 @@ Eigen::MatrixXd covariance(const Data& d, const Eigen::MatrixXd& G, const std::v
   return V;
 }
 
-// V of the runs idx factored without forming it (gaussian_likelihood.hpp: an LDLT of V met
-// negative pivots where a slope column puts V's entries 1e20 above the runs' variances).
+// V of the runs idx factored without forming it (gaussian_likelihood.hpp: V in double cannot
+// hold the runs' variances beneath a slope column's G Sigma G^T of 1e20 times them).
 FactoredCovariance factored(const Data& d, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
   return FactoredCovariance(sub(d.sigma2, idx), rows(G, idx), d.Sigma);
 }
 
 Likelihood likelihood(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
-  const FactoredCovariance v = factored(d, G, idx);
-  const Eigen::VectorXd r = sub(d.measured, idx) - sub(pred, idx);
-  Likelihood l;
-  l.chi2 = v.chi2(r);
-  l.m2logl = l.chi2 + v.log_det();
-  return l;
+  const GaussianLikelihood g = gaussian_likelihood(sub(d.measured, idx) - sub(pred, idx), sub(d.sigma2, idx), rows(G, idx), d.Sigma);
+  return {g.m2logl, g.chi2};
 }
 
 // The residual the static test's coefficient errors cannot take up: r - G dc*, with dc* the
@@ -1058,7 +1054,7 @@ class EffectFitter {
       if (!(fw < f)) continue;
       bool converged = true;
       for (Eigen::Index a = 0; a < k; ++a)
-        if (std::abs(t * newton(a)) > 1e-3 / std::sqrt(H(a, a))) converged = false;
+        if (std::abs(newton(a)) > 1e-3 / std::sqrt(H(a, a))) converged = false;  // the full step, not the halved one
       v = w, f = fw;
       return converged;
     }
@@ -1757,7 +1753,6 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
   for (int k = 0; k < n; ++k) data.sigma2(k) += std::pow(s.model_accuracy * nominal.pred(k), 2);
   std::vector<int> all(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) all[static_cast<std::size_t>(k)] = k;
-  const Eigen::MatrixXd V = covariance(data, nominal.G, all);  // (its diagonal: each run's sigma)
   const Eigen::VectorXd r = data.measured - nominal.pred;
   d.chi2_nominal = factored(data, nominal.G, all).chi2(r);
   const double chi2_sigma = chi2_as_sigma(d.chi2_nominal, n);
@@ -1784,7 +1779,7 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
     rd.predicted_g = nominal.pred(k);
     rd.sigma_predicted_g = std::sqrt(std::max(0.0, (nominal.G.row(k) * data.Sigma * nominal.G.row(k).transpose())(0, 0)));
     rd.gap_g = r(k);
-    rd.sigma_g = std::sqrt(V(k, k));
+    rd.sigma_g = std::sqrt(data.sigma2(k) + rd.sigma_predicted_g * rd.sigma_predicted_g);  // V's diagonal
     rd.adjusted_gap_g = adj(k);
     rd.z = adj(k) / std::sqrt(data.sigma2(k));
     const std::string dir = vec_name(run.direction), orient = vec_name(run.orientation_g);
@@ -2119,6 +2114,11 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
   }
   d.rms_after_g = std::sqrt(ss_a / n), d.rms_after_sigma = std::sqrt(zs_a / n);
   d.chosen = best->fit.name;
+  if (!best->fit.not_ranked.empty()) {  // no effect ranked: nothing chosen, nothing removed
+    d.chosen.clear();
+    d.rms_after_g = d.rms_before_g, d.rms_after_sigma = d.rms_before_sigma;
+    for (RunDiagnosis& rd : d.runs) rd.heldout_after_g = rd.heldout_before_g;
+  }
   if (!d.gap_significant) {
     d.verdict = "no significant gap";
   } else if (explains(*best, d.rms_after_g)) {
@@ -2165,8 +2165,8 @@ Diagnosis diagnose_once(const Campaign& c, const DiagnoseSettings& s, ResponseCa
         for (const EffectFit& f : d.effects)
           if (f.name == name) cand.emplace_back(find_effect(name), f.values());
     } else {
-      for (std::size_t i = 0; i < std::min<std::size_t>(3, d.effects.size()); ++i)
-        cand.emplace_back(find_effect(d.effects[i].name), d.effects[i].values());
+      for (std::size_t i = 0; i < d.effects.size() && cand.size() < 3; ++i)
+        if (d.effects[i].not_ranked.empty()) cand.emplace_back(find_effect(d.effects[i].name), d.effects[i].values());
     }
     std::vector<double> sig;
     for (const RunRecord& run : c.runs) sig.push_back(run.sigma_g);
@@ -2345,7 +2345,7 @@ double nominal_gap_significance(const Campaign& with, const Campaign& without, c
   const double q = w.V.chi2(g);
   // (A NaN would be size 0: the campaign out of its scored family without a word.)
   if (!w.V.ok() || !std::isfinite(q))
-    throw std::invalid_argument("nominal_gap_significance: the gap's chi^2 is not a number (V not positive definite or a prediction not finite)");
+    throw std::invalid_argument("nominal_gap_significance: the gap's chi^2 is not a number (a run's variance not positive, a coefficient's variance negative, or a slope or prediction not finite)");
   return std::sqrt(std::max(0.0, q));
 }
 

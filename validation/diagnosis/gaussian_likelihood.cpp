@@ -39,8 +39,13 @@ SigmaRoot compute_root(const Eigen::MatrixXd& Sigma) {
     root.ok = false;
     return root;
   }
-  // Over the positive eigenvalues (a negative one is rounding of a positive semi-definite
-  // Sigma: its direction carries no variance).
+  // Over the positive eigenvalues (a negative one within rounding of C's largest is a positive
+  // semi-definite Sigma's direction without variance; one beyond it, a Sigma that is no
+  // covariance: not ok, every result NaN).
+  if (es.eigenvalues()(0) < -1e-8 * es.eigenvalues()(q - 1)) {
+    root.ok = false;
+    return root;
+  }
   std::vector<Eigen::Index> positive;
   for (Eigen::Index k = 0; k < q; ++k)
     if (es.eigenvalues()(k) > 0) positive.push_back(k);

@@ -15,8 +15,8 @@
 //               taken from Q^T [S^-1/2 r; 0] below R's rows (no difference of large numbers).
 // Why: a slope column of G can be 1e5 g per unit of a parameter whose sigma puts it 1e10 run
 // sigma above S (a mechanical mode fitted on other runs, sitting on a run's frequency); V's
-// entries then hold S below their rounding, an LDLT of V meets negative pivots, and ln det V
-// was -inf. Here the column's scale cancels in G D (a slope times its own sigma), R^T R >= I
+// entries then hold S below their rounding, and a factorisation of V itself can meet negative
+// pivots (ln det V = -inf). Here the column's scale cancels in G D (a slope times its own sigma), R^T R >= I
 // holds whatever W is, and Householder QR is backward stable column by column, so each
 // column's rounding is relative to its own size. Cost O(n p^2), against O(n^3) for a dense V.
 #include <Eigen/Dense>
@@ -31,7 +31,8 @@ class FactoredCovariance {
 
   bool ok() const { return ok_; }
   double log_det() const { return log_det_; }  // ln det V
-  // The whitened residual E ((n + p) x k) of the columns of y (n x k): E^T E = y^T V^-1 y.
+  // The whitened residual E ((n + p) x k) of the columns of y (n x k): E^T E = y^T V^-1 y
+  // (n x k of NaN when not ok()).
   Eigen::MatrixXd whitened(const Eigen::MatrixXd& y) const;
   double chi2(const Eigen::VectorXd& y) const;   // y^T V^-1 y
   Eigen::MatrixXd solve(const Eigen::MatrixXd& y) const;  // V^-1 y
