@@ -16,6 +16,7 @@
 #include <random>
 #include <string>
 
+#include "support/blind_replay.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/gaussian_likelihood.hpp"
 
@@ -203,20 +204,8 @@ TEST(GaussianLikelihood, InputsThatAreNoCovarianceGiveNaN) {
 // every evidence is finite and the pickoff (16.33 +- 0.16, held-out chi^2 137 for 168 runs)
 // explains the gap. A whole campaign (~6 s in Release): in NaturalMisses, label "campaign".
 TEST(NaturalMisses, ALargePickoffIsNotOutrankedByAnInfiniteEvidence) {
-  BlindSettings s;
   const int index = 21;
-  s.n = index + 1, s.seed = 9501, s.threads = 1;
-  std::map<int, std::string> done;
-  for (int i = 0; i < index; ++i) {
-    BlindCampaign k = blind_key(i, s.seed);
-    k.called = "clean";
-    EffectFit e;
-    e.name = "pickoff_nonlinearity";
-    k.diagnosis.effects = {e};
-    k.top = e.name;
-    done[i] = campaign_result_text(k);
-  }
-  const BlindResult r = run_blind(s, {}, done, {});
+  const BlindResult r = test::replay_blind_campaign(9501, index);
   const BlindCampaign& k = r.campaigns.at(index);
   ASSERT_EQ(k.hidden.at(0).name, "pickoff_nonlinearity");
   const Diagnosis& d = k.diagnosis;  // (as blind reads it back: the verdict, the top effect)

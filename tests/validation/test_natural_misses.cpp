@@ -12,6 +12,7 @@
 #include <numbers>
 #include <string>
 
+#include "support/blind_replay.hpp"
 #include "validation/diagnosis/blind.hpp"
 
 using namespace vrelab;
@@ -19,23 +20,7 @@ using namespace vrelab::validation;
 
 namespace {
 
-// Campaign `index` of blind's draw `seed`, simulated and diagnosed as blind does; the others
-// read back as clean (not simulated).
-BlindResult replay(std::uint64_t seed, int index) {
-  BlindSettings s;
-  s.n = index + 1, s.seed = seed, s.threads = 1;
-  std::map<int, std::string> done;
-  for (int i = 0; i < index; ++i) {
-    BlindCampaign k = blind_key(i, seed);
-    k.called = "clean";
-    EffectFit e;
-    e.name = "pickoff_nonlinearity";
-    k.diagnosis.effects = {e};
-    k.top = e.name;
-    done[i] = campaign_result_text(k);
-  }
-  return run_blind(s, {}, done, {});
-}
+BlindResult replay(std::uint64_t seed, int index) { return test::replay_blind_campaign(seed, index); }
 
 const FittedParameter& parameter(const EffectFit& e, const std::string& name) {
   for (const FittedParameter& q : e.parameters)

@@ -20,6 +20,7 @@
 #include "plant/effects/mechanical_mode.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/instrument.hpp"
+#include "support/blind_replay.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/effect.hpp"
@@ -187,27 +188,6 @@ TEST(TransverseQuadrature, BlindComparesTheMagnitudes) {
   EXPECT_TRUE(parameters_match(truth, d, &why)) << why;
 }
 
-namespace {
-
-// Campaign `index` of blind's draw `seed`, simulated and diagnosed as blind does; the others
-// read back as clean (not simulated) (as tests/validation/test_natural_misses.cpp replays).
-BlindResult replay(std::uint64_t seed, int index) {
-  BlindSettings s;
-  s.n = index + 1, s.seed = seed, s.threads = 1;
-  std::map<int, std::string> done;
-  for (int i = 0; i < index; ++i) {
-    BlindCampaign k = blind_key(i, seed);
-    k.called = "clean";
-    EffectFit e;
-    e.name = "pickoff_nonlinearity";
-    k.diagnosis.effects = {e};
-    k.top = e.name;
-    done[i] = campaign_result_text(k);
-  }
-  return run_blind(s, {}, done, {});
-}
-
-}  // namespace
 
 // Seed 9501, campaign 79: a transverse motion, -0.0319 in phase and +0.0377 in quadrature,
 // f^0.657, on the other axis. The data pin the quadrature's size (its -2 ln L even in it), and
@@ -215,7 +195,7 @@ BlindResult replay(std::uint64_t seed, int index) {
 // judged 5.6 sigma off. Fitted as a magnitude, |q| is within 3 sigma of the truth's |q| and the
 // campaign is scored right.
 TEST(NaturalMisses, ATransverseQuadraturesSizeIsJudgedNotItsSign) {
-  const BlindResult r = replay(9501, 79);
+  const BlindResult r = test::replay_blind_campaign(9501, 79);
   const BlindCampaign& k = r.campaigns.at(79);
   ASSERT_EQ(k.category, "natural");
   ASSERT_EQ(k.hidden.at(0).name, "shaker_transverse_motion");
