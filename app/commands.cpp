@@ -1,15 +1,15 @@
-// app/commands.cpp -- the CLI's commands: read the case, call the study (io/studies.hpp),
-// print its report, write its JSON (io/results_json.hpp).
+// app/commands.cpp -- the CLI's commands: read the case, call the study (io/services/studies.hpp),
+// print its report, write its JSON (io/services/results_json.hpp).
 #include "app/commands.hpp"
 
 #include <cmath>
 #include <string>
 
 #include "core/dispatch.hpp"
-#include "io/case_file.hpp"
-#include "io/output.hpp"
-#include "io/results_json.hpp"
-#include "io/studies.hpp"
+#include "io/formats/case_file.hpp"
+#include "io/formats/output.hpp"
+#include "io/services/results_json.hpp"
+#include "io/services/studies.hpp"
 
 namespace vrelab::app {
 using namespace vrelab::io;

@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "io/case_file.hpp"
-#include "io/diagnosis.hpp"
+#include "io/formats/case_file.hpp"
+#include "io/services/diagnosis.hpp"
 #include "validation/diagnosis/blind.hpp"
 
 namespace vrelab::app {
@@ -94,7 +94,7 @@ struct DiagnoseOptions {
   std::string dir, json_path, report_dir;
   bool check = false;  // read and check the folder only (no diagnosis, nothing written)
   io::DiagnoseOverrides settings;  // over the manifest's [diagnose]
-  // Many campaigns (io/batch.hpp): the folders given, the summary CSV, threads, progress.
+  // Many campaigns (io/services/batch.hpp): the folders given, the summary CSV, threads, progress.
   std::vector<std::string> dirs;
   std::string summary_path;
   int threads = 0;

@@ -1,6 +1,6 @@
 // app/diagnose.cpp -- `vrelab campaign`, `vrelab diagnose`, `vrelab blind`: each calls one
-// library function, prints its report and writes its results (io/diagnosis.hpp,
-// validation/diagnosis/blind.hpp, io/diagnosis_json.hpp).
+// library function, prints its report and writes its results (io/services/diagnosis.hpp,
+// validation/diagnosis/blind.hpp, io/services/diagnosis_json.hpp).
 #include <cstdint>
 #include <fstream>
 #include <iostream>
@@ -11,11 +11,11 @@
 #include "app/commands.hpp"
 #include "core/dispatch.hpp"
 #include "core/progress.hpp"
-#include "io/batch.hpp"
-#include "io/diagnosis.hpp"
-#include "io/diagnosis_json.hpp"
-#include "io/diagnosis_report.hpp"
-#include "io/output.hpp"
+#include "io/services/batch.hpp"
+#include "io/services/diagnosis.hpp"
+#include "io/services/diagnosis_json.hpp"
+#include "io/services/diagnosis_report.hpp"
+#include "io/formats/output.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "vrelab_version.hpp"
 

@@ -22,7 +22,7 @@
 #ifdef VRELAB_HAVE_MPI
 #include "core/mpi.hpp"
 #endif
-#include "io/case_file.hpp"
+#include "io/formats/case_file.hpp"
 #include "plant/ode_solver.hpp"
 #include "vrelab_version.hpp"
 

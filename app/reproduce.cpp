@@ -1,13 +1,13 @@
 // app/reproduce.cpp -- `vrelab reproduce`: the paper's experiment, its report and its data
-// (io::reproduce_to_folder, io/reproduce_run.hpp).
+// (io::reproduce_to_folder, io/services/reproduce_run.hpp).
 #include <iostream>
 
 #include <fmt/format.h>
 
 #include "app/commands.hpp"
-#include "io/case_file.hpp"
-#include "io/reproduce_report.hpp"
-#include "io/reproduce_run.hpp"
+#include "io/formats/case_file.hpp"
+#include "io/services/reproduce_report.hpp"
+#include "io/services/reproduce_run.hpp"
 #include "vrelab_version.hpp"
 
 namespace vrelab::app {

@@ -25,7 +25,7 @@
 
 #include <fmt/format.h>
 
-#include "io/raw_hdf5.hpp"
+#include "io/formats/raw_hdf5.hpp"
 
 namespace fs = std::filesystem;
 

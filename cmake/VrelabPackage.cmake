@@ -8,7 +8,7 @@
 #   P/lib/cmake/vrelab/vrelabConfig.cmake  + version file and the exported targets
 # A consumer writes find_package(vrelab) and links vrelab::vrelab (all stages) or one stage
 # (vrelab::core, vrelab::plant, vrelab::vibration, vrelab::rectification,
-# vrelab::validation, vrelab::io). Its include directory is P/include/vrelab, so it includes
+# vrelab::validation, vrelab::formats, vrelab::services). Its include directory is P/include/vrelab, so it includes
 # the headers as the project's own code does: #include "rectification/prediction/eq3.hpp".
 # (The stage folders keep generic names such as io/ and core/: they live under vrelab/ so
 # that an install into /usr/local does not claim /usr/local/include/io.)
@@ -27,7 +27,7 @@ include(CMakePackageConfigHelpers)
 
 set(VRELAB_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/vrelab)
 set(VRELAB_INSTALL_INCLUDEDIR ${CMAKE_INSTALL_INCLUDEDIR}/vrelab)
-set(VRELAB_PLOTS_SUBDIR share/vrelab/plots)  # fixed: io/output.cpp's run_plot_script looks there
+set(VRELAB_PLOTS_SUBDIR share/vrelab/plots)  # fixed: io/formats/output.cpp's run_plot_script looks there
 
 # The plot scripts in the build tree at the installed layout's relative place
 # (build/share/vrelab/plots beside build/vrelab), refreshed when a script changes.
@@ -74,13 +74,14 @@ function(vrelab_prepare_for_export)
 endfunction()
 
 function(vrelab_install_package)
-  # stage target -> exported name vrelab::<stage>
+  # library target vrelab_<name> -> exported name vrelab::<name>; io/ holds two (formats, services)
   set(stages core plant vibration rectification validation io)
+  set(libraries core plant vibration rectification validation formats services)
   set(targets)
-  foreach(stage IN LISTS stages)
-    list(APPEND targets vrelab_${stage})
-    set_target_properties(vrelab_${stage} PROPERTIES EXPORT_NAME ${stage})
-    add_library(vrelab::${stage} ALIAS vrelab_${stage})
+  foreach(name IN LISTS libraries)
+    list(APPEND targets vrelab_${name})
+    set_target_properties(vrelab_${name} PROPERTIES EXPORT_NAME ${name})
+    add_library(vrelab::${name} ALIAS vrelab_${name})
   endforeach()
   vrelab_prepare_for_export(${targets})
   # What a consumer's compile and link need beyond the include directory: C++20 (the headers
@@ -90,9 +91,9 @@ function(vrelab_install_package)
     target_link_options(vrelab_core INTERFACE -fsanitize=address,undefined)
   endif()
 
-  # The umbrella: every stage (io links all of them).
+  # The umbrella: every stage (io/services links all of them).
   add_library(vrelab_library INTERFACE)
-  target_link_libraries(vrelab_library INTERFACE vrelab_io)
+  target_link_libraries(vrelab_library INTERFACE vrelab_services)
   set_target_properties(vrelab_library PROPERTIES EXPORT_NAME vrelab)
   add_library(vrelab::vrelab ALIAS vrelab_library)
 

@@ -10,9 +10,9 @@
 
 #include <unistd.h>
 
-#include "io/case_file.hpp"
-#include "io/csv.hpp"
-#include "io/lab_data.hpp"
+#include "io/formats/case_file.hpp"
+#include "io/formats/csv.hpp"
+#include "io/formats/lab_data.hpp"
 #include "plant/ode_solver.hpp"
 #include "rectification/measurement/series.hpp"
 

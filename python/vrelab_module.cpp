@@ -1,9 +1,9 @@
 // python/vrelab_module.cpp -- vrelab._core: the Python binding of the library (pybind11).
 //
 // A thin layer: each function reads or takes a Case, calls the same library function as the
-// CLI command of its name (io/studies.hpp, io/diagnosis.hpp, io/reproduce_run.hpp) and returns
+// CLI command of its name (io/services/studies.hpp, io/services/diagnosis.hpp, io/services/reproduce_run.hpp) and returns
 // an object holding the C++ result. Its to_dict() is the CLI's JSON for the same case, made by
-// the same writers (io/results_json.hpp, io/diagnosis_json.hpp) and converted from
+// the same writers (io/services/results_json.hpp, io/services/diagnosis_json.hpp) and converted from
 // nlohmann::json to Python objects; its typed attributes read the C++ struct. No physics here.
 //
 // Errors: io::InputError and std::invalid_argument (the CLI's exit code 2) raise
@@ -33,14 +33,14 @@
 #include <toml++/toml.h>
 
 #include "core/cancel.hpp"
-#include "io/case_file.hpp"
-#include "io/diagnosis.hpp"
-#include "io/diagnosis_json.hpp"
-#include "io/output.hpp"
-#include "io/reproduce_report.hpp"
-#include "io/reproduce_run.hpp"
-#include "io/results_json.hpp"
-#include "io/studies.hpp"
+#include "io/formats/case_file.hpp"
+#include "io/services/diagnosis.hpp"
+#include "io/services/diagnosis_json.hpp"
+#include "io/formats/output.hpp"
+#include "io/services/reproduce_report.hpp"
+#include "io/services/reproduce_run.hpp"
+#include "io/services/results_json.hpp"
+#include "io/services/studies.hpp"
 #include "plant/model1.hpp"
 #include "plant/ode_solver.hpp"
 #include "vrelab_version.hpp"

@@ -76,7 +76,7 @@ void validate(const CrossSpectralMatrix& m);
 struct RandomProfile {
   std::array<std::optional<PsdTable>, 3> psd;  // per axis [IA, PA, OA]; empty: axis at rest
   AxisCoupling coupling = AxisCoupling::common;
-  // A measured motion (the reference channels of a random run, io/lab_data.cpp): when set,
+  // A measured motion (the reference channels of a random run, io/formats/lab_data.cpp): when set,
   // the prediction takes S(f) from it, diagonal and cross terms, and `coupling` is not used
   // (the psd tables then hold its diagonal, as steps over the same bins, for the rms, the
   // band and the description). The synthesis (synthesize_random, RandomExcitation) does not

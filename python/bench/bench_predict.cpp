@@ -5,9 +5,9 @@
 
 #include <string>
 
-#include "io/case_file.hpp"
-#include "io/results_json.hpp"
-#include "io/studies.hpp"
+#include "io/formats/case_file.hpp"
+#include "io/services/results_json.hpp"
+#include "io/services/studies.hpp"
 
 namespace {
 

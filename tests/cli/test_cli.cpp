@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "support/files.hpp"
-#include "io/case_file.hpp"
+#include "io/formats/case_file.hpp"
 #include "app/commands.hpp"
 #include "rectification/simulation/work_estimate.hpp"
 

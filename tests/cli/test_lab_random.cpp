@@ -9,7 +9,7 @@
 #include <fstream>
 #include <regex>
 
-#include "io/lab_data.hpp"
+#include "io/formats/lab_data.hpp"
 #include "plant/effects/effects.hpp"
 #include "support/files.hpp"
 #include "validation/diagnosis/diagnose.hpp"

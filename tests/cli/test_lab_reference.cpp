@@ -20,7 +20,7 @@
 
 #include <fmt/format.h>
 
-#include "io/lab_data.hpp"
+#include "io/formats/lab_data.hpp"
 #include "support/files.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"

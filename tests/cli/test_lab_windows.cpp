@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.hpp"
-#include "io/lab_data.hpp"
+#include "io/formats/lab_data.hpp"
 #include "support/files.hpp"
 
 using namespace vrelab;

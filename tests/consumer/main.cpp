@@ -3,7 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "io/output.hpp"
+#include "io/formats/output.hpp"
 #include "plant/model1.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "vrelab_version.hpp"

@@ -19,9 +19,9 @@
 
 #include "support/files.hpp"
 #include "support/instrument.hpp"
-#include "io/case_file.hpp"
+#include "io/formats/case_file.hpp"
 #include "app/commands.hpp"
-#include "io/lab_data.hpp"
+#include "io/formats/lab_data.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/small_design.hpp"
 #include "validation/diagnosis/campaign.hpp"

@@ -11,10 +11,10 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/case_file.hpp"
-#include "io/csv.hpp"
-#include "io/diagnosis_json.hpp"
-#include "io/lab_data.hpp"
+#include "io/formats/case_file.hpp"
+#include "io/formats/csv.hpp"
+#include "io/services/diagnosis_json.hpp"
+#include "io/formats/lab_data.hpp"
 #include "support/files.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/diagnose.hpp"

@@ -29,7 +29,7 @@
 #include <fmt/format.h>
 #include <hdf5.h>
 
-#include "io/lab_data.hpp"
+#include "io/formats/lab_data.hpp"
 #include "plant/effects/pendulum_geometry.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/files.hpp"

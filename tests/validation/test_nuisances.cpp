@@ -12,7 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "io/diagnosis_json.hpp"
+#include "io/services/diagnosis_json.hpp"
 #include "support/instrument.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "support/small_design.hpp"

@@ -1,4 +1,4 @@
-// Raw records in HDF5 (io/raw_hdf5.hpp, docs/data-format.md "Raw records in HDF5"): the
+// Raw records in HDF5 (io/formats/raw_hdf5.hpp, docs/data-format.md "Raw records in HDF5"): the
 // reader delivers exactly what the CSV reader delivers for the same samples, a campaign and
 // its HDF5 copy diagnose number for number alike, `measure` reads either, and a bad HDF5
 // record skips its run naming the file and the dataset. All in seconds.
@@ -23,12 +23,12 @@
 #include <nlohmann/json.hpp>
 
 #include "app/commands.hpp"
-#include "io/case_file.hpp"
-#include "io/diagnosis.hpp"
-#include "io/diagnosis_json.hpp"
-#include "io/lab_data.hpp"
-#include "io/raw_hdf5.hpp"
-#include "io/series.hpp"
+#include "io/formats/case_file.hpp"
+#include "io/services/diagnosis.hpp"
+#include "io/services/diagnosis_json.hpp"
+#include "io/formats/lab_data.hpp"
+#include "io/formats/raw_hdf5.hpp"
+#include "io/formats/series.hpp"
 #include "support/files.hpp"
 
 namespace vrelab {

@@ -16,9 +16,9 @@
 #include <nlohmann/json.hpp>
 
 #include "support/files.hpp"
-#include "io/case_file.hpp"
+#include "io/formats/case_file.hpp"
 #include "app/commands.hpp"
-#include "io/report.hpp"
+#include "io/formats/report.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "support/instrument.hpp"
 #include "support/random_coefficients.hpp"

@@ -1,0 +1,687 @@
+#include "io/formats/lab_data.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <numbers>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+#include "io/formats/case_file.hpp"
+#include "io/formats/csv.hpp"
+#include "io/formats/output.hpp"
+#include "io/formats/raw_hdf5.hpp"
+#include "io/formats/series.hpp"
+#include "rectification/measurement/reference.hpp"
+#include "rectification/measurement/series.hpp"
+#include "validation/diagnosis/diagnose.hpp"
+#include "validation/identification/dividing_head.hpp"
+
+namespace vrelab::io {
+namespace {
+
+namespace fs = std::filesystem;
+
+// One CSV line into cells, trimmed of blanks. A cell may be quoted ("a, b"; "" is a quote
+// inside), as spreadsheets write them; an unclosed quote is std::invalid_argument naming `where`.
+std::vector<std::string> split(const std::string& line, const std::string& where) {
+  return split_csv_line(line, where);
+}
+
+// A CSV file with a header: rows with their line numbers; '#' lines and blank lines skipped.
+// Text checked line by line (UTF-8, a byte-order mark dropped, ',' as separator); a row with
+// more cells than the header, or a header naming a column twice, is refused.
+struct Csv {
+  std::string path;
+  std::map<std::string, std::size_t> column;
+  std::vector<std::string> names;  // the header, in order
+  std::vector<std::pair<int, std::vector<std::string>>> rows;
+  bool has(const std::string& c) const { return column.count(c) > 0; }
+};
+
+Csv read_csv(const std::string& path) {
+  if (fs::is_directory(path)) throw InputError(path + ": is a folder, not a CSV file");
+  std::ifstream in(path);
+  if (!in) throw InputError(path + ": cannot open (no such file)");
+  Csv csv;
+  csv.path = path;
+  std::string line;
+  int n = 0;
+  bool header = false;
+  while (std::getline(in, line)) {
+    ++n;
+    check_text_line(line, n, path);
+    if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
+    std::vector<std::string> cells;
+    try {
+      cells = split(line, path + ":" + std::to_string(n));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(e.what());
+    }
+    if (!header) {
+      check_separator(line, n, path);
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        if (csv.column.count(cells[i]))
+          throw InputError(fmt::format("{}:{}:{}: column '{}' appears twice in the header", path, n, i + 1, cells[i]));
+        csv.column[cells[i]] = i;
+      }
+      csv.names = cells;
+      header = true;
+      continue;
+    }
+    if (cells.size() > csv.names.size())
+      throw InputError(fmt::format("{}:{}:{}: {} cells, the header has {} (a ',' inside a cell? quote the cell)", path, n,
+                                   csv.names.size() + 1, cells.size(), csv.names.size()));
+    csv.rows.emplace_back(n, std::move(cells));
+  }
+  if (!header) throw InputError(path + ": no header line");
+  return csv;
+}
+
+// The value of `col` in a row as a number; nullopt with `why` set when absent or not a finite
+// decimal ("file:line:column (name): ...").
+std::optional<double> number(const Csv& csv, const std::pair<int, std::vector<std::string>>& row, const std::string& col,
+                             std::string* why) {
+  const auto it = csv.column.find(col);
+  if (it == csv.column.end() || it->second >= row.second.size() || row.second[it->second].empty()) {
+    *why = fmt::format("{}:{}: column {}: missing value", csv.path, row.first, col);
+    return std::nullopt;
+  }
+  const std::string& s = row.second[it->second];
+  const auto x = parse_decimal(s);
+  if (!x) {
+    const std::string reason = why_not_decimal(s);
+    *why = reason == "not finite"
+               ? fmt::format("{}:{}:{}: column {}: {} is not a finite number", csv.path, row.first, it->second + 1, col, s)
+               : fmt::format("{}:{}:{}: column {}: '{}' is not a number ({})", csv.path, row.first, it->second + 1, col, s,
+                             reason);
+    return std::nullopt;
+  }
+  return x;
+}
+
+// " (the header has: a, b, c); did you mean 'wanted' for 'close'?" for a column `wanted` that
+// is not there, `close` the header's closest name.
+std::string columns_found(const Csv& csv, const std::string& wanted) {
+  std::string found;
+  for (const auto& n : csv.names) found += (found.empty() ? "" : ", ") + n;
+  std::string out = fmt::format(" (the header has: {})", found);
+  const std::string close = closest_name(wanted, csv.names);
+  if (!close.empty()) {
+    out += fmt::format("; did you mean '{}' for '{}'?", wanted, close);
+    std::string a = close, b = wanted;
+    for (char& ch : a) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    for (char& ch : b) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    if (a == b) out += " (column names are case-sensitive: units such as Hz are written as in SI)";
+  }
+  return out;
+}
+
+void require_columns(const Csv& csv, const std::vector<std::string>& cols, const std::string& hint = "") {
+  for (const auto& c : cols)
+    if (!csv.has(c))
+      throw InputError(fmt::format("{}: the header lacks column '{}'{}{}", csv.path, c, hint, columns_found(csv, c)));
+}
+
+// A random run's PSD file (docs/data-format.md): frequency_Hz and psd_<axis>_g2_per_Hz for
+// the axes that move (a missing column: that axis at rest); breakpoints, straight lines on
+// log-log axes between them. Bad content throws InputError naming the file, line and column.
+vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling) {
+  const Csv csv = read_csv(path);
+  require_columns(csv, {"frequency_Hz"});
+  static const std::array<std::string, 3> cols{"psd_IA_g2_per_Hz", "psd_PA_g2_per_Hz", "psd_OA_g2_per_Hz"};
+  vibration::RandomProfile p;
+  p.coupling = coupling == "independent" ? vibration::AxisCoupling::independent : vibration::AxisCoupling::common;
+  bool any = false;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!csv.has(cols[i])) continue;
+    any = true;
+    vibration::PsdTable t;
+    for (const auto& row : csv.rows) {
+      std::string why;
+      const auto f = number(csv, row, "frequency_Hz", &why), g = number(csv, row, cols[i], &why);
+      if (!f || !g) throw InputError(why);
+      if (!(*f > 0) || (!t.rows.empty() && !(*f > t.rows.back().frequency_Hz)))
+        throw InputError(fmt::format("{}:{}: column frequency_Hz: {:g} must be positive and above the previous row's", path,
+                                     row.first, *f));
+      if (!(*g > 0))
+        throw InputError(fmt::format("{}:{}: column {}: {:g} must be positive (an axis at rest: leave its column out)", path,
+                                     row.first, cols[i], *g));
+      t.rows.push_back(vibration::PsdRow::level(*f, *g));
+    }
+    try {
+      vibration::validate(t);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: column {}: {}", path, cols[i], e.what()));
+    }
+    p.psd[i] = t;
+  }
+  if (!any) throw InputError(path + ": the header needs at least one of psd_IA_g2_per_Hz, psd_PA_g2_per_Hz, psd_OA_g2_per_Hz");
+  return p;
+}
+
+
+// The output column of a file must carry the manifest's unit: output_<unit>, sigma_<unit>.
+void require_unit(const Csv& csv, const std::string& prefix, const std::string& unit) {
+  if (csv.has(prefix + unit)) return;
+  for (const auto& [name, i] : csv.column)
+    if (name.rfind(prefix, 0) == 0)
+      throw InputError(fmt::format("{}: column '{}' is in '{}', the manifest's output unit is '{}' (expected '{}{}')", csv.path,
+                                   name, name.substr(prefix.size()), unit, prefix, unit));
+  throw InputError(fmt::format("{}: the header lacks column '{}{}'{}", csv.path, prefix, unit, columns_found(csv, prefix + unit)));
+}
+
+double toml_number(const toml::table& t, const std::string& table, const char* key, double fallback, const std::string& file) {
+  const toml::node* n = t.get(key);
+  if (!n) return fallback;
+  if (!n->is_number())
+    throw InputError(fmt::format("{}:{}: [{}] {}: expected a number", file, n->source().begin.line, table, key));
+  const double x = n->value<double>().value();
+  if (!std::isfinite(x)) throw InputError(fmt::format("{}:{}: [{}] {}: must be finite", file, n->source().begin.line, table, key));
+  return x;
+}
+
+void check_keys(const toml::table& t, const std::string& table, const std::vector<std::string>& allowed, const std::string& file) {
+  for (auto&& [k, v] : t) {
+    bool ok = false;
+    for (const auto& a : allowed) ok = ok || a == k.str();
+    if (!ok) throw InputError(fmt::format("{}:{}: {}{}: unknown key", file, v.source().begin.line,
+                                          table.empty() ? "" : "[" + table + "] ", std::string(k.str())));
+  }
+}
+
+int coefficient_index(const std::string& name) {
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    if (plant::coefficient_name(i) == name) return i;
+  return -1;
+}
+
+// The manifest's [diagnose]: DiagnoseSettings by field name, checked.
+void read_diagnose_settings(const toml::table& t, const std::string& file, LabManifest& m) {
+  check_keys(t, "diagnose", {"model_accuracy", "significance_sigma", "explained_shrinkage", "resimulate_runs", "try_pairs"}, file);
+  m.diagnose_given = true;
+  validation::DiagnoseSettings& s = m.diagnose;
+  s.model_accuracy = toml_number(t, "diagnose", "model_accuracy", s.model_accuracy, file);
+  s.significance_sigma = toml_number(t, "diagnose", "significance_sigma", s.significance_sigma, file);
+  s.explained_shrinkage = toml_number(t, "diagnose", "explained_shrinkage", s.explained_shrinkage, file);
+  if (const toml::node* n = t.get("resimulate_runs")) {
+    const auto v = n->value<std::int64_t>();
+    if (!n->is_integer() || *v < 0 || *v > 1000000)
+      throw InputError(fmt::format("{}:{}: [diagnose] resimulate_runs: expected a whole number of runs, 0 to 1000000", file,
+                                   n->source().begin.line));
+    s.resimulate_runs = static_cast<int>(*v);
+  }
+  if (const toml::node* n = t.get("try_pairs")) {
+    if (!n->is_boolean())
+      throw InputError(fmt::format("{}:{}: [diagnose] try_pairs: expected true or false", file, n->source().begin.line));
+    s.try_pairs = n->value<bool>().value();
+  }
+  std::string why;
+  if (!s.IsValid(&why)) throw InputError(file + ": [diagnose] " + why);
+}
+
+// A run's raw record as a CSV of time and output.
+std::string raw_record_csv(const std::string& id, const validation::RawRecord& rec, const std::string& unit) {
+  std::string text =
+      fmt::format("# {} raw record: time in s, output in {}; at rest for t < 0\ntime_s,output_{}\n", id, unit, unit);
+  for (std::size_t i = 0; i < rec.t_s.size(); ++i) text += fmt::format("{:.9g},{:.12g}\n", rec.t_s[i], rec.output[i]);
+  return text;
+}
+
+// A run's measured motion from its reference channels (docs/data-format.md, "Reference
+// channels"): a sine run's tones, a random run's Welch cross-spectral matrix over the
+// commanded band, a sine on random run's fundamental and the Welch matrix of the rest; used
+// by the prediction only with all three axes (else the departure is reported).
+rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, const rectification::ReferenceAnalysis& a) {
+  rectification::MeasuredMotion mm;
+  mm.present = a.present;
+  mm.frequency_Hz = a.frequency_Hz;
+  // Only a reference on all three axes gives the motion: an axis without a channel would keep
+  // the commanded motion (no transverse part, and a phase unrelated to the measured axes'), so
+  // the table-motion effects would be neither measured nor fitted there. With fewer axes the
+  // departure is reported and the run is predicted from the command.
+  const bool all_axes = a.present[0] && a.present[1] && a.present[2];
+  if (!r.random || r.sine_part) {
+    const vibration::SineVibration cmd = r.vibration();
+    Vec3 signed_g;
+    for (int i = 0; i < 3; ++i) signed_g[i] = cmd.amplitude_g[i] * std::cos(cmd.phase_rad[i]);
+    mm.departure = rectification::sine_departure(a, signed_g);
+    if (!r.random && all_axes)
+      for (int h = 1; h <= 3; ++h) {
+        Eigen::Vector3cd W = a.harmonic_g[static_cast<std::size_t>(h)];
+        for (std::size_t i = 0; i < 3; ++i)
+          if (!a.present[i]) W[static_cast<int>(i)] = h == 1 ? std::complex<double>(signed_g[static_cast<int>(i)], 0) : 0.0;
+        mm.tones.emplace_back(h, W);
+      }
+    if (!r.random || !all_axes) return mm;
+    // Sine on random: the sine's measured fundamental (transverse parts and phases included;
+    // the prediction takes one sine), the random part below from the spectra with that
+    // fundamental taken off (reference.hpp; the 2nd and 3rd harmonics stay in the spectra,
+    // where their second moments are carried).
+    mm.tones.emplace_back(1, a.harmonic_g[1]);
+  } else {
+    const Eigen::Matrix3d C = vibration::gaussian_equivalent(*r.random).covariance_g2();
+    mm.departure = rectification::random_departure(a, C);
+    if (!all_axes) return mm;
+  }
+  const vibration::RandomProfile& cmd = *r.random;
+  double lo = INFINITY, hi = 0;
+  for (const auto& t : cmd.psd)
+    if (t) lo = std::min(lo, t->rows.front().frequency_Hz), hi = std::max(hi, t->rows.back().frequency_Hz);
+  // Two bins beyond each end: the Hann window's main lobe spreads a sharp band edge over
+  // +-2 bins, and that power is the motion's (left out, it was ~1 % of a 20-500 Hz table's
+  // variance at 7.8 Hz bins).
+  lo = std::max(lo - 2 * a.resolution_Hz, a.bin_Hz.empty() ? 0.0 : a.bin_Hz.front());
+  hi += 2 * a.resolution_Hz;
+  vibration::RandomProfile p = cmd;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!a.present[i]) continue;
+    // A flat channel has no PSD to take (a disconnected reference reads a constant).
+    if (!(a.rms_g[static_cast<int>(i)] > 0))
+      throw std::invalid_argument(fmt::format("reference channel {}: flat over the vibration window (rms 0 g): no PSD to take",
+                                              i == 0 ? "ref_IA_g" : i == 1 ? "ref_PA_g" : "ref_OA_g"));
+    vibration::PsdTable t = rectification::welch_table(a, static_cast<int>(i), lo, hi);
+    if (t.rows.size() < 2)
+      throw std::invalid_argument(fmt::format("reference channels: Welch's PSD ({:g} Hz bins) has fewer than 2 bins in the "
+                                              "commanded band {:g} - {:g} Hz",
+                                              a.resolution_Hz, lo, hi));
+    p.psd[i] = t;
+  }
+  // The full measured cross-spectral matrix: the transverse motion's coherence and phase with
+  // the drive as measured, not the run's `coupling` (a transverse part partly coherent with
+  // IA, or delayed, rectifies through the cross terms by Re(H S H^H), not sqrt(G_i G_j)).
+  p.measured = std::make_shared<const vibration::CrossSpectralMatrix>(rectification::welch_matrix(a, lo, hi));
+  mm.random = p;
+  return mm;
+}
+
+}  // namespace
+
+validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest_out) {
+  const std::string mpath = (fs::path(dir) / "manifest.toml").string();
+  if (!fs::is_regular_file(mpath)) throw InputError(mpath + ": cannot open the manifest (no such file)");
+  toml::table root;
+  try {
+    root = toml::parse_file(mpath);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}: {}", mpath, e.source().begin.line, e.description()));
+  }
+  check_keys(root, "", {"campaign", "instrument", "dynamics", "identification", "files", "diagnose"}, mpath);
+  // What every campaign states (an empty manifest would otherwise run on defaults and fail
+  // later, on the identification's rank): the format, the output unit, and the held
+  // coefficients (a 1 g test cannot separate the common part of k_PP, k_OO and k2 from k0, so
+  // some must be held; an explicit `fixed = { }` is the lab's choice, judged by the rank check).
+  {
+    std::vector<std::string> missing;
+    if (!root["campaign"]["format_version"]) missing.push_back("[campaign] format_version = 1");
+    if (!root["instrument"]["output_unit"]) missing.push_back("[instrument] output_unit (e.g. \"mA\")");
+    if (!root["identification"]["fixed"]) missing.push_back("[identification] fixed (e.g. { k_PP = 0.0 })");
+    if (!missing.empty()) {
+      std::string list;
+      for (const auto& k : missing) list += (list.empty() ? "" : "; ") + k;
+      throw InputError(fmt::format("{}: missing {} (docs/data-format.md)", mpath, list));
+    }
+  }
+  validation::Campaign c;
+  LabManifest m;
+  if (auto* t = root["campaign"].as_table()) {
+    check_keys(*t, "campaign", {"name", "format_version"}, mpath);
+    m.name = (*t)["name"].value_or(m.name);
+    const toml::node* fv = t->get("format_version");
+    if (!fv->is_integer())
+      throw InputError(fmt::format("{}:{}: [campaign] format_version: expected the whole number 1", mpath, fv->source().begin.line));
+    if (const auto v = fv->value<std::int64_t>(); v && *v != 1)
+      throw InputError(fmt::format("{}: [campaign] format_version: {} is not supported (this program reads 1)", mpath, *v));
+    if (const toml::node* nm = t->get("name"); nm && !nm->is_string())
+      throw InputError(fmt::format("{}:{}: [campaign] name: expected a string", mpath, nm->source().begin.line));
+  }
+  c.name = m.name;
+  if (auto* t = root["instrument"].as_table()) {
+    check_keys(*t, "instrument", {"output_unit", "g_m_per_s2"}, mpath);
+    const toml::node* u = t->get("output_unit");
+    if (!u->is_string() || u->value<std::string>()->empty() ||
+        u->value<std::string>()->find_first_of(",\" \t") != std::string::npos)
+      throw InputError(fmt::format("{}:{}: [instrument] output_unit: expected a unit name such as \"mA\" (no blanks, commas or quotes)",
+                                   mpath, u->source().begin.line));
+    m.output_unit = *u->value<std::string>();
+    m.g_m_per_s2 = toml_number(*t, "instrument", "g_m_per_s2", m.g_m_per_s2, mpath);
+  }
+  if (auto* t = root["dynamics"].as_table()) {
+    m.dynamics_given = true;
+    check_keys(*t, "dynamics",
+               {"pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g", "loop_bandwidth_Hz",
+                "phase_margin_deg", "integrator", "integrator_zero_ratio"},
+               mpath);
+    plant::Dynamics& d = c.dynamics;
+    d.pendulum_frequency_Hz = toml_number(*t, "dynamics", "pendulum_frequency_Hz", d.pendulum_frequency_Hz, mpath);
+    d.pendulum_damping_ratio = toml_number(*t, "dynamics", "pendulum_damping_ratio", d.pendulum_damping_ratio, mpath);
+    d.angle_gain_rad_per_s2_per_g = toml_number(*t, "dynamics", "angle_gain_rad_per_s2_per_g", d.angle_gain_rad_per_s2_per_g, mpath);
+    d.loop_bandwidth_Hz = toml_number(*t, "dynamics", "loop_bandwidth_Hz", d.loop_bandwidth_Hz, mpath);
+    d.phase_margin_deg = toml_number(*t, "dynamics", "phase_margin_deg", d.phase_margin_deg, mpath);
+    d.integrator = (*t)["integrator"].value_or(d.integrator);
+    d.integrator_zero_ratio = toml_number(*t, "dynamics", "integrator_zero_ratio", d.integrator_zero_ratio, mpath);
+    std::string why;
+    if (!d.IsValid(&why)) throw InputError(mpath + ": [dynamics]: " + why);
+  }
+  if (auto* t = root["identification"].as_table()) {
+    check_keys(*t, "identification", {"fixed"}, mpath);
+    if (auto* f = (*t)["fixed"].as_table())
+      for (auto&& [k, v] : *f) {
+        const int i = coefficient_index(std::string(k.str()));
+        if (i < 0 || !v.is_number())
+          throw InputError(fmt::format("{}:{}: [identification] fixed: '{}' is not a coefficient of model (1) with a number",
+                                       mpath, v.source().begin.line, std::string(k.str())));
+        c.fixed[i] = v.value<double>().value();
+      }
+  }
+  if (auto* t = root["diagnose"].as_table()) read_diagnose_settings(*t, mpath, m);
+  std::string static_file = "static.csv", runs_file = "runs.csv";
+  if (auto* t = root["files"].as_table()) {
+    check_keys(*t, "files", {"static", "runs"}, mpath);
+    static_file = (*t)["static"].value_or(static_file);
+    runs_file = (*t)["runs"].value_or(runs_file);
+  }
+
+  // Static readings: every row must be usable (the identification needs them all).
+  const Csv st = read_csv((fs::path(dir) / static_file).string());
+  require_unit(st, "output_", m.output_unit);
+  require_unit(st, "sigma_", m.output_unit);
+  const bool by_vector = st.has("a_IA_g");
+  if (by_vector) require_columns(st, {"a_IA_g", "a_PA_g", "a_OA_g"});
+  else require_columns(st, {"series", "angle_deg"}, " (give a_IA_g, a_PA_g, a_OA_g or series, angle_deg)");
+  for (const auto& row : st.rows) {
+    std::string why;
+    auto get = [&](const std::string& col) {
+      const auto x = number(st, row, col, &why);
+      if (!x) throw InputError(why);
+      return *x;
+    };
+    validation::StaticRecord r;
+    if (by_vector) {
+      r.orientation_g = Vec3(get("a_IA_g"), get("a_PA_g"), get("a_OA_g"));
+      if (std::abs(r.orientation_g.norm() - 1) > 0.01)
+        throw InputError(fmt::format("{}:{}: the orientation has |a| = {:.4g} g; a static position is gravity, |a| = 1 g", st.path,
+                                     row.first, r.orientation_g.norm()));
+    } else {
+      const double s = get("series");
+      if (s != 1 && s != 2 && s != 3) throw InputError(fmt::format("{}:{}: column series: must be 1, 2 or 3", st.path, row.first));
+      r.orientation_g = validation::series_orientation(static_cast<int>(s), get("angle_deg") * std::numbers::pi / 180);
+    }
+    r.output = get("output_" + m.output_unit);
+    const double sigma = get("sigma_" + m.output_unit);
+    const bool has_count = st.has("count") && st.column.at("count") < row.second.size() && !row.second[st.column.at("count")].empty();
+    const double count = has_count ? get("count") : 1.0;
+    if (count != std::floor(count))
+      throw InputError(fmt::format("{}:{}:{}: column count: {} is not a whole number of readings", st.path, row.first,
+                                   st.column.at("count") + 1, row.second[st.column.at("count")]));
+    if (!(sigma > 0)) throw InputError(fmt::format("{}:{}: column sigma_{}: must be positive", st.path, row.first, m.output_unit));
+    if (!(count >= 1)) throw InputError(fmt::format("{}:{}: column count: must be at least 1", st.path, row.first));
+    r.sigma_output = sigma / std::sqrt(count);
+    r.where = fmt::format("{}:{}", st.path, row.first);
+    c.statics.push_back(r);
+  }
+  if (c.statics.empty()) throw InputError(st.path + ": no static readings");
+
+  // The runs: a bad one is skipped with why.
+  const Csv rn = read_csv((fs::path(dir) / runs_file).string());
+  require_columns(rn, {"id", "frequency_Hz", "amplitude_g", "d_IA", "d_PA", "d_OA", "a_IA_g", "a_PA_g", "a_OA_g"});
+  const bool summaries = rn.has("measured_ug"), series = rn.has("series");
+  if (!summaries && !series)
+    throw InputError(rn.path + ": the header needs measured_ug and sigma_ug (summaries) or series (raw records)");
+  if (summaries) require_columns(rn, {"sigma_ug"});
+  if (series) require_columns(rn, {"rest_from_s", "rest_to_s", "on_from_s", "on_to_s"});
+  // K1 for raw records: the static readings' least-squares scale factor.
+  double K1 = 0;
+  if (series) {
+    std::vector<validation::Position> pos;
+    std::vector<validation::Reading> rd;
+    std::vector<double> w;
+    for (std::size_t i = 0; i < c.statics.size(); ++i) {
+      pos.push_back(validation::vector_position(c.statics[i].orientation_g.normalized()));
+      rd.push_back({static_cast<int>(i), c.statics[i].output});
+      w.push_back(1 / std::pow(c.statics[i].sigma_output, 2));
+    }
+    K1 = validation::least_squares(pos, rd, w, c.fixed).estimate.value[plant::K1];
+  }
+  for (const auto& row : rn.rows) {
+    const std::string idc = rn.column.at("id") < row.second.size() ? row.second[rn.column.at("id")] : "";
+    const std::string label = fmt::format("{}:{} (run '{}')", rn.path, row.first, idc);
+    const std::string named = fmt::format("run '{}'", idc);  // `why` already names the file and line
+    std::string why;
+    auto get = [&](const std::string& col) { return number(rn, row, col, &why); };
+    validation::RunRecord r;
+    r.id = idc;
+    r.where = fmt::format("{}:{}", rn.path, row.first);
+    // The run's kind (optional column, default sine) and, for random ones, the PSD file.
+    auto cell = [&](const std::string& col) {
+      return rn.has(col) && rn.column.at(col) < row.second.size() ? row.second[rn.column.at(col)] : std::string();
+    };
+    std::string kind = cell("kind");
+    if (kind.empty()) kind = "sine";
+    if (kind != "sine" && kind != "random" && kind != "sine_on_random") {
+      c.skipped.push_back(fmt::format("{}:{}: column kind: must be sine, random or sine_on_random, got '{}'", rn.path,
+                                      row.first, kind));
+      continue;
+    }
+    if (kind != "sine") {
+      const std::string coupling = cell("coupling").empty() ? "common" : cell("coupling");
+      if (coupling != "common" && coupling != "independent") {
+        c.skipped.push_back(fmt::format("{}:{}: column coupling: must be common or independent, got '{}'", rn.path,
+                                        row.first, coupling));
+        continue;
+      }
+      if (cell("psd").empty()) {
+        c.skipped.push_back(fmt::format("{}:{}: column psd: a {} run needs its PSD file", rn.path, row.first, kind));
+        continue;
+      }
+      try {
+        r.random = read_psd_file((fs::path(dir) / cell("psd")).string(), coupling);
+      } catch (const InputError& e) {
+        c.skipped.push_back(label + ": " + e.what());
+        continue;
+      }
+      r.sine_part = kind == "sine_on_random";
+    }
+    const auto o0 = get("a_IA_g"), o1 = get("a_PA_g"), o2 = get("a_OA_g");
+    if (!o0 || !o1 || !o2) {
+      c.skipped.push_back(named + ": " + why);
+      continue;
+    }
+    if (kind == "random") {
+      // No sine: frequency, amplitude and direction describe the PSD (its mean frequency,
+      // sqrt(2) x its rms, each axis's rms share); the row's cells are not read.
+      Vec3 rms = Vec3::Zero();
+      double moment1 = 0;
+      for (int i = 0; i < 3; ++i)
+        if (const auto& t = r.random->psd[static_cast<std::size_t>(i)]) {
+          rms[i] = vibration::rms_g(*t);
+          moment1 += vibration::psd_moment(vibration::resolve(*t), 1);
+        }
+      r.frequency_Hz = moment1 / rms.squaredNorm(), r.amplitude_g = std::sqrt(2.0) * rms.norm(), r.direction = rms.normalized();
+      r.orientation_g = Vec3(*o0, *o1, *o2);
+    } else {
+      const auto f = get("frequency_Hz"), a = get("amplitude_g"), d0 = get("d_IA"), d1 = get("d_PA"), d2 = get("d_OA");
+      if (!f || !a || !d0 || !d1 || !d2) {
+        c.skipped.push_back(named + ": " + why);
+        continue;
+      }
+      const Vec3 d(*d0, *d1, *d2);
+      if (!(*f > 0) || !(*a > 0) || !(d.norm() > 0)) {
+        c.skipped.push_back(label + ": frequency, amplitude and direction must be positive / non-zero");
+        continue;
+      }
+      r.frequency_Hz = *f, r.amplitude_g = *a, r.direction = d.normalized(), r.orientation_g = Vec3(*o0, *o1, *o2);
+    }
+    if (std::abs(r.orientation_g.norm() - 1) > 0.01) {
+      c.skipped.push_back(fmt::format("{}: the static orientation has |a| = {:.4g} g; gravity is 1 g (a_*_g in g)", label,
+                                      r.orientation_g.norm()));
+      continue;
+    }
+    if (std::any_of(c.runs.begin(), c.runs.end(), [&](const validation::RunRecord& x) { return x.id == idc; })) {
+      c.skipped.push_back(label + ": the id is used by an earlier run");
+      continue;
+    }
+    const std::string file = series && rn.column.at("series") < row.second.size() ? row.second[rn.column.at("series")] : "";
+    if (!file.empty()) {
+      const auto rf = get("rest_from_s"), rt = get("rest_to_s"), of = get("on_from_s"), ot = get("on_to_s");
+      if (!rf || !rt || !of || !ot) {
+        c.skipped.push_back(named + ": " + why);
+        continue;
+      }
+      rectification::SeriesWindows win;
+      win.baseline_from_s = *rf, win.baseline_to_s = *rt, win.on_from_s = *of, win.on_to_s = *ot;
+      win.frequency_Hz = r.frequency_Hz, win.K1 = K1;
+      // Batch means over whole periods: up to 8 blocks of equal whole numbers of periods (the
+      // vibration window shortened to a multiple of the blocks). A random run (random or sine
+      // on random, not periodic): 8 blocks over the window as given.
+      if (r.random) win.frequency_Hz = 0, win.blocks = 8;
+      const long periods = r.random ? 8 : static_cast<long>(std::floor((*ot - *of) * r.frequency_Hz + 1e-9));
+      if (periods < 2) {
+        c.skipped.push_back(fmt::format("{}: the vibration window holds {} whole period(s) of {:g} Hz; at least 2 are needed",
+                                        label, periods, r.frequency_Hz));
+        continue;
+      }
+      if (!r.random) {
+        win.blocks = static_cast<int>(std::min<long>(8, periods));
+        win.on_to_s = *of + static_cast<double>(periods / win.blocks * win.blocks) / r.frequency_Hz;
+      }
+      const std::string spath = (fs::path(dir) / file).string();
+      try {
+        win.validate();
+        rectification::SeriesMeasurer meas(win);
+        // Reference channels (docs/data-format.md, "Reference channels"): the table's motion
+        // over the vibration window, analysed as it streams (harmonics, or Welch's PSD).
+        rectification::ReferenceWindow rwin;
+        rwin.from_s = win.on_from_s, rwin.to_s = rectification::used_on_to_s(win);
+        rwin.frequency_Hz = r.random ? (r.sine_part ? r.frequency_Hz : 0.0) : r.frequency_Hz;
+        rwin.sine_on_random = r.random && r.sine_part;
+        std::optional<rectification::ReferenceAnalyzer> refan;
+        const ReferenceSink reference = [&](double t_s, const std::array<double, 3>& ref_g, const std::array<bool, 3>& present) {
+          if (!refan) refan.emplace(rwin);
+          refan->add(t_s, ref_g, present);
+        };
+        // The record, CSV or HDF5 by its extension (io/formats/series.hpp): time_s, output_<unit> and
+        // the optional reference channels.
+        double last_t = -INFINITY, first_dt = 0;
+        read_series(
+            spath, "output_" + m.output_unit,
+            [&](double t, double u) {
+              if (std::isfinite(last_t) && first_dt == 0) first_dt = t - last_t;  // as SeriesMeasurer detects it
+              last_t = t;
+              meas.add(t, u);
+            },
+            reference);
+        // Half-open windows, decided as `measure` does (rectification/measurement/series.hpp).
+        if (!rectification::record_covers_window_end(rectification::used_on_to_s(win), last_t, first_dt))
+          throw std::invalid_argument(fmt::format("{}: the record ends at {:g} s, before on_to_s = {:g} s", spath, last_t, *ot));
+        const rectification::SeriesResult res = meas.finish();
+        r.measured_g = res.measured_g, r.sigma_g = res.sigma_g;
+        if (refan) {
+          try {
+            r.motion = measured_motion(r, refan->finish());
+          } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(fmt::format("{}: {}", spath, e.what()));
+          }
+        }
+      } catch (const std::invalid_argument& e) {
+        c.skipped.push_back(label + ": " + e.what());
+        continue;
+      } catch (const InputError& e) {
+        c.skipped.push_back(label + ": " + e.what());
+        continue;
+      }
+    } else {
+      if (!summaries) {
+        c.skipped.push_back(label + ": neither a series nor measured_ug");
+        continue;
+      }
+      const auto mu = get("measured_ug"), su = get("sigma_ug");
+      if (!mu || !su) {
+        c.skipped.push_back(named + ": " + why);
+        continue;
+      }
+      if (!(*su > 0)) {
+        c.skipped.push_back(label + ": sigma_ug must be positive");
+        continue;
+      }
+      r.measured_g = *mu * 1e-6, r.sigma_g = *su * 1e-6;
+    }
+    // Optional: the run's time and the rest reading before it (a bias drift, docs/data-format.md).
+    if (rn.has("time_h"))
+      if (const auto t = get("time_h")) r.time_h = *t;
+    if (rn.has("rest_ug"))
+      if (const auto x = get("rest_ug")) r.rest_g = *x * 1e-6;
+    c.runs.push_back(r);
+  }
+  if (manifest_out) *manifest_out = m;
+  return c;
+}
+
+void write_campaign(const std::string& dir, const validation::Campaign& c, const LabManifest& m,
+                    const std::vector<RawSeriesRef>& raw_series, RawFormat raw_format) {
+  std::vector<RawSeriesRef> raw = raw_series;
+  if (raw.empty())
+    for (std::size_t k = 0; k < c.raw.size(); ++k) {
+      const validation::RawRecord& rec = c.raw[k];
+      const std::string file = "records/" + c.runs[k].id + (raw_format == RawFormat::hdf5 ? ".h5" : ".csv");
+      if (raw_format == RawFormat::hdf5) {
+        Hdf5SeriesWriter w(dir + "/" + file, m.output_unit, {}, c.runs[k].id, "at rest for t < 0");
+        for (std::size_t i = 0; i < rec.t_s.size(); ++i) w.add(rec.t_s[i], rec.output[i]);
+        w.commit();
+      } else {
+        write_atomic(dir + "/" + file, raw_record_csv(c.runs[k].id, rec, m.output_unit));
+      }
+      raw.push_back({file, rec.rest_from_s, rec.rest_to_s, rec.on_from_s, rec.on_to_s});
+    }
+  const plant::Dynamics& d = c.dynamics;
+  std::string fixed;
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    if (c.fixed[i]) fixed += fmt::format("{}{} = {:.10g}", fixed.empty() ? "" : ", ", plant::coefficient_name(i), *c.fixed[i]);
+  write_atomic(dir + "/manifest.toml",
+               fmt::format("# vrelab lab data format 1 (docs/data-format.md)\n[campaign]\nname = \"{}\"\nformat_version = 1\n\n"
+                           "[instrument]\noutput_unit = \"{}\"\ng_m_per_s2 = {:.10g}\n\n"
+                           "[dynamics]                      # nominal, as the manufacturer states them\n"
+                           "pendulum_frequency_Hz = {:.10g}\npendulum_damping_ratio = {:.10g}\n"
+                           "angle_gain_rad_per_s2_per_g = {:.10g}\nloop_bandwidth_Hz = {:.10g}\nphase_margin_deg = {:.10g}\n"
+                           "integrator = {}\nintegrator_zero_ratio = {:.10g}\n\n"
+                           "[identification]\nfixed = {{ {} }}\n\n[files]\nstatic = \"static.csv\"\nruns = \"runs.csv\"\n",
+                           [&] {
+                             std::string e;
+                             for (char ch : m.name) e += ch == '"' || ch == '\\' ? std::string("\\") + ch : std::string(1, ch);
+                             return e;
+                           }(),
+                           m.output_unit, m.g_m_per_s2, d.pendulum_frequency_Hz, d.pendulum_damping_ratio,
+                           d.angle_gain_rad_per_s2_per_g, d.loop_bandwidth_Hz, d.phase_margin_deg, d.integrator ? "true" : "false",
+                           d.integrator_zero_ratio, fixed));
+  std::string st = fmt::format("# static readings: orientation in g (sensor axes), mean output and one reading's sigma in {}\n"
+                               "a_IA_g,a_PA_g,a_OA_g,output_{},sigma_{},count\n",
+                               m.output_unit, m.output_unit, m.output_unit);
+  for (const auto& s : c.statics)
+    st += fmt::format("{:.12g},{:.12g},{:.12g},{:.15g},{:.6g},1\n", s.orientation_g[0], s.orientation_g[1], s.orientation_g[2],
+                      s.output, s.sigma_output);
+  write_atomic(dir + "/static.csv", st);
+  std::string rn = "# shaker runs: sine, amplitude in g peak along d (sensor axes, in phase), static orientation a in g;\n"
+                   "# measured vibration error and its sigma in ug, or a raw series (time_s, output) with its windows in s\n";
+  rn += raw.empty() ? "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,measured_ug,sigma_ug\n"
+                    : "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,series,rest_from_s,rest_to_s,on_from_s,on_to_s\n";
+  for (std::size_t k = 0; k < c.runs.size(); ++k) {
+    const auto& r = c.runs[k];
+    rn += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.12g},{:.12g},{:.12g},", r.id, r.frequency_Hz, r.amplitude_g,
+                      r.direction[0], r.direction[1], r.direction[2], r.orientation_g[0], r.orientation_g[1], r.orientation_g[2]);
+    if (raw.empty())
+      rn += fmt::format("{:.10g},{:.6g}\n", r.measured_g * 1e6, r.sigma_g * 1e6);
+    else
+      rn += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g}\n", raw[k].file, raw[k].rest_from_s, raw[k].rest_to_s,
+                        raw[k].on_from_s, raw[k].on_to_s);
+  }
+  write_atomic(dir + "/runs.csv", rn);
+}
+
+}  // namespace vrelab::io
