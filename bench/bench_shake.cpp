@@ -46,7 +46,8 @@ double thread_cpu_ms() {
 }
 
 // state.range(0): 1 = the periodic steady state (default), 0 = the transient path (settle
-// 16 time constants, measure 4 periods: main's shake before issue 14).
+// 16 time constants, measure 4 periods: the fallback, ShakeSettings::periodic_steady_state
+// = false).
 void SineConditionLogSweep(benchmark::State& state) {
   const plant::PlantConfig cfg = default_plant();
   const Vec3 a(0.5, std::sqrt(0.75), 0);
@@ -72,7 +73,7 @@ void SineConditionLogSweep(benchmark::State& state) {
 BENCHMARK(SineConditionLogSweep)->Arg(1)->Arg(0)->Iterations(3)->Unit(benchmark::kMillisecond)->MeasureProcessCPUTime();
 
 // state.range(0): 1 = the exponential integrator (rectification/simulation/discretised.hpp),
-// 0 = CVODE (the path before); state.range(1): seconds measured.
+// 0 = CVODE (ShakeSettings::exponential_integrator = false); state.range(1): seconds measured.
 void RandomGevs20kHz(benchmark::State& state) {
   const plant::PlantConfig cfg = default_plant();
   const vibration::RandomExcitation ex(bench::gevs_along_ia(), 16000, 1);

@@ -93,9 +93,10 @@ int main(int argc, char** argv) {
     std::vector<double> cell;
     for (std::size_t p = line.find(','); p != std::string::npos; p = line.find(',', p + 1)) cell.push_back(std::atof(line.c_str() + p + 1));
     const double f = cell.at(0), a = cell.at(1), measured_ug = cell.at(cell.size() - 2);
-    // The reference channels carry the commanded motion, a d sin(w t) on each axis (before,
-    // 2 g on IA alone for the diagonal run diag-100Hz-2g: a table 41 % off the command on IA
-    // and still on PA, which the diagnosis, taking the motion as measured, could not explain).
+    // The reference channels carry the commanded motion, a d sin(w t) on each axis: the
+    // diagnosis takes the motion as measured, so 2 g on IA alone for the diagonal run
+    // diag-100Hz-2g would read as a table 41 % off the command on IA and still on PA, which
+    // no effect explains.
     const std::array<double, 3> d{cell.at(2), cell.at(3), cell.at(4)};
     std::unique_ptr<vrelab::io::Hdf5SeriesWriter> h5;
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> csv(nullptr, std::fclose);

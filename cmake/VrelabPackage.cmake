@@ -14,7 +14,7 @@
 # that an install into /usr/local does not claim /usr/local/include/io.)
 #
 # Static libraries, the default of add_library here: the program and the tests run the same
-# object code as before the package existed (no -fPIC, no calls through the PLT in the ODE's
+# object code as a plain executable build (no -fPIC, no calls through the PLT in the ODE's
 # inner loop), and the installed program needs no RPATH or LD_LIBRARY_PATH, so the prefix can
 # be moved. The price is that a consumer links the private dependencies too (SUNDIALS' CVODE,
 # FFTW, fmt, toml++): vrelabConfig.cmake finds them with find_dependency, so a consumer's

@@ -94,7 +94,7 @@ bool same_dynamics(const Dynamics& a, const Dynamics& b) {
 }  // namespace
 
 // The design (its check for a single crossing scans 3000 frequencies: ~0.1 ms, a quarter of a
-// sine condition's time when every plant constructed redesigned it) is kept for the last
+// sine condition's time if every plant constructed designed its own) is kept for the last
 // dynamics seen on this thread.
 Servo design_servo(const Dynamics& d) {
   thread_local std::optional<std::pair<Dynamics, Servo>> last;
@@ -667,7 +667,7 @@ double settled_output_g(const PlantConfig& config, const Vec3& a_g, double rtol)
   const double tau = plant.slowest_time_constant_s(plant.linearise());
   SolverSettings s;
   s.relative_tolerance = rtol;
-  s.analytic_jacobian = false;  // CVODE's quotients, as before (the static answers bit for bit)
+  s.analytic_jacobian = false;  // CVODE's quotients: the static answers independent of the Jacobian option
   const double amplitude = std::max(1.0, a_g.norm());
   for (double scale : plant.state_scale()) s.absolute_tolerance.push_back(rtol * 1e-3 * amplitude * scale);
   OdeSolver ode(plant, 0.0, std::vector<double>(static_cast<std::size_t>(plant.size()), 0.0), s);

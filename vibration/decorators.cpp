@@ -147,7 +147,7 @@ Vec3 HarmonicDistortion::acceleration_g(double t) const {
   Vec3 a;
   for (int i = 0; i < 3; ++i) {
     // An axis the tone does not move stays at rest (its sines are not evaluated: most runs
-    // shake along one axis). +0 where amp * s gave a zero of s's sign.
+    // shake along one axis). +0 where amp * s would give a zero of s's sign, which no sum sees.
     if (amp[i] == 0) {
       a[i] = 0.0;
       continue;

@@ -61,8 +61,8 @@ struct ShakeSettings {
   // nonlinear terms (rectification/simulation/discretised.hpp); false forces CVODE.
   bool exponential_integrator = true;
   // CVODE (the transient path, the random fallback) with the plant's analytic Jacobian where
-  // it has one (plant/accelerometer.hpp: no effects); false (the default): CVODE's difference
-  // quotients, as before. Opt-in: the Jacobian steers only Newton's iteration, but CVODE's
+  // it has one (plant/accelerometer.hpp); false (the default): CVODE's difference
+  // quotients. Opt-in: the Jacobian steers only Newton's iteration, but CVODE's
   // steps then differ, and at a case's loose tolerance (rtol 1e-4) the answer moves by the
   // solver's own error (docs/performance.md: 4e-9 g of shake-sine-on-random, 1e-4 sigma).
   bool analytic_jacobian = false;
