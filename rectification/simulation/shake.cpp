@@ -245,55 +245,67 @@ bool ShakeSettings::IsValid(std::string* error) const {
   return true;
 }
 
-ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, const vibration::SineVibration& v,
-                       const ShakeSettings& s, const SampleSink& sink, const vibration::Excitation* input) {
-  std::string why;
-  if (!s.IsValid(&why)) throw std::invalid_argument(why);
-  vibration::validate(v);
-  if (!(v.frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive for a shaker run");
-  const double w = 2 * kPi * v.frequency_Hz;
-  const double period = 1 / v.frequency_Hz;
+namespace {
+
+// What a sine run's two paths share: the drive, the plant at rest (equilibrium, linearisation,
+// the linear periodic solution's phasor), the solver's settings and the run's timing (settling
+// and measured periods, sampling).
+struct SinePlan {
+  const ShakeSettings* s = nullptr;
+  double frequency_Hz = 0, w = 0, period = 0;
+  std::vector<double> x_eq;
+  Accelerometer::Linear lin;
+  int n = 0;
+  Eigen::VectorXcd phasor;  // X = (jwI - A)^-1 B W of the linear periodic steady state
+  plant::SolverSettings solver;
+  double amplitude = 0;  // the largest axis' amplitude, g (1e-12 at least)
+  int settle_periods = 0, per_block = 0;
+  double k1 = 0;
+  bool sampled = false;
+  long per_period = 0;   // samples per period (sampled only)
+  double floor = 0;      // the floor of sigma: the quadrature's own tolerance over the measured span, g
+};
+
+// The plant at rest, the linear steady state, the tolerances and the timing of a sine run;
+// r's baseline, slowest time constant, settling, periods and sample rate are set.
+SinePlan plan_sine(const plant::PlantConfig& config, const vibration::SineVibration& v,
+                   const ShakeSettings& s, const SampleSink& sink, const Accelerometer& rest, ShakeResult& r) {
+  SinePlan p;
+  p.s = &s;
+  p.frequency_Hz = v.frequency_Hz;
+  p.w = 2 * kPi * v.frequency_Hz;
+  p.period = 1 / v.frequency_Hz;
+  const double period = p.period;
 
   // The plant at rest: baseline, equilibrium, linearisation.
-  const Accelerometer rest(config, a_static);
-  const std::vector<double> x_eq = rest.equilibrium();
-  ShakeResult r;
-  r.baseline_g = rest.output_g(0, x_eq.data());
-  const Accelerometer::Linear lin = rest.linearise();
-  const int n = rest.size();
+  p.x_eq = rest.equilibrium();
+  r.baseline_g = rest.output_g(0, p.x_eq.data());
+  p.lin = rest.linearise();
+  p.n = rest.size();
+  const int n = p.n;
 
-  r.slowest_time_constant_s = rest.slowest_time_constant_s(lin);
+  r.slowest_time_constant_s = rest.slowest_time_constant_s(p.lin);
 
   // Linear periodic steady state: x = x_eq + Im(X e^{jwt}), X = (jwI - A)^-1 B W.
   Eigen::Vector3cd wc;
   for (int i = 0; i < 3; ++i) wc[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
-  const Eigen::MatrixXcd resolvent = std::complex<double>(0, w) * Eigen::MatrixXcd::Identity(n, n) - lin.A.cast<std::complex<double>>();
-  const Eigen::VectorXcd phasor = resolvent.fullPivLu().solve(lin.B.cast<std::complex<double>>() * wc);
+  const Eigen::MatrixXcd resolvent =
+      std::complex<double>(0, p.w) * Eigen::MatrixXcd::Identity(n, n) - p.lin.A.cast<std::complex<double>>();
+  p.phasor = resolvent.fullPivLu().solve(p.lin.B.cast<std::complex<double>>() * wc);
 
-  auto table_motion = [v, w, input](double t) {
-    if (input) return input->acceleration_g(t);
-    Vec3 a;
-    for (int i = 0; i < 3; ++i) a[i] = v.amplitude_g[i] * std::sin(w * t + v.phase_rad[i]);
-    return a;
-  };
-  Accelerometer shaken(config, a_static, table_motion);
-  shaken.set_quadrature_reference(r.baseline_g);
-  std::vector<double> x0(x_eq);
-  plant::SolverSettings solver;
-  solver.relative_tolerance = s.relative_tolerance;
-  solver.analytic_jacobian = s.analytic_jacobian;
+  p.solver.relative_tolerance = s.relative_tolerance;
+  p.solver.analytic_jacobian = s.analytic_jacobian;
   const std::vector<double> scale = rest.state_scale();
-  const double amplitude = std::max(v.amplitude_g.cwiseAbs().maxCoeff(), 1e-12);
+  p.amplitude = std::max(v.amplitude_g.cwiseAbs().maxCoeff(), 1e-12);
   for (int k = 0; k < n; ++k) {
     const std::size_t kk = static_cast<std::size_t>(k);
-    x0[kk] += phasor[k].imag();
-    const double typical = std::max({std::abs(phasor[k]), std::abs(x_eq[kk]), 1e-6 * amplitude * scale[kk]});
-    solver.absolute_tolerance.push_back(s.relative_tolerance * typical);
+    const double typical = std::max({std::abs(p.phasor[k]), std::abs(p.x_eq[kk]), 1e-6 * p.amplitude * scale[kk]});
+    p.solver.absolute_tolerance.push_back(s.relative_tolerance * typical);
   }
-  solver.max_step_s = period / 8;
+  p.solver.max_step_s = period / 8;
 
-  // Settling: whole periods covering ln(1/decay) slowest time constants.
-  // Counted in double and refused beyond int (a silent overflow dropped min_measure_s = 1e9).
+  // Settling: whole periods covering ln(1/decay) slowest time constants. Counted in double and
+  // refused beyond int (an int would overflow silently for min_measure_s = 1e9).
   const double settle_count = std::ceil(std::log(1 / s.settle_decay) * r.slowest_time_constant_s / period);
   const double block_count = std::max(1.0, std::ceil(s.min_measure_s / (s.blocks * period)));
   constexpr double kMaxPeriods = std::numeric_limits<int>::max() / 2;
@@ -305,179 +317,183 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
   };
   if (!(settle_count <= kMaxPeriods)) throw too_many("settle_decay", s.settle_decay, settle_count);
   if (!(block_count * s.blocks <= kMaxPeriods)) throw too_many("min_measure_s", s.min_measure_s, block_count * s.blocks);
-  const int settle_periods = static_cast<int>(settle_count);
-  r.settle_s = settle_periods * period;
-  const int per_block = static_cast<int>(block_count);
-  r.periods = per_block * s.blocks;
+  p.settle_periods = static_cast<int>(settle_count);
+  r.settle_s = p.settle_periods * period;
+  p.per_block = static_cast<int>(block_count);
+  r.periods = p.per_block * s.blocks;
 
-  const double k1 = config.coefficients[plant::K1];
+  p.k1 = config.coefficients[plant::K1];
   const Readout& ro = s.readout;
-  const bool sampled = ro.active() || static_cast<bool>(sink);
-  long per_period = 0;
-  if (sampled) {
+  p.sampled = ro.active() || static_cast<bool>(sink);
+  if (p.sampled) {
     const double wanted = ro.active() ? ro.sample_rate_Hz : 50 * v.frequency_Hz;
-    per_period = std::max<long>(2, static_cast<long>(std::ceil(wanted / v.frequency_Hz - 1e-9)));
+    p.per_period = std::max<long>(2, static_cast<long>(std::ceil(wanted / v.frequency_Hz - 1e-9)));
     // Synchronous sampling folds the output's N-th harmonic (N samples per period) exactly
     // onto DC: demand 10 samples per period (harmonics of (1) reach the 4th, k1' more)
     // unless the anti-alias filter is on.
-    if (per_period < 10 && !(config.dynamics.antialias_Hz > 0))
-      throw std::invalid_argument("sample_rate_Hz: " + std::to_string(per_period) +
+    if (p.per_period < 10 && !(config.dynamics.antialias_Hz > 0))
+      throw std::invalid_argument("sample_rate_Hz: " + std::to_string(p.per_period) +
                                   " samples per period alias the output's harmonics onto DC; use at least 10 per "
                                   "period (" + std::to_string(10 * v.frequency_Hz) + " Hz) or an anti-alias filter");
-    r.sample_rate_Hz = per_period * v.frequency_Hz;
+    r.sample_rate_Hz = p.per_period * v.frequency_Hz;
   }
-  // Floor of sigma: the quadrature's own tolerance over the measured span.
-  const double floor = s.relative_tolerance * std::abs(phasor[Accelerometer::kQuadrature]) / (r.periods * period);
+  p.floor = s.relative_tolerance * std::abs(p.phasor[Accelerometer::kQuadrature]) / (r.periods * period);
+  return p;
+}
 
-  // The deviation path works at 1/100 of the transient path's absolute tolerances; below a
-  // relative tolerance of 1e-13 that asks for less than ~50 ulp of the state, which CVODE
-  // cannot deliver (it takes ever smaller steps instead of refusing, as the deviation starts
-  // at 0): the transient path runs, and CVODE refuses too much accuracy at its first step.
-  if (s.periodic_steady_state && s.relative_tolerance >= 1e-13) {
-    // The periodic steady state directly (docs/performance.md): the deviation from the linear
-    // periodic solution, either settled for ln(1/decay) time constants when that is shorter
-    // than a period, or found by shooting (Newton on the one-period map, its Jacobian the
-    // linearisation's monodromy e^{AT}); then one period measured stands for all of them.
-    DeviationFromLinear dev(shaken, x_eq, phasor, w);
-    dev.use_jacobian(&lin.A);
-    const double dt = sampled ? 1 / r.sample_rate_Hz : 0.0;
-    long steps = 0, rhs_evaluations = 0;
-    double simulated = 0;
-    // From (t0, y0) to t_measure, then one period, sampled at t_measure + m dt if wanted.
-    // Tolerances: 1/100 of the transient path's absolute ones. The deviation is 1e-4..1e-5
-    // of the state, so this is still a loose relative tolerance on it (cheap), and it puts
-    // the answer's own error near 1e-11 g, below the transient path's (~5e-10 g at 5 g).
-    plant::SolverSettings dev_solver = solver;
-    dev_solver.analytic_jacobian = true;  // the linearisation's A below (not the plant's Jacobian)
-    for (double& a : dev_solver.absolute_tolerance) a *= 0.01;
-    auto pass = [&](double t0, const std::vector<double>& y0, double t_measure) {
-      plant::OdeSolver ode(dev, t0, y0, dev_solver);
-      PeriodPass p;
-      p.y_start = ode.advance(t_measure);
-      const double q0 = p.y_start[Accelerometer::kQuadrature];
-      for (long m = 0; m < per_period; ++m) {
-        const double t = t_measure + static_cast<double>(m) * dt;
-        p.outputs.push_back(dev.output_g(t, ode.advance(t).data()));
-      }
-      p.y_end = ode.advance(t_measure + period);
-      p.dq = p.y_end[Accelerometer::kQuadrature] - q0;
-      steps += ode.steps();
-      rhs_evaluations += ode.rhs_evaluations();
-      simulated += t_measure + period - t0;
-      return p;
-    };
-    std::optional<PeriodPass> measured;
-    double measured_t0 = 0, correction_g = 0, residual_g = 0;
-    const double raw_settle_s = std::log(1 / s.settle_decay) * r.slowest_time_constant_s;
-    // The states that feed back: not the quadrature (nothing depends on it) nor the inert
-    // states (zero row and column of A).
-    std::vector<int> act;
-    for (int k = 0; k < n; ++k) {
-      const bool inert = lin.A.row(k).cwiseAbs().maxCoeff() == 0 && lin.A.col(k).cwiseAbs().maxCoeff() == 0;
-      if (k != Accelerometer::kQuadrature && !inert) act.push_back(k);
+// The periodic steady state directly (docs/performance.md): the deviation from the linear
+// periodic solution, either settled for ln(1/decay) time constants when that is shorter than
+// a period, or found by shooting (Newton on the one-period map, its Jacobian the
+// linearisation's monodromy e^{AT}); then one period measured stands for all of them.
+// True with r complete; false when the shooting did not converge (r counts the attempt).
+template <class Motion>
+bool periodic_path(const SinePlan& p, const Accelerometer& shaken, const Motion& table_motion, const SampleSink& sink,
+                   ShakeResult& r) {
+  const ShakeSettings& s = *p.s;
+  const double period = p.period;
+  const int n = p.n;
+  const Accelerometer::Linear& lin = p.lin;
+  DeviationFromLinear dev(shaken, p.x_eq, p.phasor, p.w);
+  dev.use_jacobian(&lin.A);
+  const double dt = p.sampled ? 1 / r.sample_rate_Hz : 0.0;
+  long steps = 0, rhs_evaluations = 0;
+  double simulated = 0;
+  // From (t0, y0) to t_measure, then one period, sampled at t_measure + m dt if wanted.
+  // Tolerances: 1/100 of the transient path's absolute ones. The deviation is 1e-4..1e-5
+  // of the state, so this is still a loose relative tolerance on it (cheap), and it puts
+  // the answer's own error near 1e-11 g, below the transient path's (~5e-10 g at 5 g).
+  plant::SolverSettings dev_solver = p.solver;
+  dev_solver.analytic_jacobian = true;  // the linearisation's A below (not the plant's Jacobian)
+  for (double& a : dev_solver.absolute_tolerance) a *= 0.01;
+  auto pass = [&](double t0, const std::vector<double>& y0, double t_measure) {
+    plant::OdeSolver ode(dev, t0, y0, dev_solver);
+    PeriodPass pp;
+    pp.y_start = ode.advance(t_measure);
+    const double q0 = pp.y_start[Accelerometer::kQuadrature];
+    for (long m = 0; m < p.per_period; ++m) {
+      const double t = t_measure + static_cast<double>(m) * dt;
+      pp.outputs.push_back(dev.output_g(t, ode.advance(t).data()));
     }
-    const Eigen::Index m = static_cast<Eigen::Index>(act.size());
-    Eigen::MatrixXd a_act(m, m);
-    Eigen::RowVectorXd c_q(m);
+    pp.y_end = ode.advance(t_measure + period);
+    pp.dq = pp.y_end[Accelerometer::kQuadrature] - q0;
+    steps += ode.steps();
+    rhs_evaluations += ode.rhs_evaluations();
+    simulated += t_measure + period - t0;
+    return pp;
+  };
+  std::optional<PeriodPass> measured;
+  double measured_t0 = 0, correction_g = 0, residual_g = 0;
+  const double raw_settle_s = std::log(1 / s.settle_decay) * r.slowest_time_constant_s;
+  // The states that feed back: not the quadrature (nothing depends on it) nor the inert
+  // states (zero row and column of A).
+  std::vector<int> act;
+  for (int k = 0; k < n; ++k) {
+    const bool inert = lin.A.row(k).cwiseAbs().maxCoeff() == 0 && lin.A.col(k).cwiseAbs().maxCoeff() == 0;
+    if (k != Accelerometer::kQuadrature && !inert) act.push_back(k);
+  }
+  const Eigen::Index m = static_cast<Eigen::Index>(act.size());
+  Eigen::MatrixXd a_act(m, m);
+  Eigen::RowVectorXd c_q(m);
+  for (Eigen::Index i = 0; i < m; ++i) {
+    c_q[i] = lin.A(Accelerometer::kQuadrature, act[static_cast<std::size_t>(i)]);
+    for (Eigen::Index j = 0; j < m; ++j) a_act(i, j) = lin.A(act[static_cast<std::size_t>(i)], act[static_cast<std::size_t>(j)]);
+  }
+  // A start off the orbit by d gives the residual r = (M - I) d after a period (M = e^{AT},
+  // the monodromy) and adds C A^-1 (M - I) d = C A^-1 r to Q over that period.
+  const Eigen::RowVectorXd q_gain = a_act.transpose().partialPivLu().solve(c_q.transpose()).transpose();
+  // The measured mean to 1e-11 of the larger of the output's and the input's amplitude.
+  const double q_tolerance =
+      0.1 * s.relative_tolerance * std::max(std::abs(p.phasor[Accelerometer::kQuadrature]) / period, p.amplitude);
+  Eigen::VectorXd res(m);
+  // Is the pass periodic to the tolerance? Sets res and *q_err (the mean's error from the
+  // start being off the orbit); returns the largest residual per typical state size and
+  // whether the pass is accepted.
+  auto periodic = [&](const PeriodPass& pp, double* q_err) {
+    double scaled = 0;
     for (Eigen::Index i = 0; i < m; ++i) {
-      c_q[i] = lin.A(Accelerometer::kQuadrature, act[static_cast<std::size_t>(i)]);
-      for (Eigen::Index j = 0; j < m; ++j) a_act(i, j) = lin.A(act[static_cast<std::size_t>(i)], act[static_cast<std::size_t>(j)]);
+      const std::size_t k = static_cast<std::size_t>(act[static_cast<std::size_t>(i)]);
+      res[i] = pp.y_end[k] - pp.y_start[k];
+      scaled = std::max(scaled, std::abs(res[i]) / (p.solver.absolute_tolerance[k] / s.relative_tolerance));
     }
-    // A start off the orbit by d gives the residual r = (M - I) d after a period (M = e^{AT},
-    // the monodromy) and adds C A^-1 (M - I) d = C A^-1 r to Q over that period.
-    const Eigen::RowVectorXd q_gain = a_act.transpose().partialPivLu().solve(c_q.transpose()).transpose();
-    // The measured mean to 1e-11 of the larger of the output's and the input's amplitude.
-    const double q_tolerance =
-        0.1 * s.relative_tolerance * std::max(std::abs(phasor[Accelerometer::kQuadrature]) / period, amplitude);
-    Eigen::VectorXd res(m);
-    // Is the pass periodic to the tolerance? Sets res and *q_err (the mean's error from the
-    // start being off the orbit); returns the largest residual per typical state size and
-    // whether the pass is accepted.
-    auto periodic = [&](const PeriodPass& p, double* q_err) {
-      double scaled = 0;
-      for (Eigen::Index i = 0; i < m; ++i) {
-        const std::size_t k = static_cast<std::size_t>(act[static_cast<std::size_t>(i)]);
-        res[i] = p.y_end[k] - p.y_start[k];
-        scaled = std::max(scaled, std::abs(res[i]) / (solver.absolute_tolerance[k] / s.relative_tolerance));
+    *q_err = q_gain.dot(res) / period;
+    return std::pair<double, bool>(scaled, scaled <= 100 * s.relative_tolerance && std::abs(*q_err) <= q_tolerance);
+  };
+  const std::vector<double> y_zero(static_cast<std::size_t>(n), 0.0);
+  try {
+    if (raw_settle_s <= period) {
+      r.path = "settle + one period";
+      measured_t0 = p.sampled ? std::ceil(raw_settle_s / dt) * dt : raw_settle_s;
+      PeriodPass pp = pass(0.0, y_zero, measured_t0);
+      double q_err = 0;
+      if (periodic(pp, &q_err).second) {
+        measured = std::move(pp);
+        correction_g = -q_err;
+        residual_g = std::abs(q_err);
       }
-      *q_err = q_gain.dot(res) / period;
-      return std::pair<double, bool>(scaled, scaled <= 100 * s.relative_tolerance && std::abs(*q_err) <= q_tolerance);
-    };
-    const std::vector<double> y_zero(static_cast<std::size_t>(n), 0.0);
-    try {
-      if (raw_settle_s <= period) {
-        r.path = "settle + one period";
-        measured_t0 = sampled ? std::ceil(raw_settle_s / dt) * dt : raw_settle_s;
-        PeriodPass p = pass(0.0, y_zero, measured_t0);
+    } else {
+      r.path = "shooting";
+      const Eigen::MatrixXd monodromy = (a_act * period).exp();
+      const Eigen::PartialPivLU<Eigen::MatrixXd> newton((Eigen::MatrixXd::Identity(m, m) - monodromy).eval());
+      std::vector<double> y = y_zero;
+      double previous = std::numeric_limits<double>::infinity();
+      constexpr int kMaxIterations = 8;
+      for (int it = 1; it <= kMaxIterations; ++it) {
+        PeriodPass pp = pass(0.0, y, 0.0);
+        r.shooting_iterations = it;
         double q_err = 0;
-        if (periodic(p, &q_err).second) {
-          measured = std::move(p);
+        const auto [scaled, done] = periodic(pp, &q_err);
+        if (done) {
+          measured = std::move(pp);
           correction_g = -q_err;
           residual_g = std::abs(q_err);
+          break;
         }
-      } else {
-        r.path = "shooting";
-        const Eigen::MatrixXd monodromy = (a_act * period).exp();
-        const Eigen::PartialPivLU<Eigen::MatrixXd> newton((Eigen::MatrixXd::Identity(m, m) - monodromy).eval());
-        std::vector<double> y = y_zero;
-        double previous = std::numeric_limits<double>::infinity();
-        constexpr int kMaxIterations = 8;
-        for (int it = 1; it <= kMaxIterations; ++it) {
-          PeriodPass p = pass(0.0, y, 0.0);
-          r.shooting_iterations = it;
-          double q_err = 0;
-          const auto [scaled, done] = periodic(p, &q_err);
-          if (done) {
-            measured = std::move(p);
-            correction_g = -q_err;
-            residual_g = std::abs(q_err);
-            break;
-          }
-          if (!(scaled < 0.5 * previous)) break;  // not contracting: leave it to the transient path
-          previous = scaled;
-          const Eigen::VectorXd step = newton.solve(res);
-          for (Eigen::Index i = 0; i < m; ++i) y[static_cast<std::size_t>(act[static_cast<std::size_t>(i)])] += step[i];
-        }
+        if (!(scaled < 0.5 * previous)) break;  // not contracting: leave it to the transient path
+        previous = scaled;
+        const Eigen::VectorXd step = newton.solve(res);
+        for (Eigen::Index i = 0; i < m; ++i) y[static_cast<std::size_t>(act[static_cast<std::size_t>(i)])] += step[i];
       }
-    } catch (const plant::SolverError&) {
-      measured.reset();  // e.g. Newton on the linear Jacobian failing in a far nonlinear loop
     }
-    if (measured) {
-      if (!sampled) {
-        r.method = "continuous integral";
-        r.measured_g = measured->dq / period + correction_g;
-        r.integral_slope_g = r.measured_g;
-        r.sigma_g = std::max(floor, residual_g);
-      } else {
-        // The record as the transient path takes it (same samples, same noise draws), each
-        // sample the steady state's output at its phase.
-        r.method = "sampled record";
-        const long settle_n = settle_periods * per_period, block_n = per_block * per_period;
-        const long first = std::llround(measured_t0 / dt);
-        SampledRecorder rec(ro, k1, r.baseline_g, s.blocks, block_n, dt, sink);
-        const long total_n = settle_n + s.blocks * block_n;
-        for (long k = 0; k < total_n; ++k) {
-          const double t = static_cast<double>(k) * dt;
-          const long phase = ((k - first) % per_period + per_period) % per_period;
-          rec.sample(t, table_motion(t), measured->outputs[static_cast<std::size_t>(phase)], k - settle_n);
-        }
-        rec.finish(r);
-      }
-      r.steps = steps;
-      r.rhs_evaluations = rhs_evaluations;
-      r.simulated_s = simulated;
-      return r;
-    }
-    // The shooting did not converge: the transient path below, its attempt counted.
-    r.steps = steps;
-    r.rhs_evaluations = rhs_evaluations;
-    r.simulated_s = simulated;
-    r.path = "transient";
+  } catch (const plant::SolverError&) {
+    measured.reset();  // e.g. Newton on the linear Jacobian failing in a far nonlinear loop
   }
+  r.steps = steps;
+  r.rhs_evaluations = rhs_evaluations;
+  r.simulated_s = simulated;
+  if (!measured) return false;
+  if (!p.sampled) {
+    r.method = "continuous integral";
+    r.measured_g = measured->dq / period + correction_g;
+    r.integral_slope_g = r.measured_g;
+    r.sigma_g = std::max(p.floor, residual_g);
+  } else {
+    // The record as the transient path takes it (same samples, same noise draws), each
+    // sample the steady state's output at its phase.
+    r.method = "sampled record";
+    const long settle_n = p.settle_periods * p.per_period, block_n = p.per_block * p.per_period;
+    const long first = std::llround(measured_t0 / dt);
+    SampledRecorder rec(s.readout, p.k1, r.baseline_g, s.blocks, block_n, dt, sink);
+    const long total_n = settle_n + s.blocks * block_n;
+    for (long k = 0; k < total_n; ++k) {
+      const double t = static_cast<double>(k) * dt;
+      const long phase = ((k - first) % p.per_period + p.per_period) % p.per_period;
+      rec.sample(t, table_motion(t), measured->outputs[static_cast<std::size_t>(phase)], k - settle_n);
+    }
+    rec.finish(r);
+  }
+  return true;
+}
 
-  plant::OdeSolver ode(shaken, 0.0, x0, solver);
-  const double block_s = per_block * period;
-  if (!sampled) {
+// The transient path: the whole run integrated from the linear steady state's start x0,
+// settled, then measured over r.periods periods (continuous integral or sampled record).
+template <class Motion>
+void transient_path(const SinePlan& p, Accelerometer& shaken, const Motion& table_motion, const std::vector<double>& x0,
+                    const SampleSink& sink, ShakeResult& r) {
+  const ShakeSettings& s = *p.s;
+  const double period = p.period;
+  plant::OdeSolver ode(shaken, 0.0, x0, p.solver);
+  const double block_s = p.per_block * period;
+  if (!p.sampled) {
     // Continuous integral: Q is a state of the ODE.
     r.method = "continuous integral";
     double q_prev = ode.advance(r.settle_s)[Accelerometer::kQuadrature];
@@ -490,13 +506,13 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
     }
     r.measured_g = (q_prev - q_start) / (r.periods * period);
     r.integral_slope_g = r.measured_g;
-    r.sigma_g = std::max(batch_sigma(block_mean, r.measured_g), floor);
+    r.sigma_g = std::max(batch_sigma(block_mean, r.measured_g), p.floor);
   } else {
     // Sampled record, synchronous with the vibration.
     r.method = "sampled record";
     const double dt = 1 / r.sample_rate_Hz;
-    const long settle_n = settle_periods * per_period, block_n = per_block * per_period;
-    SampledRecorder rec(ro, k1, r.baseline_g, s.blocks, block_n, dt, sink);
+    const long settle_n = p.settle_periods * p.per_period, block_n = p.per_block * p.per_period;
+    SampledRecorder rec(s.readout, p.k1, r.baseline_g, s.blocks, block_n, dt, sink);
     const long total_n = settle_n + s.blocks * block_n;
     for (long k = 0; k < total_n; ++k) {
       const double t = static_cast<double>(k) * dt;
@@ -507,6 +523,43 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
   r.steps += ode.steps();
   r.rhs_evaluations += ode.rhs_evaluations();
   r.simulated_s += r.settle_s + r.periods * period;
+}
+
+}  // namespace
+
+ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, const vibration::SineVibration& v,
+                       const ShakeSettings& s, const SampleSink& sink, const vibration::Excitation* input) {
+  std::string why;
+  if (!s.IsValid(&why)) throw std::invalid_argument(why);
+  vibration::validate(v);
+  if (!(v.frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive for a shaker run");
+  const double w = 2 * kPi * v.frequency_Hz;
+
+  const Accelerometer rest(config, a_static);
+  ShakeResult r;
+  const SinePlan plan = plan_sine(config, v, s, sink, rest, r);
+
+  auto table_motion = [v, w, input](double t) {
+    if (input) return input->acceleration_g(t);
+    Vec3 a;
+    for (int i = 0; i < 3; ++i) a[i] = v.amplitude_g[i] * std::sin(w * t + v.phase_rad[i]);
+    return a;
+  };
+  Accelerometer shaken(config, a_static, table_motion);
+  shaken.set_quadrature_reference(r.baseline_g);
+
+  // The deviation path works at 1/100 of the transient path's absolute tolerances; below a
+  // relative tolerance of 1e-13 that asks for less than ~50 ulp of the state, which CVODE
+  // cannot deliver (it takes ever smaller steps instead of refusing, as the deviation starts
+  // at 0): the transient path runs, and CVODE refuses too much accuracy at its first step.
+  if (s.periodic_steady_state && s.relative_tolerance >= 1e-13) {
+    if (periodic_path(plan, shaken, table_motion, sink, r)) return r;
+    r.path = "transient";  // the shooting did not converge; its attempt is counted in r
+  }
+  // The transient path starts on the linear periodic solution.
+  std::vector<double> x0(plan.x_eq);
+  for (int k = 0; k < plan.n; ++k) x0[static_cast<std::size_t>(k)] += plan.phasor[k].imag();
+  transient_path(plan, shaken, table_motion, x0, sink, r);
   return r;
 }
 
