@@ -68,18 +68,10 @@ class Table {
   bool has(std::string_view key) const { return t_.contains(key); }
   int line(const toml::node* n) const { return n ? static_cast<int>(n->source().begin.line) : 0; }
 
+  // The key's place (the node's line, else the table's) and why it is wrong.
   [[noreturn]] void fail(const toml::node* n, std::string_view key, const std::string& what) const {
-    std::ostringstream s;
-    s << file_;
-    const int l = line(n ? n : &t_);
-    if (l > 0) s << ":" << l;
-    s << ": " << qualified(key) << ": " << what;
-    throw InputError(s.str());
-  }
-
-  std::string qualified(std::string_view key) const {
-    if (name_.empty()) return std::string(key);
-    return key.empty() ? "[" + name_ + "]" : "[" + name_ + "] " + std::string(key);
+    throw FormatError({.file = file_, .line = line(n ? n : &t_), .table = name_, .key = std::string(key), .kind = KeyKind::toml_key},
+                      what);
   }
 
   const toml::node* get(std::string_view key, bool required) {
@@ -177,6 +169,7 @@ class Table {
 
   const toml::table& raw() const { return t_; }
   const std::string& name() const { return name_; }
+  const std::string& file() const { return file_; }
 
  private:
   static const char* type_name(const toml::node& n) {
@@ -394,7 +387,7 @@ void read_shaker(Table t, Case& c) {
     for (auto&& x : *a) {
       const toml::table* h = x.as_table();
       if (!h) t.fail(&x, "harmonics", "each harmonic is {order = 2, ratio = 0.05, phase_deg = 0}");
-      Table ht(*h, "shaker.harmonics", "");
+      Table ht(*h, "shaker.harmonics", t.file());
       vibration::Harmonic hm;
       const toml::node* order = h->get("order");
       if (!order || !order->is_integer()) t.fail(&x, "harmonics", "order must be an integer >= 2");
@@ -897,7 +890,7 @@ void read_campaign(Table t, Case& c) {
     for (auto&& x : *a) {
       const toml::table* e = x.as_table();
       if (!e) t.fail(&x, "hidden", "expected a table { name = \"...\", parameter = ... }");
-      Table et(*e, "campaign.hidden", "");
+      Table et(*e, "campaign.hidden", t.file());
       validation::HiddenEffect h;
       h.name = et.string("name", "");
       if (!validation::find_effect(h.name)) {
@@ -947,18 +940,14 @@ void read_campaign(Table t, Case& c) {
 
 Case read_case(const std::string& path) {
   if (std::filesystem::is_directory(path))
-    throw InputError(path + ": cannot open the case file: is a directory (give the .toml file)");
-  if (!std::filesystem::exists(path)) throw InputError(path + ": cannot open the case file (no such file)");
-  if (!std::filesystem::is_regular_file(path)) throw InputError(path + ": cannot open the case file: not a regular file");
+    throw FormatError({.file = path}, "cannot open the case file: is a directory (give the .toml file)");
+  if (!std::filesystem::exists(path)) throw FormatError({.file = path}, "cannot open the case file (no such file)");
+  if (!std::filesystem::is_regular_file(path)) throw FormatError({.file = path}, "cannot open the case file: not a regular file");
   toml::table root;
   try {
     root = toml::parse_file(path);
   } catch (const toml::parse_error& e) {
-    std::ostringstream s;
-    s << path;
-    if (e.source().begin.line > 0) s << ":" << e.source().begin.line;
-    s << ": " << e.description();
-    throw InputError(s.str());
+    throw FormatError({.file = path, .line = static_cast<long>(e.source().begin.line)}, std::string(e.description()));
   }
   Case c;
   c.path = path;
@@ -1000,7 +989,10 @@ Case read_case(const std::string& path) {
   if (auto t = top.subtable("shake", false)) read_shake(*t, c);
   c.shake.readout.seed = c.seed;
   if (auto t = top.subtable("sweep", false)) read_sweep(*t, c);
-  if (auto t = top.subtable("shaker", false)) read_shaker(*t, c);
+  if (auto t = top.subtable("shaker", false)) {
+    read_shaker(*t, c);
+    c.shaker.line = t->line(&t->raw());
+  }
   if (auto t = top.subtable("frequency_study", false)) read_frequency_study(*t, c);
   if (auto t = top.subtable("reproduce", false)) read_reproduce(*t, c);
   if (auto t = top.subtable("campaign", false)) read_campaign(*t, c);
@@ -1011,7 +1003,7 @@ Case read_case(const std::string& path) {
 }
 
 void require(const Case& c, bool present, const std::string& table, const std::string& command) {
-  if (!present) throw InputError(c.path + ": " + command + " needs a [" + table + "] table");
+  if (!present) throw FormatError({.file = c.path}, command + " needs a [" + table + "] table");
 }
 
 }  // namespace vrelab::io

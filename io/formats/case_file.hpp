@@ -3,9 +3,10 @@
 //
 // Takes: the path of a case file (keys in docs/case-files.md).
 // Gives: a Case whose tables are present only where the file has them; the parsed file as
-//        JSON (recorded in every result). Throws InputError naming the file, the line and
-//        the key for anything wrong: a syntax error, an unknown key (with a suggestion), a
-//        missing or non-finite number, a negative sigma, an empty position set.
+//        JSON (recorded in every result). Throws FormatError (io/formats/error.hpp) with the
+//        file, the line, the table and the key for anything wrong: a syntax error, an unknown
+//        key (with a suggestion), a missing or non-finite number, a negative sigma, an empty
+//        position set.
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -14,6 +15,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/formats/error.hpp"
 #include "plant/accelerometer.hpp"
 #include "plant/model1.hpp"
 #include "plant/physical.hpp"
@@ -32,10 +34,6 @@
 #include "vibration/sweep.hpp"
 
 namespace vrelab::io {
-
-struct InputError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 struct DividingHead {
   std::vector<validation::Position> positions;
@@ -56,6 +54,7 @@ struct VibrationSpec : rectification::VibrationRequest {
 // The [shaker] table: limits and imperfections, each off unless given.
 struct ShakerSpec : rectification::ShakerImperfections {
   vibration::ShakerLimits limits;
+  int line = 0;  // of the [shaker] table, for messages; 0: no such table
 };
 
 // The [campaign] table: what `vrelab campaign` hides in the truth and how the lab tests it.
@@ -96,7 +95,7 @@ struct Case {
 
 Case read_case(const std::string& path);
 
-// Throws InputError "<file>: <what>" when the case lacks a table a command needs.
+// Throws FormatError "<file>: <what>" when the case lacks a table a command needs.
 void require(const Case& c, bool present, const std::string& table, const std::string& command);
 
 }  // namespace vrelab::io

@@ -9,11 +9,11 @@
 
 #include <fmt/format.h>
 
-#include "io/formats/case_file.hpp"
+#include "io/formats/error.hpp"
 
 namespace vrelab::io {
 
-std::vector<std::string> split_csv_line(const std::string& line, const std::string& where) {
+std::vector<std::string> split_csv_line(const std::string& line, const std::string& path, long line_no) {
   std::vector<std::string> out;
   std::size_t i = 0;
   const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
@@ -22,7 +22,7 @@ std::vector<std::string> split_csv_line(const std::string& line, const std::stri
     std::string cell;
     if (i < line.size() && line[i] == '"') {
       for (++i;; ++i) {
-        if (i >= line.size()) throw std::invalid_argument(where + ": a quoted cell is not closed");
+        if (i >= line.size()) throw FormatError({.file = path, .line = line_no}, "a quoted cell is not closed");
         if (line[i] == '"') {
           if (i + 1 < line.size() && line[i + 1] == '"') cell += '"', ++i;
           else break;
@@ -32,7 +32,7 @@ std::vector<std::string> split_csv_line(const std::string& line, const std::stri
       }
       ++i;
       while (i < line.size() && blank(line[i])) ++i;
-      if (i < line.size() && line[i] != ',') throw std::invalid_argument(where + ": text after a quoted cell");
+      if (i < line.size() && line[i] != ',') throw FormatError({.file = path, .line = line_no}, "text after a quoted cell");
     } else {
       const std::size_t end = std::min(line.find(',', i), line.size());
       cell = line.substr(i, end - i);
@@ -122,18 +122,19 @@ void check_text_line(std::string& line, long line_no, const std::string& path) {
   if (!line.empty() && line.back() == '\r') line.pop_back();
   const std::size_t at = first_non_utf8(line);
   if (at != std::string::npos)
-    throw InputError(fmt::format("{}:{}:{}: not UTF-8 at byte {} (0x{:02X}; a Latin-1 or Windows-1252 export?); save the "
-                                 "file as UTF-8",
-                                 path, line_no, at + 1, at + 1, static_cast<unsigned>(static_cast<unsigned char>(line[at]))));
+    throw FormatError({.file = path, .line = line_no, .column = static_cast<long>(at + 1)},
+                      fmt::format("not UTF-8 at byte {} (0x{:02X}; a Latin-1 or Windows-1252 export?); save the file as UTF-8",
+                                  at + 1, static_cast<unsigned>(static_cast<unsigned char>(line[at]))));
 }
 
 void check_separator(const std::string& header_line, long line_no, const std::string& path) {
   if (header_line.find(',') != std::string::npos) return;
   for (const auto& [sep, name] : {std::pair<char, const char*>{';', "';'"}, {'\t', "a tab"}})
     if (header_line.find(sep) != std::string::npos)
-      throw InputError(fmt::format("{}:{}: the header uses {} as separator; vrelab reads ',' (save as CSV, comma-delimited, "
-                                   "with a decimal point)",
-                                   path, line_no, name));
+      throw FormatError({.file = path, .line = line_no},
+                        fmt::format("the header uses {} as separator; vrelab reads ',' (save as CSV, comma-delimited, "
+                                    "with a decimal point)",
+                                    name));
 }
 
 std::string closest_name(const std::string& name, const std::vector<std::string>& names) {
@@ -168,8 +169,8 @@ namespace {
 bool is_number(const std::string& field) { return parse_decimal(field).has_value(); }
 
 // The output column of a header: `name`, or the last column.
-int series_column(const std::vector<std::string>& header, const std::string& name, const std::string& where) {
-  if (header.size() < 2) throw InputError(where + ": the header needs a time column and an output column");
+int series_column(const std::vector<std::string>& header, const std::string& name, const FormatLocation& where) {
+  if (header.size() < 2) throw FormatError(where, "the header needs a time column and an output column");
   int column = -1;
   if (name.empty()) {
     // The one output_<unit> column (as the HDF5 reader's one output_<unit> dataset), else the last.
@@ -184,15 +185,15 @@ int series_column(const std::vector<std::string>& header, const std::string& nam
     if (column < 0) {
       std::string found;
       for (const auto& h : header) found += (found.empty() ? "" : ", ") + h;
-      throw InputError(fmt::format("{}: no column named '{}' (the header has: {})", where, name, found));
+      throw FormatError(where, fmt::format("no column named '{}' (the header has: {})", name, found));
     }
   }
   // The time column: time_s, else the first.
   if (column == 0 && std::find(header.begin(), header.end(), "time_s") == header.end())
-    throw InputError(where + ": the output column cannot be the time column");
+    throw FormatError(where, "the output column cannot be the time column");
   // A header names the columns: a first line of numbers means the header is missing.
   if (std::all_of(header.begin(), header.end(), is_number))
-    throw InputError(where + ": expected a header line naming the columns (e.g. time_s,output), got numbers");
+    throw FormatError(where, "expected a header line naming the columns (e.g. time_s,output), got numbers");
   return column;
 }
 
@@ -206,7 +207,7 @@ std::string read_series_csv(const std::string& path, const std::string& column_n
 std::string read_series_csv(const std::string& path, const std::string& column_name,
                             const std::function<void(double, double)>& sample, const ReferenceSink& reference) {
   std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open the series (no such file?)");
+  if (!in) throw FormatError({.file = path}, "cannot open the series (no such file?)");
   return read_series_csv(in, path, column_name, sample, reference);
 }
 
@@ -225,13 +226,8 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
     ++line_no;
     check_text_line(line, line_no, path);
     if (line.empty() || line[0] == '#') continue;
-    const std::string where = fmt::format("{}:{}", path, line_no);
-    std::vector<std::string> f;
-    try {
-      f = split_csv_line(line, where);
-    } catch (const std::invalid_argument& e) {
-      throw InputError(e.what());
-    }
+    const FormatLocation where{.file = path, .line = line_no};
+    const std::vector<std::string> f = split_csv_line(line, path, line_no);
     if (header.empty()) {
       check_separator(line, line_no, path);
       header = f;
@@ -239,7 +235,7 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
       name = header[column];
       if (const auto it = std::find(header.begin(), header.end(), "time_s"); it != header.end())
         tcol = static_cast<std::size_t>(it - header.begin());
-      if (tcol == column) throw InputError(where + ": the output column cannot be the time column");
+      if (tcol == column) throw FormatError(where, "the output column cannot be the time column");
       static const std::array<const char*, 3> axes{"IA", "PA", "OA"};
       for (std::size_t i = 0; i < 3 && reference; ++i)
         for (const std::string prefix : {"ref_", "input_"}) {
@@ -250,7 +246,7 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
       continue;
     }
     if (f.size() != header.size())
-      throw InputError(fmt::format("{}: {} fields, the header has {}", where, f.size(), header.size()));
+      throw FormatError(where, fmt::format("{} fields, the header has {}", f.size(), header.size()));
     double value[2] = {0, 0};
     for (int k = 0; k < 2; ++k) {
       const std::size_t col = k == 0 ? tcol : column;
@@ -258,19 +254,19 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
       if (!x) {
         const std::string why = why_not_decimal(f[col]);
         if (why == "not finite")
-          throw InputError(fmt::format("{}: a sample is not a finite number (column {}, '{}')", where, col + 1, f[col]));
-        throw InputError(fmt::format("{}: not a number in '{}' (column {}, '{}': {})", where, line, col + 1, f[col], why));
+          throw FormatError(where, fmt::format("a sample is not a finite number (column {}, '{}')", col + 1, f[col]));
+        throw FormatError(where, fmt::format("not a number in '{}' (column {}, '{}': {})", line, col + 1, f[col], why));
       }
       value[k] = *x;
     }
     // The reader's own check (read_series_hdf5 makes the same): time strictly increasing.
     if (!(value[0] > last_t))
-      throw InputError(fmt::format("{}: time does not increase ({} s after {} s)", where, f[tcol], last_t));
+      throw FormatError(where, fmt::format("time does not increase ({} s after {} s)", f[tcol], last_t));
     last_t = value[0];
     try {
       sample(value[0], value[1]);
     } catch (const std::invalid_argument& e) {
-      throw InputError(fmt::format("{}: {} (t = {}, {} = {})", where, e.what(), f[tcol], name, f[column]));
+      throw FormatError(where, fmt::format("{} (t = {}, {} = {})", e.what(), f[tcol], name, f[column]));
     }
     if (any_ref) {
       std::array<double, 3> ref{};
@@ -278,21 +274,22 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
         if (!ref_present[i]) continue;
         const auto x = parse_decimal(f[ref_col[i]]);
         if (!x)
-          throw InputError(fmt::format("{}:{}: reference column {}: {} (a reference channel must have a sample on every row: "
-                                       "the same length and rate as the output)",
-                                       where, ref_col[i] + 1, header[ref_col[i]],
-                                       f[ref_col[i]].empty() ? std::string("missing value")
-                                                             : "'" + f[ref_col[i]] + "' is " + why_not_decimal(f[ref_col[i]])));
+          throw FormatError({.file = path, .line = line_no, .column = static_cast<long>(ref_col[i] + 1)},
+                            fmt::format("reference column {}: {} (a reference channel must have a sample on every row: "
+                                        "the same length and rate as the output)",
+                                        header[ref_col[i]],
+                                        f[ref_col[i]].empty() ? std::string("missing value")
+                                                              : "'" + f[ref_col[i]] + "' is " + why_not_decimal(f[ref_col[i]])));
         ref[i] = *x;
       }
       try {
         reference(value[0], ref, ref_present);
       } catch (const std::invalid_argument& e) {
-        throw InputError(fmt::format("{}: {}", where, e.what()));
+        throw FormatError(where, e.what());
       }
     }
   }
-  if (header.empty()) throw InputError(path + ": no header line and no samples");
+  if (header.empty()) throw FormatError({.file = path}, "no header line and no samples");
   return name;
 }
 

@@ -17,9 +17,9 @@
 
 namespace vrelab::io {
 
-// One CSV line into cells. An unclosed quote, or text after a quoted cell, is
-// std::invalid_argument naming `where` (e.g. "file.csv:12").
-std::vector<std::string> split_csv_line(const std::string& line, const std::string& where);
+// One CSV line into cells. An unclosed quote, or text after a quoted cell, is FormatError at
+// `path`:`line_no`.
+std::vector<std::string> split_csv_line(const std::string& line, const std::string& path, long line_no);
 
 // A finite decimal number as a lab writes it: [+-]digits[.digits][(e|E)[+-]digits] (".5" and
 // "5." too), nothing else: no blanks, no hexadecimal (strtod reads "0x1E" as 30), no inf or
@@ -35,10 +35,10 @@ std::size_t first_non_utf8(std::string_view s);
 
 // The checks every line of a text file passes before it is split: on line 1 a UTF-8
 // byte-order mark is removed; a trailing '\r' is removed; a byte that is not UTF-8 is
-// InputError "<path>:<line>:<column>: not UTF-8 at byte N (0xB0) ...; save the file as UTF-8".
+// FormatError "<path>:<line>:<column>: not UTF-8 at byte N (0xB0) ...; save the file as UTF-8".
 void check_text_line(std::string& line, long line_no, const std::string& path);
 
-// A header line that uses ';' (or a tab) as its separator and holds no ',' is InputError
+// A header line that uses ';' (or a tab) as its separator and holds no ',' is FormatError
 // naming the separator: vrelab reads ',' only (a ';' file usually has decimal commas too).
 void check_separator(const std::string& header_line, long line_no, const std::string& path);
 
@@ -50,7 +50,7 @@ std::string closest_name(const std::string& name, const std::vector<std::string>
 // the first column. Streams (t, value of `column`) to `sample` row by row (`column` empty:
 // the one column named output_<unit>, else the last column) and returns the column's name. Anything wrong (no file, no header, a
 // field count, not a number, time not strictly increasing, `sample` rejecting a row with
-// std::invalid_argument) is InputError naming the file and the line. read_series
+// std::invalid_argument) is FormatError (io/formats/error.hpp) at the file and the line. read_series
 // (io/formats/series.hpp) chooses this reader or the HDF5 one by the file's extension.
 std::string read_series_csv(const std::string& path, const std::string& column,
                             const std::function<void(double t_s, double value)>& sample);
@@ -59,7 +59,7 @@ std::string read_series_csv(const std::string& path, const std::string& column,
 // --series` writes the virtual table's motion (ref_ preferred), any of the three; `present`
 // says which the header has. Called per row after `sample` when the header has any. A cell
 // that is missing or not a finite decimal, or the sink throwing std::invalid_argument (e.g.
-// rectification::ReferenceAnalyzer: another rate, another set of axes), is InputError naming
+// rectification::ReferenceAnalyzer: another rate, another set of axes), is FormatError naming
 // the file and the line ("f.csv:12:3: reference column ref_PA_g: 'nan' is not finite ...").
 // Another reader (HDF5) calls the sink the same way, once per output sample.
 using ReferenceSink = std::function<void(double t_s, const std::array<double, 3>& ref_g, const std::array<bool, 3>& present)>;

@@ -29,12 +29,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// One CSV line into cells, trimmed of blanks. A cell may be quoted ("a, b"; "" is a quote
-// inside), as spreadsheets write them; an unclosed quote is std::invalid_argument naming `where`.
-std::vector<std::string> split(const std::string& line, const std::string& where) {
-  return split_csv_line(line, where);
-}
-
 // A CSV file with a header: rows with their line numbers; '#' lines and blank lines skipped.
 // Text checked line by line (UTF-8, a byte-order mark dropped, ',' as separator); a row with
 // more cells than the header, or a header naming a column twice, is refused.
@@ -47,9 +41,9 @@ struct Csv {
 };
 
 Csv read_csv(const std::string& path) {
-  if (fs::is_directory(path)) throw InputError(path + ": is a folder, not a CSV file");
+  if (fs::is_directory(path)) throw FormatError({.file = path}, "is a folder, not a CSV file");
   std::ifstream in(path);
-  if (!in) throw InputError(path + ": cannot open (no such file)");
+  if (!in) throw FormatError({.file = path}, "cannot open (no such file)");
   Csv csv;
   csv.path = path;
   std::string line;
@@ -59,17 +53,13 @@ Csv read_csv(const std::string& path) {
     ++n;
     check_text_line(line, n, path);
     if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    std::vector<std::string> cells;
-    try {
-      cells = split(line, path + ":" + std::to_string(n));
-    } catch (const std::invalid_argument& e) {
-      throw InputError(e.what());
-    }
+    std::vector<std::string> cells = split_csv_line(line, path, n);
     if (!header) {
       check_separator(line, n, path);
       for (std::size_t i = 0; i < cells.size(); ++i) {
         if (csv.column.count(cells[i]))
-          throw InputError(fmt::format("{}:{}:{}: column '{}' appears twice in the header", path, n, i + 1, cells[i]));
+          throw FormatError({.file = path, .line = n, .column = static_cast<long>(i + 1), .key = cells[i]},
+                            fmt::format("column '{}' appears twice in the header", cells[i]));
         csv.column[cells[i]] = i;
       }
       csv.names = cells;
@@ -77,31 +67,31 @@ Csv read_csv(const std::string& path) {
       continue;
     }
     if (cells.size() > csv.names.size())
-      throw InputError(fmt::format("{}:{}:{}: {} cells, the header has {} (a ',' inside a cell? quote the cell)", path, n,
-                                   csv.names.size() + 1, cells.size(), csv.names.size()));
+      throw FormatError({.file = path, .line = n, .column = static_cast<long>(csv.names.size() + 1)},
+                        fmt::format("{} cells, the header has {} (a ',' inside a cell? quote the cell)", cells.size(),
+                                    csv.names.size()));
     csv.rows.emplace_back(n, std::move(cells));
   }
-  if (!header) throw InputError(path + ": no header line");
+  if (!header) throw FormatError({.file = path}, "no header line");
   return csv;
 }
 
 // The value of `col` in a row as a number; nullopt with `why` set when absent or not a finite
-// decimal ("file:line:column (name): ...").
+// decimal (the file, the line, the cell and the column's name).
 std::optional<double> number(const Csv& csv, const std::pair<int, std::vector<std::string>>& row, const std::string& col,
-                             std::string* why) {
+                             std::optional<FormatError>* why) {
   const auto it = csv.column.find(col);
   if (it == csv.column.end() || it->second >= row.second.size() || row.second[it->second].empty()) {
-    *why = fmt::format("{}:{}: column {}: missing value", csv.path, row.first, col);
+    why->emplace(FormatLocation{.file = csv.path, .line = row.first, .key = col, .kind = KeyKind::csv_column}, "missing value");
     return std::nullopt;
   }
   const std::string& s = row.second[it->second];
   const auto x = parse_decimal(s);
   if (!x) {
     const std::string reason = why_not_decimal(s);
-    *why = reason == "not finite"
-               ? fmt::format("{}:{}:{}: column {}: {} is not a finite number", csv.path, row.first, it->second + 1, col, s)
-               : fmt::format("{}:{}:{}: column {}: '{}' is not a number ({})", csv.path, row.first, it->second + 1, col, s,
-                             reason);
+    why->emplace(FormatLocation{.file = csv.path, .line = row.first, .column = static_cast<long>(it->second + 1), .key = col,
+                                .kind = KeyKind::csv_column},
+                 reason == "not finite" ? s + " is not a finite number" : fmt::format("'{}' is not a number ({})", s, reason));
     return std::nullopt;
   }
   return x;
@@ -127,12 +117,12 @@ std::string columns_found(const Csv& csv, const std::string& wanted) {
 void require_columns(const Csv& csv, const std::vector<std::string>& cols, const std::string& hint = "") {
   for (const auto& c : cols)
     if (!csv.has(c))
-      throw InputError(fmt::format("{}: the header lacks column '{}'{}{}", csv.path, c, hint, columns_found(csv, c)));
+      throw FormatError({.file = csv.path, .key = c}, fmt::format("the header lacks column '{}'{}{}", c, hint, columns_found(csv, c)));
 }
 
 // A random run's PSD file (docs/data-format.md): frequency_Hz and psd_<axis>_g2_per_Hz for
 // the axes that move (a missing column: that axis at rest); breakpoints, straight lines on
-// log-log axes between them. Bad content throws InputError naming the file, line and column.
+// log-log axes between them. Bad content throws FormatError at the file, line and column.
 vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling) {
   const Csv csv = read_csv(path);
   require_columns(csv, {"frequency_Hz"});
@@ -145,25 +135,27 @@ vibration::RandomProfile read_psd_file(const std::string& path, const std::strin
     any = true;
     vibration::PsdTable t;
     for (const auto& row : csv.rows) {
-      std::string why;
+      std::optional<FormatError> why;
       const auto f = number(csv, row, "frequency_Hz", &why), g = number(csv, row, cols[i], &why);
-      if (!f || !g) throw InputError(why);
+      if (!f || !g) throw *why;
+      const auto cell = [&](const std::string& col) {
+        return FormatLocation{.file = path, .line = row.first, .key = col, .kind = KeyKind::csv_column};
+      };
       if (!(*f > 0) || (!t.rows.empty() && !(*f > t.rows.back().frequency_Hz)))
-        throw InputError(fmt::format("{}:{}: column frequency_Hz: {:g} must be positive and above the previous row's", path,
-                                     row.first, *f));
+        throw FormatError(cell("frequency_Hz"), fmt::format("{:g} must be positive and above the previous row's", *f));
       if (!(*g > 0))
-        throw InputError(fmt::format("{}:{}: column {}: {:g} must be positive (an axis at rest: leave its column out)", path,
-                                     row.first, cols[i], *g));
+        throw FormatError(cell(cols[i]), fmt::format("{:g} must be positive (an axis at rest: leave its column out)", *g));
       t.rows.push_back(vibration::PsdRow::level(*f, *g));
     }
     try {
       vibration::validate(t);
     } catch (const std::invalid_argument& e) {
-      throw InputError(fmt::format("{}: column {}: {}", path, cols[i], e.what()));
+      throw FormatError({.file = path, .key = cols[i], .kind = KeyKind::csv_column}, e.what());
     }
     p.psd[i] = t;
   }
-  if (!any) throw InputError(path + ": the header needs at least one of psd_IA_g2_per_Hz, psd_PA_g2_per_Hz, psd_OA_g2_per_Hz");
+  if (!any)
+    throw FormatError({.file = path}, "the header needs at least one of psd_IA_g2_per_Hz, psd_PA_g2_per_Hz, psd_OA_g2_per_Hz");
   return p;
 }
 
@@ -173,18 +165,25 @@ void require_unit(const Csv& csv, const std::string& prefix, const std::string& 
   if (csv.has(prefix + unit)) return;
   for (const auto& [name, i] : csv.column)
     if (name.rfind(prefix, 0) == 0)
-      throw InputError(fmt::format("{}: column '{}' is in '{}', the manifest's output unit is '{}' (expected '{}{}')", csv.path,
-                                   name, name.substr(prefix.size()), unit, prefix, unit));
-  throw InputError(fmt::format("{}: the header lacks column '{}{}'{}", csv.path, prefix, unit, columns_found(csv, prefix + unit)));
+      throw FormatError({.file = csv.path, .key = name},
+                        fmt::format("column '{}' is in '{}', the manifest's output unit is '{}' (expected '{}{}')", name,
+                                    name.substr(prefix.size()), unit, prefix, unit));
+  throw FormatError({.file = csv.path, .key = prefix + unit},
+                    fmt::format("the header lacks column '{}{}'{}", prefix, unit, columns_found(csv, prefix + unit)));
+}
+
+// The place of a manifest's key: its line, its table ("" at the top level), its name.
+FormatLocation toml_place(const std::string& file, const toml::node* n, const std::string& table, const std::string& key) {
+  return {.file = file, .line = n ? static_cast<long>(n->source().begin.line) : 0, .table = table, .key = key,
+          .kind = KeyKind::toml_key};
 }
 
 double toml_number(const toml::table& t, const std::string& table, const char* key, double fallback, const std::string& file) {
   const toml::node* n = t.get(key);
   if (!n) return fallback;
-  if (!n->is_number())
-    throw InputError(fmt::format("{}:{}: [{}] {}: expected a number", file, n->source().begin.line, table, key));
+  if (!n->is_number()) throw FormatError(toml_place(file, n, table, key), "expected a number");
   const double x = n->value<double>().value();
-  if (!std::isfinite(x)) throw InputError(fmt::format("{}:{}: [{}] {}: must be finite", file, n->source().begin.line, table, key));
+  if (!std::isfinite(x)) throw FormatError(toml_place(file, n, table, key), "must be finite");
   return x;
 }
 
@@ -192,8 +191,7 @@ void check_keys(const toml::table& t, const std::string& table, const std::vecto
   for (auto&& [k, v] : t) {
     bool ok = false;
     for (const auto& a : allowed) ok = ok || a == k.str();
-    if (!ok) throw InputError(fmt::format("{}:{}: {}{}: unknown key", file, v.source().begin.line,
-                                          table.empty() ? "" : "[" + table + "] ", std::string(k.str())));
+    if (!ok) throw FormatError(toml_place(file, &v, table, std::string(k.str())), "unknown key");
   }
 }
 
@@ -214,17 +212,16 @@ void read_diagnose_settings(const toml::table& t, const std::string& file, LabMa
   if (const toml::node* n = t.get("resimulate_runs")) {
     const auto v = n->value<std::int64_t>();
     if (!n->is_integer() || *v < 0 || *v > 1000000)
-      throw InputError(fmt::format("{}:{}: [diagnose] resimulate_runs: expected a whole number of runs, 0 to 1000000", file,
-                                   n->source().begin.line));
+      throw FormatError(toml_place(file, n, "diagnose", "resimulate_runs"), "expected a whole number of runs, 0 to 1000000");
     s.resimulate_runs = static_cast<int>(*v);
   }
   if (const toml::node* n = t.get("try_pairs")) {
     if (!n->is_boolean())
-      throw InputError(fmt::format("{}:{}: [diagnose] try_pairs: expected true or false", file, n->source().begin.line));
+      throw FormatError(toml_place(file, n, "diagnose", "try_pairs"), "expected true or false");
     s.try_pairs = n->value<bool>().value();
   }
   std::string why;
-  if (!s.IsValid(&why)) throw InputError(file + ": [diagnose] " + why);
+  if (!s.IsValid(&why)) throw FormatError({.file = file, .table = "diagnose", .kind = KeyKind::toml_table}, why);
 }
 
 // A run's raw record as a CSV of time and output.
@@ -306,12 +303,12 @@ rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, co
 
 validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest_out) {
   const std::string mpath = (fs::path(dir) / "manifest.toml").string();
-  if (!fs::is_regular_file(mpath)) throw InputError(mpath + ": cannot open the manifest (no such file)");
+  if (!fs::is_regular_file(mpath)) throw FormatError({.file = mpath}, "cannot open the manifest (no such file)");
   toml::table root;
   try {
     root = toml::parse_file(mpath);
   } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}:{}: {}", mpath, e.source().begin.line, e.description()));
+    throw FormatError({.file = mpath, .line = static_cast<long>(e.source().begin.line)}, std::string(e.description()));
   }
   check_keys(root, "", {"campaign", "instrument", "dynamics", "identification", "files", "diagnose"}, mpath);
   // What every campaign states (an empty manifest would otherwise run on defaults and fail
@@ -326,7 +323,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     if (!missing.empty()) {
       std::string list;
       for (const auto& k : missing) list += (list.empty() ? "" : "; ") + k;
-      throw InputError(fmt::format("{}: missing {} (docs/data-format.md)", mpath, list));
+      throw FormatError({.file = mpath}, fmt::format("missing {} (docs/data-format.md)", list));
     }
   }
   validation::Campaign c;
@@ -336,11 +333,12 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     m.name = (*t)["name"].value_or(m.name);
     const toml::node* fv = t->get("format_version");
     if (!fv->is_integer())
-      throw InputError(fmt::format("{}:{}: [campaign] format_version: expected the whole number 1", mpath, fv->source().begin.line));
+      throw FormatError(toml_place(mpath, fv, "campaign", "format_version"), "expected the whole number 1");
     if (const auto v = fv->value<std::int64_t>(); v && *v != 1)
-      throw InputError(fmt::format("{}: [campaign] format_version: {} is not supported (this program reads 1)", mpath, *v));
+      throw FormatError(toml_place(mpath, nullptr, "campaign", "format_version"),
+                        fmt::format("{} is not supported (this program reads 1)", *v));
     if (const toml::node* nm = t->get("name"); nm && !nm->is_string())
-      throw InputError(fmt::format("{}:{}: [campaign] name: expected a string", mpath, nm->source().begin.line));
+      throw FormatError(toml_place(mpath, nm, "campaign", "name"), "expected a string");
   }
   c.name = m.name;
   if (auto* t = root["instrument"].as_table()) {
@@ -348,8 +346,8 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     const toml::node* u = t->get("output_unit");
     if (!u->is_string() || u->value<std::string>()->empty() ||
         u->value<std::string>()->find_first_of(",\" \t") != std::string::npos)
-      throw InputError(fmt::format("{}:{}: [instrument] output_unit: expected a unit name such as \"mA\" (no blanks, commas or quotes)",
-                                   mpath, u->source().begin.line));
+      throw FormatError(toml_place(mpath, u, "instrument", "output_unit"),
+                        "expected a unit name such as \"mA\" (no blanks, commas or quotes)");
     m.output_unit = *u->value<std::string>();
     m.g_m_per_s2 = toml_number(*t, "instrument", "g_m_per_s2", m.g_m_per_s2, mpath);
   }
@@ -368,7 +366,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     d.integrator = (*t)["integrator"].value_or(d.integrator);
     d.integrator_zero_ratio = toml_number(*t, "dynamics", "integrator_zero_ratio", d.integrator_zero_ratio, mpath);
     std::string why;
-    if (!d.IsValid(&why)) throw InputError(mpath + ": [dynamics]: " + why);
+    if (!d.IsValid(&why)) throw FormatError(toml_place(mpath, nullptr, "dynamics", ""), why);
   }
   if (auto* t = root["identification"].as_table()) {
     check_keys(*t, "identification", {"fixed"}, mpath);
@@ -376,8 +374,8 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       for (auto&& [k, v] : *f) {
         const int i = coefficient_index(std::string(k.str()));
         if (i < 0 || !v.is_number())
-          throw InputError(fmt::format("{}:{}: [identification] fixed: '{}' is not a coefficient of model (1) with a number",
-                                       mpath, v.source().begin.line, std::string(k.str())));
+          throw FormatError(toml_place(mpath, &v, "identification", "fixed"),
+                            fmt::format("'{}' is not a coefficient of model (1) with a number", std::string(k.str())));
         c.fixed[i] = v.value<double>().value();
       }
   }
@@ -397,21 +395,25 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
   if (by_vector) require_columns(st, {"a_IA_g", "a_PA_g", "a_OA_g"});
   else require_columns(st, {"series", "angle_deg"}, " (give a_IA_g, a_PA_g, a_OA_g or series, angle_deg)");
   for (const auto& row : st.rows) {
-    std::string why;
+    std::optional<FormatError> why;
     auto get = [&](const std::string& col) {
       const auto x = number(st, row, col, &why);
-      if (!x) throw InputError(why);
+      if (!x) throw *why;
       return *x;
+    };
+    const auto cell = [&](const std::string& col, long column = 0) {
+      return FormatLocation{.file = st.path, .line = row.first, .column = column, .key = col, .kind = KeyKind::csv_column};
     };
     validation::StaticRecord r;
     if (by_vector) {
       r.orientation_g = Vec3(get("a_IA_g"), get("a_PA_g"), get("a_OA_g"));
       if (std::abs(r.orientation_g.norm() - 1) > 0.01)
-        throw InputError(fmt::format("{}:{}: the orientation has |a| = {:.4g} g; a static position is gravity, |a| = 1 g", st.path,
-                                     row.first, r.orientation_g.norm()));
+        throw FormatError({.file = st.path, .line = row.first},
+                          fmt::format("the orientation has |a| = {:.4g} g; a static position is gravity, |a| = 1 g",
+                                      r.orientation_g.norm()));
     } else {
       const double s = get("series");
-      if (s != 1 && s != 2 && s != 3) throw InputError(fmt::format("{}:{}: column series: must be 1, 2 or 3", st.path, row.first));
+      if (s != 1 && s != 2 && s != 3) throw FormatError(cell("series"), "must be 1, 2 or 3");
       r.orientation_g = validation::series_orientation(static_cast<int>(s), get("angle_deg") * std::numbers::pi / 180);
     }
     r.output = get("output_" + m.output_unit);
@@ -419,22 +421,22 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     const bool has_count = st.has("count") && st.column.at("count") < row.second.size() && !row.second[st.column.at("count")].empty();
     const double count = has_count ? get("count") : 1.0;
     if (count != std::floor(count))
-      throw InputError(fmt::format("{}:{}:{}: column count: {} is not a whole number of readings", st.path, row.first,
-                                   st.column.at("count") + 1, row.second[st.column.at("count")]));
-    if (!(sigma > 0)) throw InputError(fmt::format("{}:{}: column sigma_{}: must be positive", st.path, row.first, m.output_unit));
-    if (!(count >= 1)) throw InputError(fmt::format("{}:{}: column count: must be at least 1", st.path, row.first));
+      throw FormatError(cell("count", static_cast<long>(st.column.at("count") + 1)),
+                        fmt::format("{} is not a whole number of readings", row.second[st.column.at("count")]));
+    if (!(sigma > 0)) throw FormatError(cell("sigma_" + m.output_unit), "must be positive");
+    if (!(count >= 1)) throw FormatError(cell("count"), "must be at least 1");
     r.sigma_output = sigma / std::sqrt(count);
     r.where = fmt::format("{}:{}", st.path, row.first);
     c.statics.push_back(r);
   }
-  if (c.statics.empty()) throw InputError(st.path + ": no static readings");
+  if (c.statics.empty()) throw FormatError({.file = st.path}, "no static readings");
 
   // The runs: a bad one is skipped with why.
   const Csv rn = read_csv((fs::path(dir) / runs_file).string());
   require_columns(rn, {"id", "frequency_Hz", "amplitude_g", "d_IA", "d_PA", "d_OA", "a_IA_g", "a_PA_g", "a_OA_g"});
   const bool summaries = rn.has("measured_ug"), series = rn.has("series");
   if (!summaries && !series)
-    throw InputError(rn.path + ": the header needs measured_ug and sigma_ug (summaries) or series (raw records)");
+    throw FormatError({.file = rn.path}, "the header needs measured_ug and sigma_ug (summaries) or series (raw records)");
   if (summaries) require_columns(rn, {"sigma_ug"});
   if (series) require_columns(rn, {"rest_from_s", "rest_to_s", "on_from_s", "on_to_s"});
   // K1 for raw records: the static readings' least-squares scale factor.
@@ -454,7 +456,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     const std::string idc = rn.column.at("id") < row.second.size() ? row.second[rn.column.at("id")] : "";
     const std::string label = fmt::format("{}:{} (run '{}')", rn.path, row.first, idc);
     const std::string named = fmt::format("run '{}'", idc);  // `why` already names the file and line
-    std::string why;
+    std::optional<FormatError> why;
     auto get = [&](const std::string& col) { return number(rn, row, col, &why); };
     validation::RunRecord r;
     r.id = idc;
@@ -483,7 +485,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       }
       try {
         r.random = read_psd_file((fs::path(dir) / cell("psd")).string(), coupling);
-      } catch (const InputError& e) {
+      } catch (const FormatError& e) {
         c.skipped.push_back(label + ": " + e.what());
         continue;
       }
@@ -491,7 +493,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     }
     const auto o0 = get("a_IA_g"), o1 = get("a_PA_g"), o2 = get("a_OA_g");
     if (!o0 || !o1 || !o2) {
-      c.skipped.push_back(named + ": " + why);
+      c.skipped.push_back(named + ": " + why->what());
       continue;
     }
     if (kind == "random") {
@@ -509,7 +511,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     } else {
       const auto f = get("frequency_Hz"), a = get("amplitude_g"), d0 = get("d_IA"), d1 = get("d_PA"), d2 = get("d_OA");
       if (!f || !a || !d0 || !d1 || !d2) {
-        c.skipped.push_back(named + ": " + why);
+        c.skipped.push_back(named + ": " + why->what());
         continue;
       }
       const Vec3 d(*d0, *d1, *d2);
@@ -532,7 +534,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     if (!file.empty()) {
       const auto rf = get("rest_from_s"), rt = get("rest_to_s"), of = get("on_from_s"), ot = get("on_to_s");
       if (!rf || !rt || !of || !ot) {
-        c.skipped.push_back(named + ": " + why);
+        c.skipped.push_back(named + ": " + why->what());
         continue;
       }
       rectification::SeriesWindows win;
@@ -593,7 +595,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       } catch (const std::invalid_argument& e) {
         c.skipped.push_back(label + ": " + e.what());
         continue;
-      } catch (const InputError& e) {
+      } catch (const FormatError& e) {
         c.skipped.push_back(label + ": " + e.what());
         continue;
       }
@@ -604,7 +606,7 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       }
       const auto mu = get("measured_ug"), su = get("sigma_ug");
       if (!mu || !su) {
-        c.skipped.push_back(named + ": " + why);
+        c.skipped.push_back(named + ": " + why->what());
         continue;
       }
       if (!(*su > 0)) {

@@ -12,9 +12,10 @@
 //                      summary) or series (a CSV of time_s and output_<unit>, read
 //                      streaming) with rest_from_s, rest_to_s, on_from_s, on_to_s
 //
-// read_campaign: bad input throws InputError naming the file, the line and the column; a run
-// that cannot be used (a NaN, a series shorter than its intervals, a missing series file)
-// is skipped and listed in Campaign::skipped with why; the others are diagnosed.
+// read_campaign: bad input throws FormatError (io/formats/error.hpp) with the file, the line
+// and the column or key; a run that cannot be used (a NaN, a series shorter than its
+// intervals, a missing series file) is skipped and listed in Campaign::skipped with why; the
+// others are diagnosed.
 // write_campaign: the same format, written atomically file by file.
 #include <string>
 

@@ -33,10 +33,10 @@ void write_atomic(const std::string& path, const std::string& text) {
   const fs::path target(path);
   std::error_code dir_error;
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), dir_error);
-  if (dir_error) throw InputError("cannot create the folder of " + target.string() + ": " + dir_error.message());
+  if (dir_error) throw FormatError("cannot create the folder of " + target.string() + ": " + dir_error.message());
   const fs::path tmp = target.string() + ".tmp." + std::to_string(::getpid());
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd < 0) throw InputError("cannot write " + tmp.string() + ": " + std::strerror(errno));
+  if (fd < 0) throw FormatError("cannot write " + tmp.string() + ": " + std::strerror(errno));
   std::size_t done = 0;
   bool ok = true;
   while (ok && done < text.size()) {
@@ -56,7 +56,7 @@ void write_atomic(const std::string& path, const std::string& text) {
   fs::rename(tmp, target, ec);
   if (ec) {
     fs::remove(tmp, dir_error);
-    throw InputError("cannot write " + target.string() + ": " + ec.message());
+    throw FormatError("cannot write " + target.string() + ": " + ec.message());
   }
   const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
   const int dfd = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);

@@ -10,7 +10,7 @@ namespace vrelab::io {
 
 // Writes `text` to `path` through a temporary file in the same folder and a rename, so a
 // reader never sees a partial file and a failed run leaves no file. Creates the folder.
-// A path that cannot be written throws InputError (exit code 2).
+// A path that cannot be written throws FormatError (io/formats/error.hpp; exit code 2).
 void write_atomic(const std::string& path, const std::string& text);
 
 // A result's JSON as written to file: indented by 2, ending in a newline. Text in a result

@@ -16,7 +16,7 @@
 #include <fmt/format.h>
 #include <hdf5.h>
 
-#include "io/formats/case_file.hpp"
+#include "io/formats/error.hpp"
 
 namespace vrelab::io {
 namespace {
@@ -133,24 +133,29 @@ struct Channel {
   std::vector<double> block;
 };
 
+// The place of a dataset (or one of its elements) in a file.
+FormatLocation dataset(const std::string& path, const std::string& name, long long element = -1) {
+  return {.file = path, .key = name, .kind = KeyKind::hdf5_dataset, .element = element};
+}
+
 Channel open_channel(hid_t file, const std::string& path, const std::string& name, const std::string& unit) {
   Channel c;
   c.name = name;
   c.dataset = Id(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose);
   if (!c.dataset.ok())
-    throw InputError(with_reason(fmt::format("{}: dataset {}: cannot be opened (a group or a link, not a dataset?)", path, name)));
+    throw FormatError(dataset(path, name), with_reason("cannot be opened (a group or a link, not a dataset?)"));
   c.space = Id(H5Dget_space(c.dataset.get()), H5Sclose);
   if (!c.space.ok() || H5Sget_simple_extent_ndims(c.space.get()) != 1)
-    throw InputError(fmt::format("{}: dataset {}: must be one-dimensional (one sample per element), has {} dimensions", path,
-                                 name, c.space.ok() ? H5Sget_simple_extent_ndims(c.space.get()) : -1));
+    throw FormatError(dataset(path, name), fmt::format("must be one-dimensional (one sample per element), has {} dimensions",
+                                                       c.space.ok() ? H5Sget_simple_extent_ndims(c.space.get()) : -1));
   H5Sget_simple_extent_dims(c.space.get(), &c.length, nullptr);
   Id type(H5Dget_type(c.dataset.get()), H5Tclose);
   const H5T_class_t cls = type.ok() ? H5Tget_class(type.get()) : H5T_NO_CLASS;
   if (cls != H5T_FLOAT && cls != H5T_INTEGER)
-    throw InputError(fmt::format("{}: dataset {}: must hold numbers (floating point, e.g. float64), not {}", path, name,
-                                 cls == H5T_STRING ? "strings" : "this type"));
+    throw FormatError(dataset(path, name), fmt::format("must hold numbers (floating point, e.g. float64), not {}",
+                                                       cls == H5T_STRING ? "strings" : "this type"));
   if (const auto u = string_attribute(c.dataset.get(), "units"); u && !unit.empty() && *u != unit)
-    throw InputError(fmt::format("{}: dataset {}: attribute units = '{}', its name says '{}'", path, name, *u, unit));
+    throw FormatError(dataset(path, name), fmt::format("attribute units = '{}', its name says '{}'", *u, unit));
   return c;
 }
 
@@ -158,10 +163,10 @@ Channel open_channel(hid_t file, const std::string& path, const std::string& nam
 void read_block(Channel& c, const std::string& path, hsize_t from, hsize_t n) {
   c.block.resize(n);
   if (H5Sselect_hyperslab(c.space.get(), H5S_SELECT_SET, &from, nullptr, &n, nullptr) < 0)
-    throw InputError(with_reason(fmt::format("{}: dataset {}: cannot select samples {} to {}", path, c.name, from, from + n - 1)));
+    throw FormatError(dataset(path, c.name), with_reason(fmt::format("cannot select samples {} to {}", from, from + n - 1)));
   Id mem(H5Screate_simple(1, &n, nullptr), H5Sclose);
   if (H5Dread(c.dataset.get(), H5T_NATIVE_DOUBLE, mem.get(), c.space.get(), H5P_DEFAULT, c.block.data()) < 0)
-    throw InputError(with_reason(fmt::format("{}: dataset {}: cannot read samples {} to {}", path, c.name, from, from + n - 1)));
+    throw FormatError(dataset(path, c.name), with_reason(fmt::format("cannot read samples {} to {}", from, from + n - 1)));
 }
 
 bool fsync_path(const std::string& p, bool directory) {
@@ -183,18 +188,19 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
                              const std::function<void(double, double)>& sample, const ReferenceSink& reference) {
   silence_hdf5();
   std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw InputError(path + ": cannot open the series (no such file?)");
+  if (!fs::is_regular_file(path, ec)) throw FormatError({.file = path}, "cannot open the series (no such file?)");
   if (H5Fis_hdf5(path.c_str()) <= 0)
-    throw InputError(path + ": not an HDF5 file (a name ending in .h5 or .hdf5 is read as HDF5; a CSV record must end in .csv)");
+    throw FormatError({.file = path},
+                      "not an HDF5 file (a name ending in .h5 or .hdf5 is read as HDF5; a CSV record must end in .csv)");
   Id file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
-  if (!file.ok()) throw InputError(with_reason(path + ": cannot open the HDF5 file"));
+  if (!file.ok()) throw FormatError({.file = path}, with_reason("cannot open the HDF5 file"));
   const std::vector<std::string> names = root_names(file.get());
   const auto has = [&](const std::string& n) { return std::find(names.begin(), names.end(), n) != names.end(); };
   const auto missing = [&](const std::string& n, const std::string& what) {
-    std::string msg = fmt::format("{}: no dataset '{}' ({}; the file has: {})", path, n, what, joined(names));
+    std::string msg = fmt::format("no dataset '{}' ({}; the file has: {})", n, what, joined(names));
     if (const std::string close = closest_name(n, names); !close.empty())
       msg += fmt::format("; did you mean '{}' for '{}'?", n, close);
-    return InputError(msg);
+    return FormatError({.file = path, .key = n}, msg);
   };
   if (!has("time_s")) throw missing("time_s", "a raw record needs time_s, in s, and output_<unit>");
   std::string out_name = column;
@@ -203,13 +209,13 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
     for (const auto& n : names)
       if (n.rfind("output_", 0) == 0) outputs.push_back(n);
     if (outputs.size() != 1)
-      throw InputError(outputs.empty()
-                           ? fmt::format("{}: no dataset output_<unit> (the file has: {})", path, joined(names))
-                           : fmt::format("{}: several output datasets ({}); name one (measure --column)", path, joined(outputs)));
+      throw FormatError({.file = path},
+                        outputs.empty() ? fmt::format("no dataset output_<unit> (the file has: {})", joined(names))
+                                        : fmt::format("several output datasets ({}); name one (measure --column)", joined(outputs)));
     out_name = outputs.front();
   }
   if (!has(out_name)) throw missing(out_name, "the output, in the unit its name gives");
-  if (out_name == "time_s") throw InputError(path + ": the output dataset cannot be the time dataset");
+  if (out_name == "time_s") throw FormatError({.file = path}, "the output dataset cannot be the time dataset");
   const std::string out_unit = out_name.rfind("output_", 0) == 0 ? out_name.substr(7) : "";
   std::vector<Channel> ch;
   ch.push_back(open_channel(file.get(), path, "time_s", "s"));
@@ -229,8 +235,9 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
   const hsize_t n = ch[0].length;
   for (const Channel& c : ch)
     if (c.length != n)
-      throw InputError(fmt::format("{}: dataset {} has {} samples, time_s has {} (every channel of a record has one length)", path,
-                                   c.name, c.length, n));
+      throw FormatError({.file = path, .key = c.name},
+                        fmt::format("dataset {} has {} samples, time_s has {} (every channel of a record has one length)", c.name,
+                                    c.length, n));
   const bool any_ref = reference && (present[0] || present[1] || present[2]);
   double last_t = -INFINITY;
   for (hsize_t from = 0; from < n; from += kHdf5BlockSamples) {
@@ -242,17 +249,17 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
       const double t = ch[0].block[j], u = ch[1].block[j];
       for (std::size_t k = 0; k < 2; ++k)
         if (!std::isfinite(ch[k].block[j]))
-          throw InputError(fmt::format("{}: dataset {}[{}]: a sample is not a finite number ({})", path, ch[k].name, at,
-                                       ch[k].block[j]));
+          throw FormatError(dataset(path, ch[k].name, static_cast<long long>(at)),
+                            fmt::format("a sample is not a finite number ({})", ch[k].block[j]));
       if (!(t > last_t))
-        throw InputError(fmt::format("{}: dataset time_s[{}]: time does not increase ({} s after {} s)", path, at, t,
-                                     last_t));
+        throw FormatError(dataset(path, "time_s", static_cast<long long>(at)),
+                          fmt::format("time does not increase ({} s after {} s)", t, last_t));
       last_t = t;
       try {
         sample(t, u);
       } catch (const std::invalid_argument& e) {
-        throw InputError(fmt::format("{}: dataset {}[{}]: {} (t = {}, {} = {})", path, out_name, at, e.what(), t,
-                                     out_name, u));
+        throw FormatError(dataset(path, out_name, static_cast<long long>(at)),
+                          fmt::format("{} (t = {}, {} = {})", e.what(), t, out_name, u));
       }
       if (any_ref) {
         std::array<double, 3> g{};
@@ -260,13 +267,14 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
           if (!present[i]) continue;
           const Channel& c = ch[ref_index[i]];
           if (!std::isfinite(c.block[j]))
-            throw InputError(fmt::format("{}: dataset {}[{}]: a sample is not a finite number ({})", path, c.name, at, c.block[j]));
+            throw FormatError(dataset(path, c.name, static_cast<long long>(at)),
+                              fmt::format("a sample is not a finite number ({})", c.block[j]));
           g[i] = c.block[j];
         }
         try {
           reference(t, g, present);
         } catch (const std::invalid_argument& e) {
-          throw InputError(fmt::format("{}: sample {} (t = {} s): {}", path, at, t, e.what()));
+          throw FormatError({.file = path}, fmt::format("sample {} (t = {} s): {}", at, t, e.what()));
         }
       }
     }
@@ -295,7 +303,7 @@ void write_string_attribute(hid_t obj, const char* name, const std::string& valu
   Id a(H5Acreate2(obj, name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT), H5Aclose);
   const std::string padded = value.empty() ? std::string(1, '\0') : value;
   if (!a.ok() || H5Awrite(a.get(), type.get(), padded.data()) < 0)
-    throw InputError(with_reason(fmt::format("{}: cannot write the attribute {}", where, name)));
+    throw FormatError(with_reason(fmt::format("{}: cannot write the attribute {}", where, name)));
 }
 
 }  // namespace
@@ -308,9 +316,9 @@ Hdf5SeriesWriter::Hdf5SeriesWriter(const std::string& path, const std::string& o
   const fs::path target(path);
   std::error_code ec;
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), ec);
-  if (ec) throw InputError("cannot create the folder of " + path + ": " + ec.message());
+  if (ec) throw FormatError("cannot create the folder of " + path + ": " + ec.message());
   s_->file = Id(H5Fcreate(s_->tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose);
-  if (!s_->file.ok()) throw InputError(with_reason("cannot write " + s_->tmp));
+  if (!s_->file.ok()) throw FormatError(with_reason("cannot write " + s_->tmp));
   try {
     create_datasets(output_unit, run_id, comment);
   } catch (...) {
@@ -338,7 +346,7 @@ void Hdf5SeriesWriter::create_datasets(const std::string& output_unit, const std
     c.name = name;
     c.dataset = Id(H5Dcreate2(s_->file.get(), name.c_str(), H5T_IEEE_F64LE, space.get(), H5P_DEFAULT, dcpl.get(), H5P_DEFAULT),
                    H5Dclose);
-    if (!c.dataset.ok()) throw InputError(with_reason(fmt::format("{}: cannot create the dataset {}", s_->tmp, name)));
+    if (!c.dataset.ok()) throw FormatError(with_reason(fmt::format("{}: cannot create the dataset {}", s_->tmp, name)));
     write_string_attribute(c.dataset.get(), "units", unit, fmt::format("{}: dataset {}", s_->tmp, name));
     c.block.reserve(kHdf5BlockSamples);
     s_->ch.push_back(std::move(c));
@@ -368,12 +376,12 @@ void Hdf5SeriesWriter::flush() {
   const hsize_t total = s_->written + m, from = s_->written;
   for (Channel& c : s_->ch) {
     if (H5Dset_extent(c.dataset.get(), &total) < 0)
-      throw InputError(with_reason(fmt::format("{}: dataset {}: cannot grow to {} samples", s_->tmp, c.name, total)));
+      throw FormatError(with_reason(fmt::format("{}: dataset {}: cannot grow to {} samples", s_->tmp, c.name, total)));
     Id space(H5Dget_space(c.dataset.get()), H5Sclose);
     H5Sselect_hyperslab(space.get(), H5S_SELECT_SET, &from, nullptr, &m, nullptr);
     Id mem(H5Screate_simple(1, &m, nullptr), H5Sclose);
     if (H5Dwrite(c.dataset.get(), H5T_NATIVE_DOUBLE, mem.get(), space.get(), H5P_DEFAULT, c.block.data()) < 0)
-      throw InputError(with_reason(fmt::format("{}: dataset {}: cannot write samples {} to {}", s_->tmp, c.name, from, total - 1)));
+      throw FormatError(with_reason(fmt::format("{}: dataset {}: cannot write samples {} to {}", s_->tmp, c.name, from, total - 1)));
     c.block.clear();
   }
   s_->written = total;
@@ -382,16 +390,16 @@ void Hdf5SeriesWriter::flush() {
 void Hdf5SeriesWriter::commit() {
   flush();
   s_->ch.clear();
-  if (H5Fflush(s_->file.get(), H5F_SCOPE_GLOBAL) < 0) throw InputError(with_reason("cannot write " + s_->tmp));
+  if (H5Fflush(s_->file.get(), H5F_SCOPE_GLOBAL) < 0) throw FormatError(with_reason("cannot write " + s_->tmp));
   const hid_t f = s_->file.get();
-  if (H5Fclose(f) < 0) throw InputError(with_reason("cannot write " + s_->tmp));
+  if (H5Fclose(f) < 0) throw FormatError(with_reason("cannot write " + s_->tmp));
   s_->file = Id();
   // Durable as well as atomic, as write_atomic (io/formats/output.hpp): the data synced before the
   // rename, the folder after it.
-  if (!fsync_path(s_->tmp, false)) throw InputError("cannot write " + s_->tmp + ": " + std::strerror(errno));
+  if (!fsync_path(s_->tmp, false)) throw FormatError("cannot write " + s_->tmp + ": " + std::strerror(errno));
   std::error_code ec;
   fs::rename(s_->tmp, s_->path, ec);
-  if (ec) throw InputError("cannot write " + s_->path + ": " + ec.message());
+  if (ec) throw FormatError("cannot write " + s_->path + ": " + ec.message());
   s_->committed = true;
   const fs::path target(s_->path);
   fsync_path(target.has_parent_path() ? target.parent_path().string() : ".", true);

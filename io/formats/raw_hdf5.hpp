@@ -7,7 +7,7 @@
 // each with a string attribute `units` ("s", the unit, "g"). Read in bounded hyperslabs
 // (kHdf5BlockSamples samples per channel at a time): memory does not grow with the record.
 // The reader delivers the same callbacks, in the same order, with the same checks as
-// read_series_csv (io/formats/csv.hpp); anything wrong is InputError naming the file and the dataset.
+// read_series_csv (io/formats/csv.hpp); anything wrong is FormatError naming the file and the dataset.
 #include <array>
 #include <cstddef>
 #include <functional>
@@ -25,14 +25,14 @@ inline constexpr std::size_t kHdf5BlockSamples = 65536;
 bool is_hdf5_path(const std::string& path);
 
 // `column`: the output dataset's name; empty: the one dataset whose name starts with
-// "output_" (several: InputError naming them). Returns the output dataset's name.
+// "output_" (several: FormatError naming them). Returns the output dataset's name.
 std::string read_series_hdf5(const std::string& path, const std::string& column,
                              const std::function<void(double t_s, double value)>& sample,
                              const ReferenceSink& reference = {});
 
 // Writes a record streaming: chunked datasets (kHdf5BlockSamples samples per chunk) grown as
 // samples come, to `path`.tmp.<pid>, renamed to `path` by commit(); a writer destroyed
-// without commit() removes its temporary file. HDF5 errors are InputError naming the file.
+// without commit() removes its temporary file. HDF5 errors are FormatError naming the file.
 class Hdf5SeriesWriter {
  public:
   // `output_unit`: the dataset output_<unit>; `reference`: which ref_<axis>_g datasets to

@@ -13,7 +13,7 @@ namespace vrelab::io {
 // sample(t_s, output) in time order, then reference(...) for the same sample when the record
 // has reference channels; both check the same things (time strictly increasing, finite
 // samples, the output column/dataset present, every channel of one length) and throw
-// InputError naming the file and the line or dataset. Returns the output column's name.
+// FormatError naming the file and the line or dataset. Returns the output column's name.
 std::string read_series(const std::string& path, const std::string& column,
                         const std::function<void(double t_s, double value)>& sample, const ReferenceSink& reference = {});
 

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/formats/case_file.hpp"
-#include "io/services/studies.hpp"
+#include "io/services/study_results.hpp"
 #include "rectification/measurement/series.hpp"
 #include "rectification/prediction/frequency_study.hpp"
 #include "rectification/simulation/shake.hpp"

@@ -32,6 +32,11 @@
 namespace vrelab::io {
 namespace {
 
+// A case table the reason is about: "<case>: [table] <reason>".
+FormatLocation table_of(const Case& c, const std::string& table) {
+  return {.file = c.path, .table = table, .kind = KeyKind::toml_table};
+}
+
 using plant::kNumCoefficients;
 constexpr double kArcsec = std::numbers::pi / (180.0 * 3600.0);
 
@@ -186,6 +191,15 @@ rectification::Eq3Terms predict_terms(const Case& c) {
   return rectification::sine_rectification(k, a, v.sine, c.range_limit_g);  // sine, swept sine
 }
 
+namespace {
+
+// A key of the case's [vibration] table (`line` 0: the message names no line).
+FormatLocation vibration_key(const Case& c, long line, const std::string& key) {
+  return {.file = c.path, .line = line, .table = "vibration", .key = key, .kind = KeyKind::toml_key};
+}
+
+}  // namespace
+
 PredictStudy predict(const Case& c, bool frequency_dependent) {
   require(c, c.coefficients.has_value(), "coefficients", "predict");
   require(c, c.orientation_g.has_value(), "orientation", "predict");
@@ -193,11 +207,12 @@ PredictStudy predict(const Case& c, bool frequency_dependent) {
   const VibrationSpec& vs = *c.vibration;
   const bool random_kind = vs.type == "random" || vs.type == "sine_on_random";
   if (frequency_dependent && vs.type != "sine" && !random_kind)
-    throw InputError(c.path + ": [vibration] type: --frequency-dependent takes a \"sine\", \"random\" or \"sine_on_random\" vibration");
+    throw FormatError(vibration_key(c, 0, "type"), "--frequency-dependent takes a \"sine\", \"random\" or \"sine_on_random\" vibration");
   if (frequency_dependent && random_kind && !vs.psd)
-    throw InputError(c.path + ":" + std::to_string(vs.line) + ": [vibration] psd_IA: --frequency-dependent needs the random part as PSD tables (psd_IA, psd_PA, psd_OA), not rms_g");
+    throw FormatError(vibration_key(c, vs.line, "psd_IA"),
+                      "--frequency-dependent needs the random part as PSD tables (psd_IA, psd_PA, psd_OA), not rms_g");
   if (frequency_dependent && vs.type != "random" && !(vs.sine.frequency_Hz > 0))
-    throw InputError(c.path + ": [vibration] frequency_Hz: --frequency-dependent needs a positive frequency");
+    throw FormatError(vibration_key(c, 0, "frequency_Hz"), "--frequency-dependent needs a positive frequency");
   PredictStudy s;
   s.terms = predict_terms(c);
   s.description = vs.type;
@@ -290,23 +305,32 @@ namespace {
 rectification::ShakerMotion shake_motion(const Case& c) {
   const VibrationSpec& vs = *c.vibration;
   rectification::ShakerMotion t;
+  // The request alone first: what it refuses is the [vibration] table's. What the request
+  // accepts and the imperfections then refuse (e.g. imperfections on a random run) is the
+  // [shaker] table's, at its first imperfection key.
+  try {
+    (void)rectification::shaker_motion(vs, {}, *c.orientation_g, c.g_m_per_s2, c.seed);
+  } catch (const std::invalid_argument& e) {
+    throw FormatError({.file = c.path, .line = vs.line, .table = "vibration", .kind = KeyKind::toml_key}, e.what());
+  }
   try {
     t = rectification::shaker_motion(vs, c.shaker, *c.orientation_g, c.g_m_per_s2, c.seed);
   } catch (const std::invalid_argument& e) {
-    // The imperfections' own limits are the [shaker] table's; the rest is the request's.
-    const bool shaker = std::string(e.what()).rfind("transverse motion, harmonics and rocking", 0) == 0;
-    throw InputError(fmt::format("{}:{}: [{}] {}", c.path, vs.line, shaker ? "shaker" : "vibration", e.what()));
+    const char* key = c.shaker.transverse ? "transverse" : !c.shaker.harmonics.empty() ? "harmonics" : "rocking";
+    throw FormatError({.file = c.path, .line = c.shaker.line, .table = "shaker", .key = key, .kind = KeyKind::toml_key},
+                      e.what());
   }
   try {
     vibration::check_feasible(t.demand, c.shaker.limits);
   } catch (const std::invalid_argument& e) {
-    throw InputError(c.path + ": [shaker] the profile is beyond the shaker: " + e.what());
+    throw FormatError(table_of(c, "shaker"), std::string("the profile is beyond the shaker: ") + e.what());
   }
   const auto& ro = c.shake.readout;
   if (ro.active() && t.top_Hz >= ro.sample_rate_Hz / 2)
-    throw InputError(fmt::format("{}: [vibration] content up to {:g} Hz is at or above the Nyquist frequency {:g} Hz of "
-                                 "[readout] sample_rate_Hz = {:g}",
-                                 c.path, t.top_Hz, ro.sample_rate_Hz / 2, ro.sample_rate_Hz));
+    throw FormatError(table_of(c, "vibration"),
+                      fmt::format("content up to {:g} Hz is at or above the Nyquist frequency {:g} Hz of "
+                                  "[readout] sample_rate_Hz = {:g}",
+                                  t.top_Hz, ro.sample_rate_Hz / 2, ro.sample_rate_Hz));
   return t;
 }
 
@@ -360,7 +384,7 @@ ShakeStudy shake_with(const Case& c, const std::function<rectification::SampleSi
   require(c, c.coefficients.has_value(), "coefficients", "shake");
   require(c, c.orientation_g.has_value(), "orientation", "shake");
   require(c, c.vibration.has_value(), "vibration", "shake");
-  if (std::string why; !c.shake.IsValid(&why)) throw InputError(c.path + ": [shake] " + why);
+  if (std::string why; !c.shake.IsValid(&why)) throw FormatError(table_of(c, "shake"), why);
   const VibrationSpec& vs = *c.vibration;
   ShakeStudy s;
   s.table = shake_motion(c);
@@ -486,7 +510,7 @@ MeasureStudy measure(const std::string& series_path, const std::string& column, 
   try {
     s.result = m.finish();
   } catch (const std::invalid_argument& e) {
-    throw InputError(series_path + ": " + e.what());
+    throw FormatError({.file = series_path}, e.what());
   }
   return s;
 }
@@ -630,8 +654,8 @@ SweepStudy sweep(const Case& c, const std::string& out_path, bool restart, int t
   require(c, c.coefficients.has_value(), "coefficients", "sweep");
   require(c, c.sweep.has_value(), "sweep", "sweep");
   const rectification::SweepGrid& grid = *c.sweep;
-  if (std::string why; !grid.IsValid(&why)) throw InputError(c.path + ": [sweep] " + why);
-  if (std::string why; !c.shake.IsValid(&why)) throw InputError(c.path + ": [shake] " + why);
+  if (std::string why; !grid.IsValid(&why)) throw FormatError(table_of(c, "sweep"), why);
+  if (std::string why; !c.shake.IsValid(&why)) throw FormatError(table_of(c, "shake"), why);
   const std::string fingerprint = fmt::format("{:016x}", fnv1a(c.content.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + kProgramVersion + kGitDescribe));
   const int used = core::threads_per_process(threads >= 0 ? threads : c.sweep_threads);
   const std::string header = sweep_header(c, fingerprint, used);
@@ -697,7 +721,7 @@ FrequencyStudy frequency(const Case& c) {
   FrequencyStudy s;
   s.settings = c.frequency_study.value_or(rectification::FrequencyStudySettings{
       rectification::spaced(1, 5000, 80, true), rectification::spaced(1, 5000, 10, true)});
-  if (std::string why; !s.settings.IsValid(&why)) throw InputError(c.path + ": [frequency_study] " + why);
+  if (std::string why; !s.settings.IsValid(&why)) throw FormatError(table_of(c, "frequency_study"), why);
   const auto start = std::chrono::steady_clock::now();
   s.curves = rectification::frequency_study(c.plant, *c.orientation_g, s.settings);
   s.wall_s = seconds_since(start);

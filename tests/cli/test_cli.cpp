@@ -270,6 +270,31 @@ TEST(CliShake, WritesTheDocumentedJsonAndRejectsWhatTheShakerCannotDo) {
   rejects("frequency_Hz = 5.0", "frequency_Hz = -5.0", R"(frequency_Hz)");
 }
 
+// Shaker imperfections act on tones: on a random run they are refused as the [shaker] table's
+// (its line, its first imperfection key), not the [vibration] table's. The place is data.
+TEST(CliShake, ImperfectionsOnARandomRunAreTheShakerTablesFault) {
+  TempDir d;
+  const fs::path c = edited_case(d, "shake-random-gevs.toml", "\\[run\\]",
+                                 "[shaker]\ntransverse = {from_axis = \"IA\", to_axis = \"PA\", ratio = 0.05}\n\n[run]");
+  const std::string text = read_file(c);
+  long shaker_line = 1;  // the line of "[shaker]" in the text written, counted here
+  for (std::size_t i = 0; i < text.find("[shaker]"); ++i) shaker_line += text[i] == '\n';
+  ShakeOptions o;
+  o.case_path = c.string();
+  o.json_path = (d.path / "bad.json").string();
+  std::ostringstream out;
+  try {
+    run_shake(o, out);
+    ADD_FAILURE() << "accepted transverse motion on a random run";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().table, "shaker") << e.what();
+    EXPECT_EQ(e.where().key, "transverse") << e.what();
+    EXPECT_EQ(e.where().line, shaker_line) << e.what();
+    EXPECT_EQ(e.reason(), "transverse motion, harmonics and rocking apply to sine and swept-sine runs");
+  }
+  EXPECT_FALSE(fs::exists(o.json_path));
+}
+
 TEST(CliSweep, ResumesAfterAnInterruptionWithIdenticalRowsAndRefusesAnotherCase) {
   TempDir d;
   const fs::path c = edited_case(d, "sweep-frequency.toml", "frequency_points = 40", "frequency_points = 6");

@@ -1,5 +1,6 @@
-// The diagnosis stage's settings and results on file: the manifest's [diagnose] table, the
-// settings' checks, the confusion matrix's CSV (no campaign is simulated: fast).
+// The diagnosis stage's settings and results on file: the settings' checks and JSON, the
+// confusion matrix's CSV, the blind report, the runs' VRC in diagnose --json (no campaign is
+// simulated: fast). Reading the manifest's [diagnose] table: tests/io/test_lab_data.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -12,7 +13,6 @@
 #include <nlohmann/json.hpp>
 
 #include "io/formats/case_file.hpp"
-#include "io/formats/csv.hpp"
 #include "io/services/diagnosis_json.hpp"
 #include "io/formats/lab_data.hpp"
 #include "support/files.hpp"
@@ -22,59 +22,6 @@
 using namespace vrelab;
 namespace fs = std::filesystem;
 using vrelab::test::TempDir;
-
-namespace {
-
-// The shipped hand-written campaign with `table` appended to its manifest.
-fs::path lab_with(const TempDir& t, const std::string& table) {
-  const fs::path dir = t.path / "lab";
-  fs::copy(fs::path(VRELAB_CASES_DIR) / "lab-example", dir, fs::copy_options::recursive);
-  std::ofstream(dir / "manifest.toml", std::ios::app) << "\n" << table;
-  return dir;
-}
-
-std::string error_of(const fs::path& dir) {
-  try {
-    io::read_campaign(dir.string());
-  } catch (const io::InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-}  // namespace
-
-TEST(DiagnoseSettings, TheManifestsDiagnoseTableSetsThemByFieldName) {
-  TempDir t;
-  io::LabManifest m;
-  io::read_campaign(lab_with(t, "[diagnose]\nsignificance_sigma = 4\nresimulate_runs = 0\ntry_pairs = false\n").string(), &m);
-  EXPECT_TRUE(m.diagnose_given);
-  EXPECT_EQ(m.diagnose.significance_sigma, 4.0);
-  EXPECT_EQ(m.diagnose.resimulate_runs, 0);
-  EXPECT_FALSE(m.diagnose.try_pairs);
-  EXPECT_EQ(m.diagnose.model_accuracy, validation::DiagnoseSettings{}.model_accuracy);  // absent: the default
-}
-
-TEST(DiagnoseSettings, ABadKeyOrValueNamesTheFileTheKeyAndWhy) {
-  {
-    TempDir t;
-    EXPECT_NE(error_of(lab_with(t, "[diagnose]\nsignificance = 4\n")).find("manifest.toml:"), std::string::npos);
-  }
-  {
-    TempDir t;
-    EXPECT_NE(error_of(lab_with(t, "[diagnose]\nsignificance = 4\n")).find("[diagnose] significance: unknown key"),
-              std::string::npos);
-  }
-  {
-    TempDir t;
-    EXPECT_NE(error_of(lab_with(t, "[diagnose]\nresimulate_runs = 2.5\n")).find("resimulate_runs: expected a whole number"),
-              std::string::npos);
-  }
-  {
-    TempDir t;
-    EXPECT_NE(error_of(lab_with(t, "[diagnose]\nmodel_accuracy = -0.1\n")).find("model_accuracy = -0.1"), std::string::npos);
-  }
-}
 
 TEST(DiagnoseSettings, IsValidNamesTheField) {
   std::string why;
@@ -141,51 +88,6 @@ TEST(Blind, HtmlReportHasTheFamiliesTheConfusionAndEveryMissEscaped) {
   EXPECT_NE(h.find("<td class=\"l\">mechanical_mode</td><td class=\"ok\">2</td><td class=\"\">1</td>"), std::string::npos) << h;
   EXPECT_NE(h.find("<li>[single] campaign 3: mode &lt;1 kHz &amp; more</li>"), std::string::npos) << h;
   EXPECT_EQ(h.find("<1 kHz"), std::string::npos);
-}
-
-// Numbers as a lab writes them: finite decimals only. strtod alone reads "0x1E" as 30, "inf"
-// and "nan" as themselves, and stops quietly at a decimal comma.
-TEST(CsvText, OnlyFiniteDecimalNumbersAreNumbers) {
-  EXPECT_EQ(io::parse_decimal("30").value(), 30.0);
-  EXPECT_EQ(io::parse_decimal("-1.5e-3").value(), -1.5e-3);
-  EXPECT_EQ(io::parse_decimal(".5").value(), 0.5);
-  EXPECT_EQ(io::parse_decimal("5.").value(), 5.0);
-  EXPECT_EQ(io::parse_decimal("+2E+2").value(), 200.0);
-  for (const char* bad : {"0x1E", "0X1e", "inf", "-inf", "nan", "NaN", "1,5", " 1", "1 ", "", "-", ".", "e5", "1e", "1e+",
-                          "1.2.3", "1e999", "12abc"})
-    EXPECT_FALSE(io::parse_decimal(bad).has_value()) << bad;
-  EXPECT_EQ(io::why_not_decimal("0x1E"), "hexadecimal; write the decimal value");
-  EXPECT_EQ(io::why_not_decimal("nan"), "not finite");
-  EXPECT_EQ(io::why_not_decimal("1,5"), "a decimal comma; write a decimal point");
-}
-
-// UTF-8 as RFC 3629 has it: a Latin-1 degree sign (0xB0) is not UTF-8, its UTF-8 form (C2 B0)
-// is; overlong forms, surrogates and truncated sequences are not.
-TEST(CsvText, Utf8IsCheckedByteByByte) {
-  EXPECT_EQ(io::first_non_utf8("angle 30\xC2\xB0"), std::string::npos);
-  EXPECT_EQ(io::first_non_utf8("\xE2\x82\xAC \xF0\x9F\x98\x80"), std::string::npos);  // euro, an emoji
-  EXPECT_EQ(io::first_non_utf8("id\xB0"), 2u);
-  EXPECT_EQ(io::first_non_utf8("\xC0\xAF"), 0u);          // overlong '/'
-  EXPECT_EQ(io::first_non_utf8("a\xED\xA0\x80"), 1u);     // a surrogate
-  EXPECT_EQ(io::first_non_utf8("ab\xE2\x82"), 2u);        // truncated at the end
-  EXPECT_EQ(io::first_non_utf8("\xF4\x90\x80\x80"), 0u);  // past U+10FFFF
-  std::string bom = "\xEF\xBB\xBFid,frequency_Hz\r";
-  io::check_text_line(bom, 1, "runs.csv");
-  EXPECT_EQ(bom, "id,frequency_Hz");
-  std::string latin1 = "run\xB0,1";
-  try {
-    io::check_text_line(latin1, 7, "runs.csv");
-    ADD_FAILURE() << "accepted a Latin-1 byte";
-  } catch (const io::InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("runs.csv:7:4: not UTF-8 at byte 4 (0xB0"), std::string::npos) << e.what();
-  }
-}
-
-TEST(CsvText, ClosestColumnNameIsSuggested) {
-  const std::vector<std::string> names = {"id", "frequency_Hz", "amplitude_g"};
-  EXPECT_EQ(io::closest_name("frequency_hz", names), "frequency_Hz");
-  EXPECT_EQ(io::closest_name("amplitud_g", names), "amplitude_g");
-  EXPECT_EQ(io::closest_name("temperature_C", names), "");
 }
 
 namespace {

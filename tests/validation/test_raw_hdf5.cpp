@@ -1,7 +1,7 @@
-// Raw records in HDF5 (io/formats/raw_hdf5.hpp, docs/data-format.md "Raw records in HDF5"): the
-// reader delivers exactly what the CSV reader delivers for the same samples, a campaign and
-// its HDF5 copy diagnose number for number alike, `measure` reads either, and a bad HDF5
-// record skips its run naming the file and the dataset. All in seconds.
+// Raw records in HDF5 (io/formats/raw_hdf5.hpp, docs/data-format.md "Raw records in HDF5") in
+// the commands: a campaign and its HDF5 copy diagnose number for number alike, `measure` reads
+// either, and a bad HDF5 record skips its run naming the file and the dataset. All in seconds.
+// The reader against the CSV reader and the writer alone: tests/io/test_raw_hdf5.cpp.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -48,24 +48,6 @@ struct Lcg {
   }
 };
 
-struct Captured {
-  std::vector<double> t, u, rt;
-  std::vector<std::array<double, 3>> ref;
-  std::vector<std::array<bool, 3>> present;
-  std::string name;
-};
-
-Captured capture(const std::string& path, const std::string& column = "", bool with_reference = true) {
-  Captured c;
-  io::ReferenceSink sink;
-  if (with_reference)
-    sink = [&c](double t, const std::array<double, 3>& g, const std::array<bool, 3>& p) {
-      c.rt.push_back(t), c.ref.push_back(g), c.present.push_back(p);
-    };
-  c.name = io::read_series(path, column, [&c](double t, double u) { c.t.push_back(t), c.u.push_back(u); }, sink);
-  return c;
-}
-
 // A raw HDF5 file from datasets given whole (the test's own writer, with the C API, for
 // files the library's writer would never make: missing or mismatched datasets).
 void write_h5(const fs::path& p, const std::vector<std::pair<std::string, std::vector<double>>>& datasets) {
@@ -79,51 +61,6 @@ void write_h5(const fs::path& p, const std::vector<std::pair<std::string, std::v
     H5Dclose(d), H5Sclose(space);
   }
   H5Fclose(f);
-}
-
-TEST(RawHdf5, DeliversExactlyWhatTheCsvReaderDelivers) {
-  // 150001 samples (three 64 Ki blocks, the last partial) of output and three reference
-  // channels, written as CSV with round-trip digits and as HDF5 by the library's writer: both
-  // readers must hand over the same doubles in the same order, bit for bit.
-  TempDir d;
-  const std::string csv = (d.path / "r.csv").string(), h5 = (d.path / "r.h5").string();
-  Lcg rng;
-  {
-    std::ofstream out(csv);
-    out << "# a record\ntime_s,output_mA,ref_IA_g,ref_PA_g,ref_OA_g\n";
-    io::Hdf5SeriesWriter w(h5, "mA", {true, true, true}, "r", "test");
-    for (int i = 0; i <= 150000; ++i) {
-      const double t = -1.0 + i / 20000.0, u = 0.88 + 0.3 * std::sin(2 * std::numbers::pi * 100 * t) + 1e-5 * rng.next();
-      const std::array<double, 3> g{2 * std::sin(2 * std::numbers::pi * 100 * t), 0.1 * rng.next(), 1e-3 * rng.next()};
-      out << fmt::format("{},{},{},{},{}\n", t, u, g[0], g[1], g[2]);
-      w.add(t, u, g);
-    }
-    w.commit();
-  }
-  EXPECT_FALSE(fs::exists(h5 + ".tmp." + std::to_string(::getpid())));  // renamed into place
-  const Captured a = capture(csv), b = capture(h5);
-  ASSERT_EQ(a.t.size(), 150001u);
-  EXPECT_EQ(a.name, "output_mA");
-  EXPECT_EQ(b.name, a.name);
-  EXPECT_EQ(b.t, a.t);
-  EXPECT_EQ(b.u, a.u);
-  EXPECT_EQ(b.rt, a.rt);
-  EXPECT_EQ(b.ref, a.ref);
-  EXPECT_EQ(b.present, a.present);
-  // Without a reference sink the channels are not read; the output chosen by name.
-  const Captured c = capture(h5, "output_mA", false);
-  EXPECT_EQ(c.u, a.u);
-  EXPECT_TRUE(c.ref.empty());
-}
-
-TEST(RawHdf5, AWriterNotCommittedLeavesNoFile) {
-  TempDir d;
-  const fs::path p = d.path / "x.h5";
-  {
-    io::Hdf5SeriesWriter w(p.string(), "mA");
-    w.add(0, 1);
-  }
-  EXPECT_TRUE(fs::is_empty(d.path)) << "a temporary file left behind";
 }
 
 // cases/lab-example with three runs given as raw records (records/<id>.csv): 10 kHz, 0.3 s at

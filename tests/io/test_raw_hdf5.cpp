@@ -1,0 +1,104 @@
+// Raw records in HDF5 (io/formats/raw_hdf5.hpp, docs/data-format.md "Raw records in HDF5"), the
+// reader and the writer alone: the reader delivers exactly what the CSV reader delivers for
+// the same samples; a writer not committed leaves no file. In the commands (diagnose, measure,
+// campaign): tests/validation/test_raw_hdf5.cpp.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "io/formats/raw_hdf5.hpp"
+#include "io/formats/series.hpp"
+#include "support/files.hpp"
+
+namespace vrelab {
+namespace {
+
+namespace fs = std::filesystem;
+using test::TempDir;
+
+// A deterministic pseudo-random number in [-1, 1) (a 64-bit LCG): noise without <random>'s
+// implementation-defined distributions.
+struct Lcg {
+  std::uint64_t s = 12345;
+  double next() {
+    s = s * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<double>(s >> 11) / static_cast<double>(1ull << 52) - 1.0;
+  }
+};
+
+struct Captured {
+  std::vector<double> t, u, rt;
+  std::vector<std::array<double, 3>> ref;
+  std::vector<std::array<bool, 3>> present;
+  std::string name;
+};
+
+Captured capture(const std::string& path, const std::string& column = "", bool with_reference = true) {
+  Captured c;
+  io::ReferenceSink sink;
+  if (with_reference)
+    sink = [&c](double t, const std::array<double, 3>& g, const std::array<bool, 3>& p) {
+      c.rt.push_back(t), c.ref.push_back(g), c.present.push_back(p);
+    };
+  c.name = io::read_series(path, column, [&c](double t, double u) { c.t.push_back(t), c.u.push_back(u); }, sink);
+  return c;
+}
+
+TEST(RawHdf5, DeliversExactlyWhatTheCsvReaderDelivers) {
+  // 150001 samples (three 64 Ki blocks, the last partial) of output and three reference
+  // channels, written as CSV with round-trip digits and as HDF5 by the library's writer: both
+  // readers must hand over the same doubles in the same order, bit for bit.
+  TempDir d;
+  const std::string csv = (d.path / "r.csv").string(), h5 = (d.path / "r.h5").string();
+  Lcg rng;
+  {
+    std::ofstream out(csv);
+    out << "# a record\ntime_s,output_mA,ref_IA_g,ref_PA_g,ref_OA_g\n";
+    io::Hdf5SeriesWriter w(h5, "mA", {true, true, true}, "r", "test");
+    for (int i = 0; i <= 150000; ++i) {
+      const double t = -1.0 + i / 20000.0, u = 0.88 + 0.3 * std::sin(2 * std::numbers::pi * 100 * t) + 1e-5 * rng.next();
+      const std::array<double, 3> g{2 * std::sin(2 * std::numbers::pi * 100 * t), 0.1 * rng.next(), 1e-3 * rng.next()};
+      out << fmt::format("{},{},{},{},{}\n", t, u, g[0], g[1], g[2]);
+      w.add(t, u, g);
+    }
+    w.commit();
+  }
+  EXPECT_FALSE(fs::exists(h5 + ".tmp." + std::to_string(::getpid())));  // renamed into place
+  const Captured a = capture(csv), b = capture(h5);
+  ASSERT_EQ(a.t.size(), 150001u);
+  EXPECT_EQ(a.name, "output_mA");
+  EXPECT_EQ(b.name, a.name);
+  EXPECT_EQ(b.t, a.t);
+  EXPECT_EQ(b.u, a.u);
+  EXPECT_EQ(b.rt, a.rt);
+  EXPECT_EQ(b.ref, a.ref);
+  EXPECT_EQ(b.present, a.present);
+  // Without a reference sink the channels are not read; the output chosen by name.
+  const Captured c = capture(h5, "output_mA", false);
+  EXPECT_EQ(c.u, a.u);
+  EXPECT_TRUE(c.ref.empty());
+}
+
+TEST(RawHdf5, AWriterNotCommittedLeavesNoFile) {
+  TempDir d;
+  const fs::path p = d.path / "x.h5";
+  {
+    io::Hdf5SeriesWriter w(p.string(), "mA");
+    w.add(0, 1);
+  }
+  EXPECT_TRUE(fs::is_empty(d.path)) << "a temporary file left behind";
+}
+
+}  // namespace
+}  // namespace vrelab
