@@ -21,7 +21,7 @@ std::shared_ptr<const vibration::Excitation> sine_motion(const vibration::SineVi
                                                          const rectification::ShakerImperfections& shaker,
                                                          const Vec3& static_gravity_g, double g_m_per_s2) {
   rectification::VibrationRequest request;
-  request.type = "sine";
+  request.type = rectification::VibrationKind::sine;
   request.sine = sine;
   return rectification::shaker_motion(request, shaker, static_gravity_g, g_m_per_s2, 0).motion;
 }
