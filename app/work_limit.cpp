@@ -51,14 +51,14 @@ void check_shake_work(const io::Case& c) {
   WorkRequest r;
   r.sample_rate_Hz = c.shake.readout.active() ? c.shake.readout.sample_rate_Hz : 0.0;
   double drive = 0;
-  if (v.type == "sine" || v.type == "sine_on_random") drive = v.sine.frequency_Hz * harmonic_factor(c);
+  if (rectification::has_sine_tone(v.type)) drive = v.sine.frequency_Hz * harmonic_factor(c);
   if (v.psd)
     for (const auto& t : v.psd->psd)
       if (t && !t->rows.empty()) drive = std::max(drive, t->rows.back().frequency_Hz);
   if (v.swept) drive = std::max(v.swept->start_frequency_Hz, v.swept->end_frequency_Hz) * harmonic_factor(c);
   r.drive_Hz = drive;
   r.drive_key = v.swept ? "[vibration] start/end_frequency_Hz" : v.psd ? "[vibration] psd_* frequencies" : "[vibration] frequency_Hz";
-  if (v.type == "sine") {
+  if (v.type == rectification::VibrationKind::sine) {
     r.simulated_s = settle_s(c, p) + measure_s(c, v.sine.frequency_Hz);
     r.time_key = "[shake] min_measure_s, blocks and settle_decay";
   } else {

@@ -13,6 +13,8 @@
 
 namespace vrelab::vibration {
 
+class RandomExcitation;  // vibration/sampled.hpp
+
 class Excitation {
  public:
   virtual ~Excitation() = default;
@@ -21,6 +23,10 @@ class Excitation {
   virtual double max_frequency_Hz() const = 0;
   // A one-line description for reports.
   virtual std::string describe() const = 0;
+  // The excitation as a stream of Gaussian random samples, which a plant may step through
+  // sample by sample (rectification/simulation/discretised.hpp); nullptr when it is not one
+  // (a sum holding one is not: its other parts are not sampled).
+  virtual const RandomExcitation* random_samples() const { return nullptr; }
 };
 
 // A tone: A_i sin(theta(t) + phase_i) on axis i, one carrier phase theta(t) for all axes

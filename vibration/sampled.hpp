@@ -84,6 +84,7 @@ class RandomExcitation final : public Excitation {
   Vec3 acceleration_g(double t_s) const override;
   double max_frequency_Hz() const override { return max_frequency_Hz_; }
   std::string describe() const override;
+  const RandomExcitation* random_samples() const override { return this; }
 
   // Stream samples n = first .. first + count - 1 (the values acceleration_g passes through
   // at t = n / fs), per axis.

@@ -310,19 +310,24 @@ void read_random_part(Table& t, VibrationSpec& v, bool psd_required) {
 void read_vibration(Table t, Case& c) {
   VibrationSpec v;
   v.line = t.line(&t.raw());
-  v.type = t.string("type", "");
-  if (v.type == "sine") {
+  const std::string type = t.string("type", "");
+  const auto kind = rectification::parse_vibration_kind(type);
+  if (!kind)
+    t.fail(t.raw().get("type"), "type",
+           "must be \"sine\", \"random\", \"sine_on_random\" or \"swept_sine\", got \"" + type + "\"");
+  v.type = *kind;
+  if (v.type == VibrationKind::sine) {
     v.sine = read_sine_part(t, false);
     t.check_unknown({"type", "amplitude_g", "phase_deg", "frequency_Hz"});
-  } else if (v.type == "random") {
+  } else if (v.type == VibrationKind::random) {
     read_random_part(t, v, false);
     t.check_unknown({"type", "rms_g", "correlation", "psd_IA", "psd_PA", "psd_OA", "coupling", "duration_s"});
-  } else if (v.type == "sine_on_random") {
+  } else if (v.type == VibrationKind::sine_on_random) {
     v.sine = read_sine_part(t, true);
     read_random_part(t, v, false);
     t.check_unknown({"type", "amplitude_g", "phase_deg", "frequency_Hz", "rms_g", "correlation", "psd_IA", "psd_PA",
                      "psd_OA", "coupling", "duration_s"});
-  } else if (v.type == "swept_sine") {
+  } else {  // swept_sine
     vibration::SweptSine s;
     s.amplitude_g = t.vec3("amplitude_g");
     s.phase_rad = t.opt_vec3("phase_deg").value_or(Vec3::Zero()) * kDeg;
@@ -346,9 +351,6 @@ void read_vibration(Table t, Case& c) {
     v.duration_s = vibration::sweep_duration_s(s);
     t.check_unknown({"type", "amplitude_g", "phase_deg", "start_frequency_Hz", "end_frequency_Hz", "law",
                      "rate_octaves_per_min", "rate_Hz_per_s"});
-  } else {
-    t.fail(t.raw().get("type"), "type",
-           "must be \"sine\", \"random\", \"sine_on_random\" or \"swept_sine\", got \"" + v.type + "\"");
   }
   c.vibration = v;
 }

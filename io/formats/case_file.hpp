@@ -42,6 +42,8 @@ struct DividingHead {
   bool from_ode = false;    // source = "ode": readings from the ODE plant, else model (1)
 };
 
+using rectification::VibrationKind;
+
 // The [vibration] table. type: sine | random | sine_on_random | swept_sine. The request a
 // shaker run builds its table motion from (rectification/simulation/shaker_motion.hpp), and
 // what eq. (3) needs.

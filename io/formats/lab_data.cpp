@@ -465,14 +465,14 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     auto cell = [&](const std::string& col) {
       return rn.has(col) && rn.column.at(col) < row.second.size() ? row.second[rn.column.at(col)] : std::string();
     };
-    std::string kind = cell("kind");
-    if (kind.empty()) kind = "sine";
-    if (kind != "sine" && kind != "random" && kind != "sine_on_random") {
+    const std::string kind_text = cell("kind");
+    const auto kind = kind_text.empty() ? VibrationKind::sine : rectification::parse_vibration_kind(kind_text);
+    if (!kind || kind == VibrationKind::swept_sine) {
       c.skipped.push_back(fmt::format("{}:{}: column kind: must be sine, random or sine_on_random, got '{}'", rn.path,
-                                      row.first, kind));
+                                      row.first, kind_text));
       continue;
     }
-    if (kind != "sine") {
+    if (kind != VibrationKind::sine) {
       const std::string coupling = cell("coupling").empty() ? "common" : cell("coupling");
       if (coupling != "common" && coupling != "independent") {
         c.skipped.push_back(fmt::format("{}:{}: column coupling: must be common or independent, got '{}'", rn.path,
@@ -480,7 +480,8 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
         continue;
       }
       if (cell("psd").empty()) {
-        c.skipped.push_back(fmt::format("{}:{}: column psd: a {} run needs its PSD file", rn.path, row.first, kind));
+        c.skipped.push_back(fmt::format("{}:{}: column psd: a {} run needs its PSD file", rn.path, row.first,
+                                        rectification::to_string(*kind)));
         continue;
       }
       try {
@@ -489,14 +490,14 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
         c.skipped.push_back(label + ": " + e.what());
         continue;
       }
-      r.sine_part = kind == "sine_on_random";
+      r.sine_part = kind == VibrationKind::sine_on_random;
     }
     const auto o0 = get("a_IA_g"), o1 = get("a_PA_g"), o2 = get("a_OA_g");
     if (!o0 || !o1 || !o2) {
       c.skipped.push_back(named + ": " + why->what());
       continue;
     }
-    if (kind == "random") {
+    if (kind == VibrationKind::random) {
       // No sine: frequency, amplitude and direction describe the PSD (its mean frequency,
       // sqrt(2) x its rms, each axis's rms share); the row's cells are not read.
       Vec3 rms = Vec3::Zero();

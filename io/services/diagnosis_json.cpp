@@ -71,8 +71,10 @@ json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
   for (std::size_t k = 0; k < c.runs.size(); ++k) {
     const auto& r = c.runs[k];
     const auto& x = d.runs[k];
+    const VibrationKind kind =
+        !r.random ? VibrationKind::sine : r.sine_part ? VibrationKind::sine_on_random : VibrationKind::random;
     runs.push_back({{"id", r.id},
-                    {"kind", !r.random ? "sine" : r.sine_part ? "sine_on_random" : "random"},
+                    {"kind", rectification::to_string(kind)},
                     {"frequency_Hz", r.frequency_Hz},
                     {"amplitude_g", r.amplitude_g},
                     {"direction", vec_json(r.direction)},
@@ -262,7 +264,7 @@ json to_json(const validation::Diagnosis& d, const validation::Campaign& c) {
 }
 
 json to_json(const rectification::MotionDeparture& m) {
-  json j = {{"kind", m.kind},
+  json j = {{"kind", rectification::to_string(m.kind)},
             {"axes", m.axes},
             {"sample_rate_Hz", m.sample_rate_Hz},
             {"samples", m.samples},
@@ -275,7 +277,7 @@ json to_json(const rectification::MotionDeparture& m) {
             {"transverse_axis_ratio",
              {finite_or_null(m.transverse_axis_ratio[0]), finite_or_null(m.transverse_axis_ratio[1]),
               finite_or_null(m.transverse_axis_ratio[2])}}};
-  if (m.kind == "sine") {
+  if (m.kind == VibrationKind::sine) {
     j["fundamental_ratio"] = finite_or_null(m.fundamental_ratio);
     j["harmonic2_ratio"] = finite_or_null(m.harmonic2_ratio);
     j["harmonic2_sigma"] = finite_or_null(m.harmonic2_sigma);

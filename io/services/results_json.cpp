@@ -87,7 +87,7 @@ json reproduce_settings_json(const validation::ReproduceSettings& s) {
 double vibration_input_rms_g(const VibrationSpec& v) {
   vibration::SineVibration sine = v.sine;
   if (v.swept) sine.amplitude_g = v.swept->amplitude_g;
-  const double s2 = v.type == "random" ? 0.0 : std::pow(rectification::input_rms_g(sine), 2);
+  const double s2 = v.type == VibrationKind::random ? 0.0 : std::pow(rectification::input_rms_g(sine), 2);
   const double r2 = v.gaussian ? std::pow(rectification::input_rms_g(*v.gaussian), 2) : 0.0;
   return std::sqrt(s2 + r2);
 }
@@ -98,8 +98,8 @@ json vrc_json(double error_g, double input_rms_g) {
 }
 
 json vibration_json(const VibrationSpec& v) {
-  json j = {{"type", v.type}};
-  if (v.type != "random") {
+  json j = {{"type", rectification::to_string(v.type)}};
+  if (v.type != VibrationKind::random) {
     j["amplitude_g"] = vec_json(v.sine.amplitude_g);
     j["phase_deg"] = vec_json(v.sine.phase_rad * 180 / std::numbers::pi);
     j["frequency_Hz"] = v.sine.frequency_Hz > 0 ? json(v.sine.frequency_Hz) : json(nullptr);
@@ -234,7 +234,8 @@ json predict_json(const Case& c, const PredictStudy& s) {
     json ft = terms_json(fp.terms);
     ft["pickoff_nonlinearity"] = fp.pickoff_g;
     ft["pendulum_geometry"] = fp.pendulum_geometry_g;
-    j["frequency_dependent"] = {{"frequency_Hz", c.vibration->type == "random" ? json(nullptr) : json(c.vibration->sine.frequency_Hz)},
+    const bool random = c.vibration->type == VibrationKind::random;
+    j["frequency_dependent"] = {{"frequency_Hz", random ? json(nullptr) : json(c.vibration->sine.frequency_Hz)},
                                 {"total_g", fp.total_g()},
                                 {"vrc_ug_per_g2", vrc_json(fp.total_g(), rms)},
                                 {"terms", ft},

@@ -185,8 +185,8 @@ rectification::Eq3Terms predict_terms(const Case& c) {
   const VibrationSpec& v = *c.vibration;
   const plant::Coefficients& k = *c.coefficients;
   const Vec3& a = *c.orientation_g;
-  if (v.type == "random") return rectification::random_rectification(k, a, *v.gaussian, c.range_limit_g);
-  if (v.type == "sine_on_random")
+  if (v.type == VibrationKind::random) return rectification::random_rectification(k, a, *v.gaussian, c.range_limit_g);
+  if (v.type == VibrationKind::sine_on_random)
     return rectification::sine_on_random_rectification(k, a, v.sine, *v.gaussian, c.range_limit_g);
   return rectification::sine_rectification(k, a, v.sine, c.range_limit_g);  // sine, swept sine
 }
@@ -205,29 +205,30 @@ PredictStudy predict(const Case& c, bool frequency_dependent) {
   require(c, c.orientation_g.has_value(), "orientation", "predict");
   require(c, c.vibration.has_value(), "vibration", "predict");
   const VibrationSpec& vs = *c.vibration;
-  const bool random_kind = vs.type == "random" || vs.type == "sine_on_random";
-  if (frequency_dependent && vs.type != "sine" && !random_kind)
+  const bool random_kind = rectification::has_random_part(vs.type);
+  if (frequency_dependent && vs.type != VibrationKind::sine && !random_kind)
     throw FormatError(vibration_key(c, 0, "type"), "--frequency-dependent takes a \"sine\", \"random\" or \"sine_on_random\" vibration");
   if (frequency_dependent && random_kind && !vs.psd)
     throw FormatError(vibration_key(c, vs.line, "psd_IA"),
                       "--frequency-dependent needs the random part as PSD tables (psd_IA, psd_PA, psd_OA), not rms_g");
-  if (frequency_dependent && vs.type != "random" && !(vs.sine.frequency_Hz > 0))
+  if (frequency_dependent && vs.type != VibrationKind::random && !(vs.sine.frequency_Hz > 0))
     throw FormatError(vibration_key(c, 0, "frequency_Hz"), "--frequency-dependent needs a positive frequency");
   PredictStudy s;
   s.terms = predict_terms(c);
-  s.description = vs.type;
-  if (vs.type == "sine" || vs.type == "swept_sine") {
+  s.description = rectification::to_string(vs.type);
+  if (vs.type == VibrationKind::sine || vs.type == VibrationKind::swept_sine) {
     s.printed_g = rectification::sine_rectification_as_printed(*c.coefficients, *c.orientation_g, vs.sine);
     const Vec3 ph = vs.sine.phase_rad * 180 / std::numbers::pi;
     s.description += fmt::format(", peak [{:g}, {:g}, {:g}] g, phase [{:g}, {:g}, {:g}] deg", vs.sine.amplitude_g[0],
                                  vs.sine.amplitude_g[1], vs.sine.amplitude_g[2], ph[0], ph[1], ph[2]);
   }
   if (vs.gaussian)
-    s.description += fmt::format("{}Gaussian rms [{:g}, {:g}, {:g}] g", vs.type == "sine_on_random" ? " + " : ", ",
+    s.description += fmt::format("{}Gaussian rms [{:g}, {:g}, {:g}] g",
+                                 vs.type == VibrationKind::sine_on_random ? " + " : ", ",
                                  vs.gaussian->rms_g[0], vs.gaussian->rms_g[1], vs.gaussian->rms_g[2]);
-  if (frequency_dependent && vs.type == "random")
+  if (frequency_dependent && vs.type == VibrationKind::random)
     s.at_frequency = rectification::random_rectification_at_frequency(c.plant, *c.orientation_g, *vs.psd, c.range_limit_g);
-  else if (frequency_dependent && vs.type == "sine_on_random")
+  else if (frequency_dependent && vs.type == VibrationKind::sine_on_random)
     s.at_frequency = rectification::sine_on_random_rectification_at_frequency(c.plant, *c.orientation_g, vs.sine, *vs.psd,
                                                                                c.range_limit_g);
   else if (frequency_dependent)
@@ -241,7 +242,7 @@ std::string predict_at_frequency_report(const Case& c, const PredictStudy& s) {
   const VibrationSpec& vs = *c.vibration;
   const rectification::FrequencyPrediction& fp = *s.at_frequency;
   std::string out;
-  if (vs.type == "sine")
+  if (vs.type == VibrationKind::sine)
     out = fmt::format(
         "At {:g} Hz through the plant's dynamics ({}): current amplitude |I| = {:.6g} g per {:g} g on IA, "
         "pendulum angle |Theta| = {:.4g} rad\n",
@@ -250,7 +251,8 @@ std::string predict_at_frequency_report(const Case& c, const PredictStudy& s) {
   else
     out = fmt::format("Through the plant's dynamics ({}): the {} motion's PSD filtered by the loop, each term's Gaussian "
                       "expectation (docs/frequency.md, random motion)\n",
-                      c.physical ? "physical parameters" : "from coefficients", vs.type == "random" ? "random" : "sine-on-random");
+                      c.physical ? "physical parameters" : "from coefficients",
+                      vs.type == VibrationKind::random ? "random" : "sine-on-random");
   out += fmt::format("  {:<20}{:>14}{:>16}\n", "term", "quasi-static", "at frequency");
   for (int t = 0; t < rectification::kNumTerms; ++t) {
     if (t == rectification::t_clipping && !c.range_limit_g) continue;
@@ -535,7 +537,7 @@ std::string measure_report(const MeasureStudy& s) {
     static const char* axis[3] = {"IA", "PA", "OA"};
     int dom = 0;
     m.measured_rms_axis_g.maxCoeff(&dom);
-    if (m.kind == "sine")
+    if (m.kind == VibrationKind::sine)
       out += fmt::format("  motion: transverse to {} {:.5g} +/- {:.2g} (per axis [{:.4g}, {:.4g}, {:.4g}]), 2nd harmonic {:.5g} +/- "
                          "{:.2g}, 3rd harmonic {:.5g} +/- {:.2g} (of the fundamental)\n",
                          axis[dom], m.transverse_ratio, m.transverse_sigma, m.transverse_axis_ratio[0], m.transverse_axis_ratio[1],

@@ -12,6 +12,7 @@
 // Only OutputPolynomial changes the static response inside the range (the static
 // identification absorbs part of it); the others vanish at rest.
 #include <complex>
+#include <optional>
 #include <string>
 
 #include "plant/model1.hpp"
@@ -64,6 +65,10 @@ class Effect {
   virtual double extra_damping_per_s(double /*theta_amplitude_rad*/, double /*plant_angle_gain_rad_per_s2_per_g*/) const {
     return 0.0;
   }
+  // The bytes that say which effect this is, its class and parameters, for the prediction's
+  // cache of a run's balance (rectification::film_balance_key): two effects with the same key
+  // act alike. nullopt: no such key, and the cache tells the effect by its address.
+  virtual std::optional<std::string> cache_key() const { return std::nullopt; }
 };
 
 }  // namespace vrelab::plant

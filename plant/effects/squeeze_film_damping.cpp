@@ -15,6 +15,12 @@ SqueezeFilmDamping::SqueezeFilmDamping(double gap, double c0, double b) : gap_ra
   if (!(b > 0) || !std::isfinite(b)) throw std::invalid_argument("squeeze film angle_gain must be positive");
 }
 
+std::optional<std::string> SqueezeFilmDamping::cache_key() const {
+  std::string key = name();
+  for (double x : {gap_rad_, c0_, b_}) key.append(reinterpret_cast<const char*>(&x), sizeof x);
+  return key;
+}
+
 double SqueezeFilmDamping::extra_input_g(double theta, double omega, double, const Vec3&) const {
   const double x = std::min(std::abs(theta) / gap_rad_, 0.95);
   const double y = 1 - x * x;

@@ -25,6 +25,8 @@ class SqueezeFilmDamping final : public Effect {
   // Its own c0 and b as constructed (what makes two films the same film).
   double c0_own_per_s() const { return c0_; }
   double angle_gain_own_rad_per_s2_per_g() const { return b_; }
+  // Its name, then the bytes of its gap, c0 and b as constructed.
+  std::optional<std::string> cache_key() const override;
   // The film's nominal damping as the plant feels it, 1/s: c0 times b(plant) / b(film).
   double c0_per_s(double plant_angle_gain_rad_per_s2_per_g) const { return c0_ * plant_angle_gain_rad_per_s2_per_g / b_; }
   bool amplitude_dependent_damping() const override { return true; }

@@ -306,7 +306,7 @@ std::string axes_of(const std::array<bool, 3>& present) {
 
 MotionDeparture sine_departure(const ReferenceAnalysis& a, const Vec3& commanded_g) {
   MotionDeparture d;
-  d.kind = "sine", d.axes = axes_of(a.present), d.sample_rate_Hz = a.sample_rate_Hz, d.samples = a.samples;
+  d.kind = VibrationKind::sine, d.axes = axes_of(a.present), d.sample_rate_Hz = a.sample_rate_Hz, d.samples = a.samples;
   Vec3 mask = Vec3::Zero();
   for (int i = 0; i < 3; ++i) mask[i] = a.present[static_cast<std::size_t>(i)] ? 1.0 : 0.0;
   d.commanded_rms_g = commanded_g.cwiseProduct(mask).norm() / std::sqrt(2.0);
@@ -351,7 +351,8 @@ MotionDeparture sine_departure(const ReferenceAnalysis& a, const Vec3& commanded
 
 MotionDeparture random_departure(const ReferenceAnalysis& a, const Eigen::Matrix3d& commanded) {
   MotionDeparture d;
-  d.kind = "random", d.axes = axes_of(a.present), d.sample_rate_Hz = a.sample_rate_Hz, d.samples = a.samples;
+  d.kind = VibrationKind::random, d.axes = axes_of(a.present);
+  d.sample_rate_Hz = a.sample_rate_Hz, d.samples = a.samples;
   d.resolution_Hz = a.resolution_Hz, d.dof = a.dof, d.segments = a.segments;
   Eigen::Matrix3d mask = Eigen::Matrix3d::Zero();
   for (int i = 0; i < 3; ++i) mask(i, i) = a.present[static_cast<std::size_t>(i)] ? 1.0 : 0.0;

@@ -35,6 +35,7 @@
 #include <Eigen/Dense>
 
 #include "plant/model1.hpp"
+#include "rectification/simulation/vibration_kind.hpp"
 #include "vibration/random.hpp"
 
 namespace vrelab::rectification {
@@ -121,7 +122,7 @@ class ReferenceAnalyzer {
 
 // How the measured motion departs from the commanded one.
 struct MotionDeparture {
-  std::string kind;  // "sine" or "random"
+  VibrationKind kind = VibrationKind::sine;  // sine or random
   std::string axes;  // the reference axes, e.g. "IA,PA"
   double sample_rate_Hz = 0;
   long samples = 0;

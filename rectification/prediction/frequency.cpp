@@ -6,13 +6,12 @@
 #include <array>
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
-
-#include "plant/effects/squeeze_film_damping.hpp"
 
 namespace vrelab::rectification {
 
@@ -366,9 +365,10 @@ std::string film_balance_key(const PlantConfig& config, const vibration::SineVib
   put(config.torquer_c2_per_g), put(config.torquer_c3_per_g2);
   count(config.effects.size());
   for (const auto& e : config.effects) {
-    if (const auto* f = dynamic_cast<const plant::SqueezeFilmDamping*>(e.get())) {
+    if (const std::optional<std::string> k = e->cache_key()) {
       put(1);
-      put(f->gap_angle_rad()), put(f->c0_own_per_s()), put(f->angle_gain_own_rad_per_s2_per_g());
+      count(k->size());
+      key += *k;
     } else {
       put(2);
       put(reinterpret_cast<std::uintptr_t>(e.get()));

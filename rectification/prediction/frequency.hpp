@@ -158,10 +158,10 @@ PeriodicInput film_harmonic_balance(const plant::PlantConfig& with_films, const 
 
 // What amplitude_linearised(with_films, v) and film_harmonic_balance(with_films, ., in, .)
 // depend on, as bytes: equal keys give equal results (a caller may reuse them, e.g. for runs
-// that differ only in the orientation). Films are compared by their parameters, every other
-// effect by its identity (an effect made afresh gives another key). Each part of variable
-// length (coefficients, locations, effects, tones, loop tones) is preceded by its count, so
-// different inputs give different bytes. Empty without a film.
+// that differ only in the orientation). Effects with a cache_key (the films) are compared by
+// it, every other effect by its identity (an effect made afresh gives another key). Each part
+// of variable length (coefficients, locations, effects, tones, loop tones, an effect's key) is
+// preceded by its count, so different inputs give different bytes. Empty without a film.
 std::string film_balance_key(const plant::PlantConfig& with_films, const vibration::SineVibration& v, const PeriodicInput& in);
 
 // The same two predictions split in two (for a caller that varies the coefficients only, such

@@ -587,7 +587,7 @@ ShakeResult shake_excitation(const plant::PlantConfig& config, const Vec3& a_sta
   const Readout& ro = s.readout;
 
   // A random excitation: one step per sample (rectification/simulation/discretised.hpp).
-  const auto* random = dynamic_cast<const vibration::RandomExcitation*>(&input);
+  const vibration::RandomExcitation* random = input.random_samples();
   std::string cvode_reason = "not a random excitation";
   if (!s.exponential_integrator) cvode_reason = "exponential_integrator off";
   if (random && s.exponential_integrator) {

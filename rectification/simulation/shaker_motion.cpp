@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 
 #include "vibration/sampled.hpp"
 
@@ -36,13 +37,14 @@ ExcitationPtr imperfect_tone(const std::shared_ptr<const vibration::ToneExcitati
 ShakerMotion shaker_motion(const VibrationRequest& v, const ShakerImperfections& shaker, const Vec3& a_static_g,
                          double g_m_per_s2, std::uint64_t seed) {
   ShakerMotion t;
-  t.periodic = v.type == "sine";
-  if ((v.type == "random" || v.type == "sine_on_random") && !v.psd)
-    throw std::invalid_argument("rms_g: a shaken " + v.type + " profile needs PSD tables psd_IA / psd_PA / psd_OA");
+  t.periodic = v.type == VibrationKind::sine;
+  if (has_random_part(v.type) && !v.psd)
+    throw std::invalid_argument("rms_g: a shaken " + to_string(v.type) +
+                                " profile needs PSD tables psd_IA / psd_PA / psd_OA");
   if (t.periodic && !(v.sine.frequency_Hz > 0))
     throw std::invalid_argument("frequency_Hz: a shaker run needs a positive frequency");
   std::shared_ptr<const vibration::ToneExcitation> tone;
-  if (v.type == "sine" || v.type == "sine_on_random") tone = std::make_shared<vibration::SineExcitation>(v.sine);
+  if (has_sine_tone(v.type)) tone = std::make_shared<vibration::SineExcitation>(v.sine);
   if (v.swept) tone = std::make_shared<vibration::SweptSineExcitation>(*v.swept);
   if (!tone && shaker.imperfect())
     throw std::invalid_argument("transverse motion, harmonics and rocking apply to sine and swept-sine runs");
@@ -54,11 +56,11 @@ ShakerMotion shaker_motion(const VibrationRequest& v, const ShakerImperfections&
     t.demand = vibration::shaker_demand(*v.psd, g_m_per_s2);
   }
   if (v.swept) t.demand = vibration::shaker_demand(*v.swept, g_m_per_s2);
-  if (v.type == "sine" || v.type == "sine_on_random") {
+  if (has_sine_tone(v.type)) {
     const auto d = vibration::shaker_demand(v.sine, shaker.harmonics, g_m_per_s2);
-    t.demand = v.type == "sine" ? d : vibration::combine(d, t.demand);
+    t.demand = v.type == VibrationKind::sine ? d : vibration::combine(d, t.demand);
   }
-  if (!m) throw std::invalid_argument("type: no motion for vibration type '" + v.type + "'");
+  if (!m) throw std::invalid_argument("type: no motion for vibration type '" + to_string(v.type) + "'");
   t.top_Hz = std::max(t.top_Hz, m->max_frequency_Hz());
   t.motion = m;
   return t;

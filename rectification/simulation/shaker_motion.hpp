@@ -16,9 +16,9 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
-#include <string>
 #include <vector>
 
+#include "rectification/simulation/vibration_kind.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/demand.hpp"
 #include "vibration/excitation.hpp"
@@ -28,9 +28,9 @@
 
 namespace vrelab::rectification {
 
-// The commanded vibration. type: sine | random | sine_on_random | swept_sine.
+// The commanded vibration.
 struct VibrationRequest {
-  std::string type;
+  VibrationKind type = VibrationKind::sine;
   vibration::SineVibration sine;                // sine, sine_on_random
   std::optional<vibration::RandomProfile> psd;  // random, sine_on_random: PSD tables
   std::optional<vibration::SweptSine> swept;    // swept_sine

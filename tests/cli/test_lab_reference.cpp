@@ -158,12 +158,12 @@ TEST(LabReference, TransverseMotionIsMeasuredNotFitted) {
     const double expected = r.random ? kRandomTransverse : kTransverseAt1kHz * r.frequency_Hz / 1000;
     EXPECT_NEAR(m.transverse_ratio, expected, 4 * m.transverse_sigma + 2e-3) << r.id;
     if (!r.random) {
-      EXPECT_EQ(m.kind, "sine");
+      EXPECT_EQ(m.kind, rectification::VibrationKind::sine);
       EXPECT_NEAR(m.fundamental_ratio, 1.0, 1e-3) << r.id;
       EXPECT_LT(m.harmonic2_ratio, 5 * m.harmonic2_sigma) << r.id;  // none in the truth
       ASSERT_EQ(r.motion->tones.size(), 3u);
     } else {
-      EXPECT_EQ(m.kind, "random");
+      EXPECT_EQ(m.kind, rectification::VibrationKind::random);
       ASSERT_TRUE(r.motion->random.has_value());
       ASSERT_TRUE(r.motion->random->psd[1].has_value());  // the measured transverse PA
       // rms: sqrt(0.02 x 480 x 1.01) = 3.114 g on IA and PA; the synthesis draws exact

@@ -158,7 +158,7 @@ OdeCheck ode_check(const PlantConfig& cfg, const Vec3& a, const rectification::V
   s.relative_tolerance = 1e-4;  // the record's own scatter dominates (cases/shake-random-gevs.toml)
   s.blocks = 16;
   const auto r = rectification::shake_excitation(cfg, a, *motion.motion, measure_s, s);
-  const double pred = v.type == "random"
+  const double pred = v.type == rectification::VibrationKind::random
                           ? rectification::random_rectification_at_frequency(cfg, a, *v.psd).total_g()
                           : rectification::sine_on_random_rectification_at_frequency(cfg, a, v.sine, *v.psd).total_g();
   return {pred, r.measured_g, r.sigma_g};
@@ -176,7 +176,7 @@ TEST(RandomAtFrequency, MatchesTheOdeForGevsAndSineOnRandom) {
   cfg.coefficients[k_PP] = 4e-6;
   {
     rectification::VibrationRequest v;  // cases/shake-random-gevs.toml
-    v.type = "random";
+    v.type = rectification::VibrationKind::random;
     v.psd = gevs_ia();
     const OdeCheck c = ode_check(cfg, a, v, 4.0, 1);
     EXPECT_NEAR(c.measured_g, c.predicted_g, 3 * c.sigma_g + 0.01 * std::abs(c.predicted_g)) << "GEVS";
@@ -186,7 +186,7 @@ TEST(RandomAtFrequency, MatchesTheOdeForGevsAndSineOnRandom) {
   }
   {
     rectification::VibrationRequest v;  // cases/shake-sine-on-random.toml
-    v.type = "sine_on_random";
+    v.type = rectification::VibrationKind::sine_on_random;
     v.sine.amplitude_g = Vec3(2, 0, 0);
     v.sine.frequency_Hz = 300;
     v.psd = two_axes(vibration::AxisCoupling::common, 1.0);
@@ -200,7 +200,7 @@ TEST(RandomAtFrequency, MatchesTheOdeForGevsAndSineOnRandom) {
 TEST(RandomAtFrequency, EffectsMatchTheOde) {
   const Vec3 a(0.5, std::sqrt(0.75), 0);
   rectification::VibrationRequest v;
-  v.type = "random";
+  v.type = rectification::VibrationKind::random;
   v.psd = two_axes(vibration::AxisCoupling::common, 0.25);  // 5 - 500 Hz: where the angle is large
   {
     PlantConfig cfg = test::paper_like_linear_plant();

@@ -127,7 +127,7 @@ TEST(ShakeSampled, SinkSeesEverySampleOfTheRecord) {
 
 TEST(ShakerMotion, SineIsPeriodicWithItsDemandAndImperfectionsNeedATone) {
   rectification::VibrationRequest v;
-  v.type = "sine";
+  v.type = rectification::VibrationKind::sine;
   v.sine.amplitude_g = Vec3(3.0, 0.0, 0.0);
   v.sine.frequency_Hz = 40.0;
   rectification::ShakerImperfections none;
@@ -142,7 +142,7 @@ TEST(ShakerMotion, SineIsPeriodicWithItsDemandAndImperfectionsNeedATone) {
   EXPECT_GE(rectification::shaker_motion(v, harmonic, Vec3(1, 0, 0), 9.81, 1).top_Hz, 80.0);
   // A random request without PSD tables, and imperfections without a tone, are refused.
   rectification::VibrationRequest random;
-  random.type = "random";
+  random.type = rectification::VibrationKind::random;
   EXPECT_THROW(rectification::shaker_motion(random, none, Vec3(1, 0, 0), 9.81, 1), std::invalid_argument);
   v.sine.frequency_Hz = 0;
   EXPECT_THROW(rectification::shaker_motion(v, none, Vec3(1, 0, 0), 9.81, 1), std::invalid_argument);

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <array>
-#include <memory>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "plant/effects/output_polynomial.hpp"
 #include "rectification/simulation/shaker_motion.hpp"
@@ -21,7 +23,7 @@ std::shared_ptr<const vibration::Excitation> sine_motion(const vibration::SineVi
                                                          const rectification::ShakerImperfections& shaker,
                                                          const Vec3& static_gravity_g, double g_m_per_s2) {
   rectification::VibrationRequest request;
-  request.type = "sine";
+  request.type = rectification::VibrationKind::sine;
   request.sine = sine;
   return rectification::shaker_motion(request, shaker, static_gravity_g, g_m_per_s2, 0).motion;
 }
@@ -150,22 +152,57 @@ Effect higher_order_term(int n, int rank, std::string physics, double unit_value
   p.example = example;
   p.linear = true, p.unit_value = unit_value;
   e.parameters = {p};
-  const auto term = [n, name = e.name](double k) {
+  e.hypothesis = [n, name = e.name](ParameterValues v, plant::PlantConfig& c, TableMotion&) {
+    if (v[0] == 0) return;
     std::array<double, 7> poly{};
-    poly[static_cast<std::size_t>(n)] = k;
-    return std::make_shared<plant::OutputPolynomial>(name, poly);
+    poly[static_cast<std::size_t>(n)] = v[0];
+    c.effects.push_back(std::make_shared<plant::OutputPolynomial>(name, poly));
   };
-  e.hypothesis = [term](ParameterValues v, plant::PlantConfig& c, TableMotion&) {
-    if (v[0] != 0) c.effects.push_back(term(v[0]));
-  };
-  // The instrument's own term: the static test and the runs both read it.
-  e.truth = [term](ParameterValues v, VirtualLab& lab) {
-    if (v[0] != 0) lab.instrument.effects.push_back(term(v[0]));
+  // The instrument's own term: the static test and the runs both read it (written out: the
+  // truth does not share the hypothesis' code).
+  e.truth = [n, name = e.name](ParameterValues v, VirtualLab& lab) {
+    if (v[0] == 0) return;
+    std::array<double, 7> c{};
+    c[static_cast<std::size_t>(n)] = v[0];
+    lab.instrument.effects.push_back(std::make_shared<plant::OutputPolynomial>(name, c));
   };
   e.draw = [lo, hi](std::mt19937_64& rng) {
     const double s = random_sign(rng);
     return std::vector<double>{s * log_uniform(rng, lo, hi)};
   };
+  return e;
+}
+
+Effect shaker_harmonic(int order, std::string name, int rank, std::string physics) {
+  static const char* const kOrdinal[] = {"", "", "second", "third", "fourth", "fifth"};
+  if (order < 2 || order > 5)
+    throw std::invalid_argument(std::string("shaker_harmonic: order 2 to 5, got ").append(std::to_string(order)));
+  const std::string ordinal = kOrdinal[order];
+  Effect e;
+  e.name = std::move(name);
+  e.rank = rank;
+  e.acts_on = ActsOn::table_motion;
+  e.physics = std::move(physics);
+  EffectParameter p(ordinal + "_harmonic_ratio", "1");
+  p.example = 0.2;
+  p.nominal = 0;
+  p.grid = {0};
+  for (double h : geometric(0.01, 0.5, 22)) p.grid.push_back(h);
+  e.parameters = {p, harmonic_phase(ordinal + "_harmonic_phase_rad")};
+  e.hypothesis = [order](ParameterValues v, plant::PlantConfig&, TableMotion& m) {
+    if (v[0] > 0) m.harmonics.push_back({order, v[0], v[1]});
+  };
+  e.truth = [order](ParameterValues v, VirtualLab& lab) {
+    if (v[0] > 0) lab.harmonics.push_back(vibration::Harmonic{.order = order, .ratio = v[0], .phase_rad = v[1]});
+  };
+  e.draw = [](std::mt19937_64& rng) {
+    random_sign(rng);
+    return std::vector<double>{log_uniform(rng, 0.1, 0.3)};
+  };
+  e.draw_form = [](std::mt19937_64& rng) {
+    return std::vector<double>{std::uniform_real_distribution<double>(-std::numbers::pi, std::numbers::pi)(rng)};
+  };
+  e.check = [name = e.name](ParameterValues v, std::string* why) { return harmonic_ratio(name, v, why); };
   return e;
 }
 

@@ -140,8 +140,8 @@ struct Effect {
   std::function<void(ParameterValues, VirtualLab&)> truth;
   std::function<std::vector<double>(std::mt19937_64&)> draw;
   // The natural form's draw (blind): the further parameters (parameters[1..]) away from their
-  // defaults (damping, axis, phase, a second angle); null: none. Apart from `draw`, so that the
-  // default-form draws of a seed stay as they were.
+  // defaults (damping, axis, phase, a second angle); null: none. Apart from `draw`, so that a
+  // seed's default-form draws do not depend on the natural forms.
   std::function<std::vector<double>(std::mt19937_64&)> draw_form;
   std::function<bool(ParameterValues, std::string* why)> check;  // null: any finite values
 

@@ -1,7 +1,27 @@
 #pragma once
 // validation/diagnosis/effects/common.hpp -- what the effect files share: grids, the blind
-// draws' distributions, the in-phase and phasor views of a sine, the usual checks.
+// draws' distributions, the in-phase and phasor views of a sine, the usual checks, and the
+// families of effects that differ only in a number (higher_order_term, shaker_harmonic; their
+// bodies in validation/diagnosis/effect.cpp: every .cpp in this folder is taken for an effect).
 // Internal to validation/diagnosis/.
+//
+// The folder's convention. One effect per file, <name>.cpp, defining `Effect effect_<name>()`
+// in namespace vrelab::validation (the registry's list is generated from the file names,
+// validation/CMakeLists.txt); adding an effect is adding its file here and, when the virtual
+// lab needs a new module for its truth, one in plant/effects/. The file
+//  - opens with one line of what the effect is, with the plant module or shaker decorator of
+//    its truth (if any) in parentheses; "Outside the library:" first for an effect only the
+//    virtual lab knows (no hypothesis, in_library false, rank above 100);
+//  - includes the standard headers it uses, its plant module's header, then this header;
+//  - keeps its own helpers in an anonymous namespace, then sets, in this order: name (the
+//    file's stem), rank, in_library, acts_on and the flags, physics, the parameters (the size
+//    first, then the natural form's), hypothesis, truth, draw, draw_form, check;
+//  - writes the truth out from the plant's modules and the shaker's decorators, sharing none of
+//    the hypothesis' own code (the views and checks here aside): a wrong sign or axis in the
+//    hypothesis then shows in `blind`;
+//  - starts `draw` with a sign (used or not: a blind seed then draws the same truths whatever
+//    the effect).
+// An effect of a family is one call of the family's function.
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -91,6 +111,12 @@ inline EffectParameter harmonic_phase(const std::string& name) {
 // (plant::OutputPolynomial): linear in k_n, acting at rest too (the static test takes part of
 // it up), the instrument's own in the virtual lab; drawn log-uniform in [lo, hi] with a sign.
 Effect higher_order_term(int n, int rank, std::string physics, double unit_value, double example, double lo, double hi);
+
+// The table's motion carries a harmonic of `order` (2 to 5) on every axis
+// (vibration::HarmonicDistortion): its ratio h to the fundamental (the size, grid 0 and
+// 0.01-0.5, drawn log-uniform in [0.1, 0.3]) and its phase (the natural form, drawn uniform);
+// the parameters are named <ordinal>_harmonic_ratio and <ordinal>_harmonic_phase_rad.
+Effect shaker_harmonic(int order, std::string name, int rank, std::string physics);
 
 }  // namespace vrelab::validation::effects
 

@@ -20,7 +20,7 @@ Effect effect_fixture_rocking() {
   p.nominal = 0;
   p.grid = effects::symmetric_geometric(0.03e-6, 5e-6, 12);
   // The natural form: the rocking axis (discrete: 0 IA, 1 PA, 2 OA; nominal OA), the sensor
-  // 30 mm from it along the next axis (IA -> PA -> OA -> IA: along IA for OA, as before).
+  // 30 mm from it along the next axis (IA -> PA -> OA -> IA: along IA for OA, the default form).
   EffectParameter ax("axis", "0 IA, 1 PA, 2 OA");
   ax.nominal = 2, ax.lower = 0, ax.upper = 2, ax.example = 1;
   ax.discrete = true, ax.starts = {0, 1, 2};

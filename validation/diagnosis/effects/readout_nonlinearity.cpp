@@ -20,13 +20,15 @@ Effect effect_readout_nonlinearity() {
   p.example = 2e-6;
   p.linear = true, p.unit_value = 1e-6;
   e.parameters = {p};
-  e.hypothesis = [](ParameterValues v, plant::PlantConfig& c, TableMotion&) {
-    if (v[0] != 0) c.effects.push_back(std::make_shared<plant::OutputPolynomial>("readout_nonlinearity", std::array<double, 7>{0, 0, v[0], 0, 0, 0, 0}));
+  e.hypothesis = [name = e.name](ParameterValues v, plant::PlantConfig& c, TableMotion&) {
+    if (v[0] != 0)
+      c.effects.push_back(
+          std::make_shared<plant::OutputPolynomial>(name, std::array<double, 7>{0, 0, v[0], 0, 0, 0, 0}));
   };
-  e.truth = [](ParameterValues v, VirtualLab& lab) {
+  e.truth = [name = e.name](ParameterValues v, VirtualLab& lab) {
     if (v[0] != 0)
       lab.run_acquisition.push_back(
-          std::make_shared<plant::OutputPolynomial>("readout_nonlinearity", std::array<double, 7>{0, 0, v[0], 0, 0, 0, 0}));
+          std::make_shared<plant::OutputPolynomial>(name, std::array<double, 7>{0, 0, v[0], 0, 0, 0, 0}));
   };
   e.draw = [](std::mt19937_64& rng) {
     const double s = effects::random_sign(rng);

@@ -30,9 +30,7 @@ Effect effect_servo_dynamics() {
   p.nominal = 1;
   p.grid = effects::geometric(0.5, 2.0, 41);
   // The natural form. The margin: the closed loop's peaking at the crossover, pinned by runs near
-  // it (the library's servo_phase_margin effect was this parameter alone, with its grid's
-  // range). Prior width 10 deg: a lab's margin is known to a few degrees; the drawn changes
-  // reach 20.
+  // it. Prior width 10 deg: a lab's margin is known to a few degrees; the drawn changes reach 20.
   EffectParameter m("phase_margin_change_deg", "deg");
   m.nominal = 0, m.lower = -32, m.upper = 32, m.example = -15;
   m.prior_sigma = 10, m.step = 0.05;
@@ -56,8 +54,7 @@ Effect effect_servo_dynamics() {
     effects::random_sign(rng);
     return std::vector<double>{effects::coin(rng) ? effects::log_uniform(rng, 0.6, 0.85) : effects::log_uniform(rng, 1.15, 1.6)};
   };
-  // The natural form: the margin 4-20 deg either way (servo_phase_margin's draws), the pendulum
-  // frequency 2-5 % either way.
+  // The natural form: the margin 4-20 deg either way, the pendulum frequency 2-5 % either way.
   e.draw_form = [](std::mt19937_64& rng) {
     const double sm = effects::random_sign(rng);
     const double margin = sm * effects::log_uniform(rng, 4, 20);

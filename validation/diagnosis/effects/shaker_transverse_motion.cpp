@@ -43,7 +43,7 @@ Effect effect_shaker_transverse_motion() {
   e.hypothesis = [](ParameterValues v, plant::PlantConfig&, TableMotion& m) {
     if (v[0] == 0 && v[1] == 0) return;
     const double f = m.sine.frequency_Hz / 1000;
-    if (v[1] == 0 && v[2] == 1 && v[3] == 0) {  // the default form, as it always was: in-phase amplitudes
+    if (v[1] == 0 && v[2] == 1 && v[3] == 0) {  // the default form: in-phase amplitudes
       const double r = v[0] * f;
       const Vec3 a = effects::signed_in_phase(m.sine);
       effects::set_in_phase(m.sine, a + r * Vec3(a[2], a[0], a[1]));

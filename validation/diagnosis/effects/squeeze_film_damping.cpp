@@ -7,14 +7,6 @@
 
 namespace vrelab::validation {
 
-namespace {
-// The film on a plant: c0 its nominal damping 2 zeta w_p, gap 1 / inverse_gap.
-std::shared_ptr<const plant::Effect> film(double inverse_gap_per_rad, const plant::Dynamics& d) {
-  const double c0 = 2 * d.pendulum_damping_ratio * 2 * std::numbers::pi * d.pendulum_frequency_Hz;
-  return std::make_shared<plant::SqueezeFilmDamping>(1 / inverse_gap_per_rad, c0, d.angle_gain_rad_per_s2_per_g);
-}
-}  // namespace
-
 Effect effect_squeeze_film_damping() {
   Effect e;
   e.name = "squeeze_film_damping";
@@ -33,11 +25,21 @@ Effect effect_squeeze_film_damping() {
   p.grid = {0};
   for (double x : effects::geometric(30, 3000, 16)) p.grid.push_back(x);
   e.parameters = {p};
+  // The film on the nominal plant: c0 its nominal damping 2 zeta w_p, the gap 1 / parameter.
   e.hypothesis = [](ParameterValues v, plant::PlantConfig& c, TableMotion&) {
-    if (v[0] > 0) c.effects.push_back(film(v[0], c.dynamics));
+    if (!(v[0] > 0)) return;
+    const plant::Dynamics& d = c.dynamics;
+    const double c0_per_s = 2 * d.pendulum_damping_ratio * 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+    c.effects.push_back(std::make_shared<plant::SqueezeFilmDamping>(1 / v[0], c0_per_s, d.angle_gain_rad_per_s2_per_g));
   };
+  // The instrument's film, on its own dynamics (written out: the truth does not share the
+  // hypothesis' code).
   e.truth = [](ParameterValues v, VirtualLab& lab) {
-    if (v[0] > 0) lab.instrument.effects.push_back(film(v[0], lab.instrument.dynamics));
+    if (!(v[0] > 0)) return;
+    const plant::Dynamics& d = lab.instrument.dynamics;
+    const double c0_per_s = 2 * d.pendulum_damping_ratio * 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+    lab.instrument.effects.push_back(
+        std::make_shared<plant::SqueezeFilmDamping>(1 / v[0], c0_per_s, d.angle_gain_rad_per_s2_per_g));
   };
   // The gap 1.0-1.2 mrad: the pendulum swings up to 1.01 mrad at 4 g (130 Hz; 0.998 mrad in
   // the 100 Hz runs), so these films are near contact; at 1.3 mrad and more the film's gap
