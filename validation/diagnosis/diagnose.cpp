@@ -22,11 +22,11 @@
 #include <boost/math/distributions/students_t.hpp>
 
 #include "rectification/prediction/frequency.hpp"
+#include "rectification/prediction/gradient.hpp"
 #include "rectification/prediction/random.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "vibration/excitation.hpp"
 #include "validation/diagnosis/gaussian_likelihood.hpp"
-#include "validation/reproduce/reproduce.hpp"
 
 namespace vrelab::validation {
 namespace {
@@ -280,7 +280,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       for (int i = 0; i < plant::kNumCoefficients; ++i) q[i] = co[i] + shift[i];
       return (*periodic)(q).total_g();
     };
-    const CoefArray g = prediction_gradient(f, nominal.coefficients);
+    const CoefArray g = rectification::prediction_gradient(f, nominal.coefficients);
     for (int i = 0; i < plant::kNumCoefficients; ++i) t.G(k, i) = g[i];
     t.pred(k) = f(nominal.coefficients);
   }
