@@ -20,6 +20,7 @@
 #include "app/commands.hpp"
 #include "io/formats/report.hpp"
 #include "rectification/prediction/eq3.hpp"
+#include "rectification/prediction/gradient.hpp"
 #include "support/instrument.hpp"
 #include "support/random_coefficients.hpp"
 #include "validation/reproduce/reproduce.hpp"
@@ -58,7 +59,7 @@ TEST(PredictionUncertainty, GradientIsExactAndSigmaMatchesMonteCarloOverTheCoeff
     for (int i = 0; i < kNumCoefficients; ++i)
       for (int j = 0; j < kNumCoefficients; ++j) cov[i][j] = S(i, j);
     // Eq. (3) is linear in the rectifying coefficients: f(c) = f(c0) + g . c exactly.
-    const CoefArray g = prediction_gradient(f, c);
+    const CoefArray g = rectification::prediction_gradient(f, c);
     Coefficients c0 = c;
     double lin = 0;
     for (int i : {k1_asym, k2, k3, k4, k_IP, k_IO, k_PO, k_PP, k_OO}) lin += g[i] * c[i], c0[i] = 0;

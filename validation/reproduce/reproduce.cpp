@@ -14,15 +14,13 @@
 #include "core/progress.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/prediction/frequency.hpp"
+#include "rectification/prediction/gradient.hpp"
 #include "rectification/simulation/sweep.hpp"
 
 namespace vrelab::validation {
 namespace {
 
 using plant::Coefficients;
-constexpr int kRectifying[] = {plant::k1_asym, plant::k2,   plant::k3,   plant::k4,  plant::k_IP,
-                               plant::k_IO,    plant::k_PO, plant::k_PP, plant::k_OO};
-
 vibration::SineVibration sine_of(const Vec3& direction, double amplitude_g, double frequency_Hz) {
   rectification::SweepCondition c;
   c.direction = direction, c.amplitude_g = amplitude_g, c.frequency_Hz = frequency_Hz;
@@ -114,25 +112,9 @@ double RunResult::combined_sigma_g() const {
   return std::sqrt(sigma_measured_g * sigma_measured_g + predicted.sigma_g * predicted.sigma_g);
 }
 
-CoefArray prediction_gradient(const Model& f, const Coefficients& c) {
-  Coefficients zero = c;
-  for (int i : kRectifying) zero[i] = 0.0;
-  const double f0 = f(zero);
-  CoefArray g{};
-  // The predictions are linear in these coefficients; the step only has to stay small
-  // enough for the plant (a model (1) term of 1e-6 per g^n is a small nonlinearity).
-  constexpr double h = 1e-6;
-  for (int i : kRectifying) {
-    Coefficients one = zero;
-    one[i] = h;
-    g[i] = (f(one) - f0) / h;
-  }
-  return g;
-}
-
 Prediction predict_with_uncertainty(const Model& f, const Coefficients& c,
                                     const std::array<CoefArray, plant::kNumCoefficients>& covariance) {
-  const CoefArray g = prediction_gradient(f, c);
+  const CoefArray g = rectification::prediction_gradient(f, c);
   double var = 0;
   for (int i = 0; i < plant::kNumCoefficients; ++i)
     for (int j = 0; j < plant::kNumCoefficients; ++j) var += g[i] * covariance[i][j] * g[j];
@@ -430,7 +412,7 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
       RunResult& r = inv.runs[static_cast<std::size_t>(k)];
       predict_run(r, nominal, cov);
       const vibration::SineVibration v = sine_of(r.direction_unit, r.amplitude_g, r.frequency_Hz);
-      const CoefArray g = prediction_gradient(
+      const CoefArray g = rectification::prediction_gradient(
           [&](const Coefficients& c) { return rectification::sine_rectification(c, r.orientation_g, v).total_g(); },
           out.identified);
       for (int i = 0; i < plant::kNumCoefficients; ++i) G(k, i) = g[i];

@@ -201,12 +201,8 @@ void predict_run(RunResult& r, const plant::PlantConfig& nominal,
 Prediction predicted_change(const RunResult& r, const RunResult& ref, const plant::PlantConfig& nominal,
                             const std::array<CoefArray, plant::kNumCoefficients>& covariance);
 
-// The gradient of a prediction that is linear in the rectifying coefficients (k1_asym, k2,
-// k3, k4, k_IP, k_IO, k_PO, k_PP, k_OO): g_i = f(c with only coefficient i = h) / h - f(0).
-// Other entries are 0.
-CoefArray prediction_gradient(const std::function<double(const plant::Coefficients&)>& f,
-                              const plant::Coefficients& c);
-// f(c) with the standard uncertainty sqrt(g^T Sigma g).
+// f(c) with the standard uncertainty sqrt(g^T Sigma g), g its gradient in the coefficients
+// (rectification/prediction/gradient.hpp).
 Prediction predict_with_uncertainty(const std::function<double(const plant::Coefficients&)>& f,
                                     const plant::Coefficients& c,
                                     const std::array<CoefArray, plant::kNumCoefficients>& covariance);

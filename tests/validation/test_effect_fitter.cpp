@@ -1,0 +1,290 @@
+// The effect fitter's numerics (validation/diagnosis/internal/effect_fitter.hpp) on synthetic
+// problems whose answer is known without the fitter: predictions linear in the parameters,
+// pred = f0 + S theta, with a constant coefficient gradient G, so that V = diag(s2) + G Sigma G^T
+// does not depend on the parameters and -2 ln L + the further parameters' priors is the
+// quadratic (r - S theta)^T V^-1 (r - S theta) + sum_j w_j (theta_j - nominal_j)^2 + const.
+// Its minimum and covariance are the generalised least squares solution with the priors as
+// pseudo-observations, computed here with Eigen in long double:
+//   theta* = (S^T V^-1 S + W)^-1 (S^T V^-1 r + W theta_nominal),  C = (S^T V^-1 S + W)^-1,
+// the covariance being the inverse of half the objective's Hessian, as the fitter defines it.
+// The cases: a two-parameter fit; a narrow valley (correlation below -0.998) from a start far off it;
+// a parameter whose optimum lies outside its range (it ends on the edge, at_bound); and held
+// parameters (a slope in the span of another's; a slope the data cannot pin within the prior).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "validation/diagnosis/effect.hpp"
+#include "validation/diagnosis/internal/effect_fitter.hpp"
+#include "validation/diagnosis/internal/likelihood.hpp"
+
+using namespace vrelab::validation;
+using namespace vrelab::validation::internal;
+
+namespace {
+
+using MatrixL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
+using VectorL = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
+
+// A synthetic campaign: n runs, the predictions f0 + S theta (g), two coefficient columns in G
+// with a correlated Sigma (V is not diagonal), measured = f0 + S theta_true + noise.
+struct Problem {
+  Eigen::VectorXd f0;
+  Eigen::MatrixXd S;  // n x k: d pred / d theta
+  Table nominal;
+  Data data;
+  std::vector<int> all;
+};
+
+Problem make_problem(const Eigen::MatrixXd& S, const Eigen::VectorXd& theta_true, unsigned seed) {
+  const Eigen::Index n = S.rows();
+  Problem p;
+  p.S = S;
+  p.f0.resize(n);
+  Eigen::MatrixXd G(n, 2);
+  p.data.sigma2.resize(n);
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n01;
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double x = 1 + 0.25 * static_cast<double>(k);
+    p.f0(k) = 1e-3 * x;
+    G(k, 0) = 1, G(k, 1) = x * x;
+    p.data.sigma2(k) = std::pow(0.05 * (1 + 0.1 * static_cast<double>(k % 3)), 2);
+  }
+  p.data.Sigma.resize(2, 2);
+  p.data.Sigma << 0.02 * 0.02, 0.5 * 0.02 * 0.003, 0.5 * 0.02 * 0.003, 0.003 * 0.003;
+  p.nominal = {p.f0, G};
+  // The measured values: the truth plus noise of V (the runs' own and the coefficients' shared).
+  const Eigen::MatrixXd Lc = p.data.Sigma.llt().matrixL();
+  Eigen::Vector2d c;
+  c << n01(rng), n01(rng);
+  const Eigen::VectorXd shared = G * (Lc * c);
+  p.data.measured.resize(n);
+  for (Eigen::Index k = 0; k < n; ++k) p.data.measured(k) = p.f0(k) + S.row(k).dot(theta_true) + shared(k) + std::sqrt(p.data.sigma2(k)) * n01(rng);
+  for (Eigen::Index k = 0; k < n; ++k) p.all.push_back(static_cast<int>(k));
+  return p;
+}
+
+// The model the fitter sees: the predictions at theta (one value per parameter), G constant.
+EffectFitter::TableAt model_of(const Problem& p) {
+  return [&p](const std::vector<double>& v) {
+    Eigen::VectorXd theta(static_cast<Eigen::Index>(v.size()));
+    for (std::size_t j = 0; j < v.size(); ++j) theta(static_cast<Eigen::Index>(j)) = v[j];
+    return Table{p.f0 + p.S * theta, p.nominal.G};
+  };
+}
+
+// The closed-form answer in long double: theta* and C (see the file's head). prior_weight[j]:
+// w_j (0 for the first parameter, which has no prior).
+struct Gls {
+  VectorL theta;
+  MatrixL cov;
+};
+Gls gls(const Problem& p, const std::vector<long double>& prior_weight, const std::vector<long double>& nominal) {
+  const Eigen::Index n = p.S.rows(), k = p.S.cols();
+  MatrixL V = (p.nominal.G * p.data.Sigma * p.nominal.G.transpose()).cast<long double>();
+  for (Eigen::Index i = 0; i < n; ++i) V(i, i) += p.data.sigma2(i);
+  const MatrixL S = p.S.cast<long double>();
+  const VectorL r = (p.data.measured - p.f0).cast<long double>();
+  const Eigen::LDLT<MatrixL> ldlt(V);
+  MatrixL A = S.transpose() * ldlt.solve(S);
+  VectorL b = S.transpose() * ldlt.solve(r);
+  for (Eigen::Index j = 0; j < k; ++j) {
+    A(j, j) += prior_weight[static_cast<std::size_t>(j)];
+    b(j) += prior_weight[static_cast<std::size_t>(j)] * nominal[static_cast<std::size_t>(j)];
+  }
+  Gls g;
+  g.cov = A.inverse();
+  g.theta = g.cov * b;
+  return g;
+}
+
+EffectParameter linear_first(double lower, double upper) {
+  EffectParameter q("size", "1");
+  q.nominal = 0, q.linear = true, q.unit_value = 1, q.lower = lower, q.upper = upper;
+  return q;
+}
+EffectParameter further(double lower, double upper, double prior_sigma, double step) {
+  EffectParameter q("form", "1");
+  q.nominal = 0, q.lower = lower, q.upper = upper, q.prior_sigma = prior_sigma, q.step = step;
+  return q;
+}
+
+Effect effect_of(std::vector<EffectParameter> parameters) {
+  Effect e;
+  e.name = "synthetic";
+  e.parameters = std::move(parameters);
+  e.hypothesis_accuracy = 0;
+  return e;
+}
+
+}  // namespace
+
+// One linear parameter: the fit (a scan, then parabolic refinement of an exactly quadratic
+// -2 ln L) and its sigma (the curvature's second difference) against GLS. The parabola through
+// three points of a quadratic lands on its vertex up to the rounding of -2 ln L (~1e-14 of
+// its ~100 size, moving the vertex by ~1e-12 sigma); 1e-6 sigma is a wide margin that a wrong
+// V (a dropped coefficient term shifts theta by ~0.1 sigma here) or a wrong sigma still fails.
+TEST(EffectFitter, OneParameterEqualsGeneralisedLeastSquares) {
+  Eigen::MatrixXd S(20, 1);
+  for (Eigen::Index k = 0; k < 20; ++k) S(k, 0) = 0.1 * std::sin(0.7 * static_cast<double>(k)) + 0.02 * static_cast<double>(k);
+  Eigen::VectorXd truth(1);
+  truth << 1.5;
+  const Problem p = make_problem(S, truth, 11);
+  const Effect e = effect_of({linear_first(-100, 100)});
+  const EffectFitter fitter(e, p.nominal, model_of(p));
+  const EffectFitter::Multi mf = fitter.fit_all(p.data, p.all);
+  const Gls g = gls(p, {0}, {0});
+  const double sigma = std::sqrt(static_cast<double>(g.cov(0, 0)));
+  ASSERT_EQ(mf.values.size(), 1u);
+  EXPECT_NEAR(mf.values[0], static_cast<double>(g.theta(0)), 1e-6 * sigma);
+  EXPECT_NEAR(mf.sigma[0], sigma, 1e-6 * sigma);
+  EXPECT_EQ(mf.status[0], "fitted");
+  // The same fit through fit(): the one-parameter path.
+  const auto [value, s] = fitter.fit(p.data, p.all);
+  EXPECT_EQ(value, mf.values[0]);
+  EXPECT_EQ(s, mf.sigma[0]);
+}
+
+// Two parameters (the first linear, a further continuous one with a weak prior): Levenberg-
+// Marquardt's end and the Hessian covariance against GLS with the prior. Tolerances: the
+// descent stops when every move is below 1e-3 of the parameter's conditional sigma, and each of
+// its nearly Newton steps (lambda <= 1e-3) leaves much less than the move it made, so 1e-3 of
+// the marginal sigma bounds the values' error; the covariance is a second difference of an
+// exact quadratic (rounding ~1e-12 relative), checked to 1e-6.
+TEST(EffectFitter, TwoParametersEqualGeneralisedLeastSquaresWithThePrior) {
+  Eigen::MatrixXd S(24, 2);
+  for (Eigen::Index k = 0; k < 24; ++k) {
+    const double x = static_cast<double>(k);
+    S(k, 0) = 0.05 + 0.01 * x, S(k, 1) = 0.08 * std::cos(0.5 * x);
+  }
+  Eigen::VectorXd truth(2);
+  truth << 2.0, -1.0;
+  const Problem p = make_problem(S, truth, 12);
+  const double prior_sigma = 5;
+  const Effect e = effect_of({linear_first(-100, 100), further(-20, 20, prior_sigma, 1e-3)});
+  const EffectFitter fitter(e, p.nominal, model_of(p));
+  const EffectFitter::Multi mf = fitter.fit_all(p.data, p.all);
+  const Gls g = gls(p, {0, 1 / (static_cast<long double>(prior_sigma) * prior_sigma)}, {0, 0});
+  ASSERT_EQ(mf.status.size(), 2u);
+  EXPECT_EQ(mf.status[0], "fitted");
+  EXPECT_EQ(mf.status[1], "fitted");
+  ASSERT_EQ(mf.cov.rows(), 2);
+  for (int j = 0; j < 2; ++j) {
+    const double sj = std::sqrt(static_cast<double>(g.cov(j, j)));
+    EXPECT_NEAR(mf.values[static_cast<std::size_t>(j)], static_cast<double>(g.theta(j)), 1e-3 * sj) << "parameter " << j;
+    EXPECT_NEAR(mf.sigma[static_cast<std::size_t>(j)], sj, 1e-6 * sj) << "parameter " << j;
+    for (int i = 0; i < 2; ++i)
+      EXPECT_NEAR(mf.cov(i, j), static_cast<double>(g.cov(i, j)), 1e-6 * std::sqrt(static_cast<double>(g.cov(i, i) * g.cov(j, j))));
+  }
+}
+
+// A narrow valley: the two slopes nearly collinear, the estimates correlated beyond -0.998
+// (checked on the closed form), and the further parameter's difference step (0.5) more than
+// twice its conditional sigma, where differences straddle the valley (the valley step's case).
+// The start, the first parameter fitted with the second at its nominal 0, lies far off the
+// optimum (the truth 40 is ~20 marginal sigma from 0; asserted: -2 ln L at the start exceeds
+// the minimum by more than 100). The end must be the GLS
+// optimum: within 1e-3 of each marginal sigma (the descent's stopping rule, as above).
+TEST(EffectFitter, FindsTheOptimumOfANarrowValleyFromFarOff) {
+  const Eigen::Index n = 30;
+  Eigen::MatrixXd S(n, 2);
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double x = static_cast<double>(k) / static_cast<double>(n - 1);
+    S(k, 0) = 0.2 + 0.3 * x, S(k, 1) = 0.2 + 0.3 * x + 0.012 * std::sin(6 * x);
+  }
+  Eigen::VectorXd truth(2);
+  truth << 3.0, 40.0;
+  const Problem p = make_problem(S, truth, 13);
+  const double prior_sigma = 50;
+  const Effect e = effect_of({linear_first(-200, 200), further(-100, 100, prior_sigma, 0.5)});
+  const Gls g = gls(p, {0, 1 / (static_cast<long double>(prior_sigma) * prior_sigma)}, {0, 0});
+  const double s0 = std::sqrt(static_cast<double>(g.cov(0, 0))), s1 = std::sqrt(static_cast<double>(g.cov(1, 1)));
+  const double rho = static_cast<double>(g.cov(0, 1)) / (s0 * s1);
+  ASSERT_LT(rho, -0.998) << "the valley is not as narrow as the test says";
+  const double conditional_sigma1 = s1 * std::sqrt(1 - rho * rho);
+  ASSERT_GT(0.5, 2 * conditional_sigma1) << "the difference step does not straddle the valley";
+  const EffectFitter fitter(e, p.nominal, model_of(p));
+  // The start: the one-parameter fit at the second's nominal, and how far above the minimum it is.
+  const double p0_start = fitter.fit(p.data, p.all).first;
+  const auto objective = [&](double a, double b) {
+    const Eigen::VectorXd pred = p.f0 + p.S.col(0) * a + p.S.col(1) * b;
+    return likelihood(p.data, pred, p.nominal.G, p.all).m2logl + b * b / (prior_sigma * prior_sigma);
+  };
+  ASSERT_GT(objective(p0_start, 0) - objective(static_cast<double>(g.theta(0)), static_cast<double>(g.theta(1))), 100);
+  const EffectFitter::Multi mf = fitter.fit_all(p.data, p.all);
+  ASSERT_EQ(mf.status.size(), 2u);
+  EXPECT_EQ(mf.status[1], "fitted");
+  EXPECT_NEAR(mf.values[0], static_cast<double>(g.theta(0)), 1e-3 * s0);
+  EXPECT_NEAR(mf.values[1], static_cast<double>(g.theta(1)), 1e-3 * s1);
+  EXPECT_NEAR(mf.sigma[1], s1, 1e-3 * s1);
+}
+
+// The unconstrained optimum outside the range: the first parameter ends on its upper edge
+// (the scan's last point, lo + (hi - lo), equal to the edge up to one rounding), with no
+// curvature there (sigma not finite), and fitted_parameters reports at_bound.
+TEST(EffectFitter, AnOptimumBeyondTheRangeEndsOnItsEdge) {
+  Eigen::MatrixXd S(20, 1);
+  for (Eigen::Index k = 0; k < 20; ++k) S(k, 0) = 0.1 + 0.01 * static_cast<double>(k);
+  Eigen::VectorXd truth(1);
+  truth << 8.0;
+  const Problem p = make_problem(S, truth, 14);
+  const Gls g = gls(p, {0}, {0});
+  const double upper = 5;
+  // The optimum well beyond the edge (many sigma), so the edge is not a rounding matter.
+  ASSERT_GT(static_cast<double>(g.theta(0)) - upper, 5 * std::sqrt(static_cast<double>(g.cov(0, 0))));
+  const Effect e = effect_of({linear_first(-5, upper)});
+  const EffectFitter fitter(e, p.nominal, model_of(p));
+  const EffectFitter::Multi mf = fitter.fit_all(p.data, p.all);
+  EXPECT_NEAR(mf.values[0], upper, 1e-12 * upper);
+  EXPECT_FALSE(std::isfinite(mf.sigma[0]));
+  const std::vector<FittedParameter> fp = fitted_parameters(e, mf);
+  ASSERT_EQ(fp.size(), 1u);
+  EXPECT_TRUE(fp[0].at_bound);
+  EXPECT_EQ(fp[0].upper, upper);
+}
+
+// Held parameters (EffectFitter::unpinned): a further parameter whose slope is twice the
+// first's (in its span: the whitened Jacobian has rank 1) is held at its nominal, and the
+// result is the one-parameter fit (no covariance, the first parameter's GLS value). Likewise a
+// further parameter whose slope is so small that its sigma from the data (~8 here, computed
+// below) is not below its prior width (1): held.
+TEST(EffectFitter, HoldsAParameterTheDataDoNotPin) {
+  const Eigen::Index n = 20;
+  Eigen::MatrixXd S1(n, 1);
+  for (Eigen::Index k = 0; k < n; ++k) S1(k, 0) = 0.1 + 0.02 * static_cast<double>(k);
+  for (const bool collinear : {true, false}) {
+    Eigen::MatrixXd S(n, 2);
+    S.col(0) = S1.col(0);
+    for (Eigen::Index k = 0; k < n; ++k) S(k, 1) = collinear ? 2 * S1(k, 0) : 1e-3 * std::cos(static_cast<double>(k));
+    Eigen::VectorXd truth(2);
+    truth << 1.0, 0.0;
+    const Problem p = make_problem(S, truth, 15);
+    const double prior_sigma = 1;
+    const Effect e = effect_of({linear_first(-100, 100), further(-4, 4, prior_sigma, 1e-3)});
+    if (!collinear) {  // the data alone leave the slope's parameter looser than its prior
+      const Problem q = make_problem(S, truth, 15);
+      const Gls data_only = gls(q, {0, 0}, {0, 0});
+      ASSERT_GT(std::sqrt(static_cast<double>(data_only.cov(1, 1))), prior_sigma);
+    }
+    const EffectFitter fitter(e, p.nominal, model_of(p));
+    const EffectFitter::Multi mf = fitter.fit_all(p.data, p.all);
+    ASSERT_EQ(mf.status.size(), 2u);
+    EXPECT_EQ(mf.status[1], "held") << (collinear ? "collinear" : "loose");
+    EXPECT_EQ(mf.values[1], 0.0);
+    EXPECT_TRUE(std::isnan(mf.sigma[1]));
+    EXPECT_EQ(mf.cov.size(), 0);
+    // The one-parameter fit: GLS on the first slope alone (1e-6 sigma: as in the first test).
+    Problem first_only = p;
+    first_only.S = S1;
+    const Gls g = gls(first_only, {0}, {0});
+    const double sigma = std::sqrt(static_cast<double>(g.cov(0, 0)));
+    EXPECT_NEAR(mf.values[0], static_cast<double>(g.theta(0)), 1e-6 * sigma);
+    EXPECT_NEAR(mf.sigma[0], sigma, 1e-6 * sigma);
+  }
+}

@@ -1,0 +1,170 @@
+#include "validation/diagnosis/internal/evidence.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <stdexcept>
+
+#include "validation/diagnosis/internal/tabulate.hpp"
+
+namespace vrelab::validation::internal {
+
+std::vector<int> Folds::train(double k) const {
+  std::vector<int> t;
+  for (std::size_t j = 0; j < key.size(); ++j)
+    if (key[j] != k) t.push_back(static_cast<int>(j));
+  if (t.empty())
+    for (std::size_t j = 0; j < key.size(); ++j) t.push_back(static_cast<int>(j));
+  return t;
+}
+
+Folds folds_of(const std::vector<RunRecord>& runs) {
+  std::set<double> amplitudes, frequencies;
+  for (const auto& run : runs) amplitudes.insert(run.amplitude_g), frequencies.insert(run.frequency_Hz);
+  const bool by_amplitude = amplitudes.size() >= 2, by_frequency = !by_amplitude && frequencies.size() >= 2;
+  Folds f;
+  f.description = by_amplitude ? "leave one amplitude out" : by_frequency ? "leave one frequency out" : "none (in-sample: one amplitude, one frequency)";
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    f.key.push_back(by_amplitude ? runs[k].amplitude_g : by_frequency ? runs[k].frequency_Hz : 0.0);
+    f.test[f.key.back()].push_back(static_cast<int>(k));
+  }
+  return f;
+}
+
+void note_measured_motion(const Campaign& c, Diagnosis& d) {
+{
+  int sine_runs = 0, measured_sine_runs = 0;
+  for (const RunRecord& r : c.runs) {
+    if (motion_used(r)) ++d.runs_with_measured_motion;
+    if (!r.random) ++sine_runs, measured_sine_runs += motion_used(r) ? 1 : 0;
+  }
+  if (sine_runs > 0 && measured_sine_runs == sine_runs)
+    for (const Effect& e : effect_library())
+      if (e.acts_on == ActsOn::table_motion) d.measured_effects.push_back(e.name);
+}
+}
+
+Likelihood Scorer::conditional_on(const Data& dd, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G,
+                                  const std::vector<int>& train) const {
+  const Likelihood l_all = likelihood(dd, pred, G, m_.all), l_train = likelihood(dd, pred, G, train);
+  return Likelihood{l_all.m2logl - l_train.m2logl, l_all.chi2 - l_train.chi2};
+}
+
+void Scorer::score(const std::function<Fitted(const std::vector<int>&)>& fit_on, Scored& sc) const {
+  const Data& data = m_.data;
+  const Table& nominal = m_.nominal;
+  const std::vector<int>& all = m_.all;
+  const int n = m_.n;
+  sc.heldout = Eigen::VectorXd::Zero(n);
+  for (const auto& [key, test] : folds_.test) {
+    const std::vector<int> train = folds_.train(key);
+    const Fitted f = fit_on(train);
+    Likelihood with;
+    if (train.size() == all.size()) {
+      with = likelihood(data, f.t.pred, f.t.G, all);
+    } else {
+      const Eigen::Index k = f.cov.rows(), m = plant::kNumCoefficients;
+      Data da = data;
+      da.Sigma = Eigen::MatrixXd::Zero(m + k, m + k);
+      da.Sigma.topLeftCorner(m, m) = data.Sigma;
+      da.Sigma.bottomRightCorner(k, k) = f.cov;
+      Eigen::MatrixXd Ga(n, m + k);
+      Ga << f.t.G, f.slopes;
+      with = conditional_on(da, f.t.pred, Ga, train);
+    }
+    auto known = nominal_heldout_.find(key);
+    if (known == nominal_heldout_.end())
+      known = nominal_heldout_
+                  .emplace(key, train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all) : conditional_on(data, nominal.pred, nominal.G, train))
+                  .first;
+    const Likelihood without = known->second;
+    sc.fit.evidence += without.m2logl - with.m2logl;
+    sc.fit.heldout_chi2 += with.chi2;
+    const Eigen::VectorXd a = adjusted_residual(data, f.t.pred, f.t.G, train, test);
+    for (std::size_t i = 0; i < test.size(); ++i) sc.heldout(test[i]) = a(static_cast<Eigen::Index>(i));
+  }
+}
+
+Fitted Scorer::fitted_at(const EffectFitter& fitter, double p, double sp) const {
+  const int n = m_.n;
+  Fitted f{fitter.at(p), Eigen::MatrixXd(n, 0), Eigen::MatrixXd(0, 0)};
+  if (std::isfinite(sp) && sp > 0) {
+    f.slopes = fitter.slope(p, sp);
+    f.cov = Eigen::MatrixXd::Constant(1, 1, sp * sp);
+  }
+  return f;
+}
+
+Fitted Scorer::fitted_multi(const EffectFitter& fitter, const EffectFitter::Multi& mf) const {
+  const int n = m_.n;
+  if (mf.cov.size() == 0) {
+    if (mf.values.size() > 1 && mf.status.size() > 1 &&
+        std::any_of(mf.status.begin() + 1, mf.status.end(), [](const std::string& x) { return x != "held"; })) {
+      // A discrete parameter chosen, the first fitted at it: its slope at that value.
+      Fitted f{fitter.at(mf.values), Eigen::MatrixXd(n, 0), Eigen::MatrixXd(0, 0)};
+      const double sp = mf.sigma.front();
+      if (std::isfinite(sp) && sp > 0) {
+        std::vector<double> up = mf.values, down = mf.values;
+        up.front() += sp, down.front() -= sp;
+        try {
+          f.slopes = (fitter.at(up).pred - fitter.at(down).pred) / (2 * sp);
+          f.cov = Eigen::MatrixXd::Constant(1, 1, sp * sp);
+        } catch (const std::invalid_argument&) {
+          f.slopes = Eigen::MatrixXd(n, 0);
+        }
+      }
+      return f;
+    }
+    return fitted_at(fitter, mf.values.front(), mf.sigma.front());
+  }
+  return Fitted{fitter.at(mf.values), mf.slopes, mf.cov};
+}
+
+void heldout_nominal(const CampaignModel& m, Evidence& ev, Diagnosis& d) {
+  ev.folds = folds_of(m.campaign.runs);
+  d.folds = ev.folds.description;
+  const int n = m.n;
+  const Data& data = m.data;
+  const Table& nominal = m.nominal;
+  Eigen::VectorXd& heldout_nominal = ev.heldout_nominal;
+  heldout_nominal = Eigen::VectorXd::Zero(n);
+  for (const auto& [key, test] : ev.folds.test) {
+    const Eigen::VectorXd a = adjusted_residual(data, nominal.pred, nominal.G, ev.folds.train(key), test);
+    for (std::size_t i = 0; i < test.size(); ++i) heldout_nominal(test[i]) = a(static_cast<Eigen::Index>(i));
+  }
+}
+
+void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, Diagnosis& d) {
+  const Data& data = m.data;
+  const std::vector<int>& all = m.all;
+  std::map<std::string, std::unique_ptr<EffectFitter>>& fitters = ev.fitters;
+  std::vector<Scored>& scored = ev.scored;
+  const auto fitted_one = [&](const EffectFitter& fitter, const Data& dd, const std::vector<int>& runs) {
+    return scorer.fitted_multi(fitter, fitter.fit_all(dd, runs));
+  };
+  for (const Effect& e : effect_library()) {
+    if (std::find(d.measured_effects.begin(), d.measured_effects.end(), e.name) != d.measured_effects.end()) continue;
+    const EffectFitter& fitter = *(fitters[e.name] = std::make_unique<EffectFitter>(make_effect_fitter(e, m.nominal, m.plant, m.campaign.runs, m.cache, m.absorbed)));
+    Scored sc;
+    sc.fit.name = e.name, sc.fit.parameter = e.fitted().name, sc.fit.unit = e.fitted().unit;
+    scorer.score([&](const std::vector<int>& runs) { return fitted_one(fitter, data, runs); }, sc);
+    EffectFitter::Multi mf = fitter.fit_all(data, all);
+    fitter.add_model_error(data, all, mf);
+    const double p = mf.values.front(), sp = mf.sigma.front();
+    sc.fit.value = p, sc.fit.sigma = sp;
+    sc.fit.at_bound = !std::isfinite(sp);
+    sc.fit.parameters = fitted_parameters(e, mf);
+    sc.all = std::move(mf);
+    scored.push_back(std::move(sc));
+  }
+  // An effect whose held-out evidence or chi^2 is not a finite number (a fold's -2 ln L not
+  // finite) is no candidate: listed after the ranked ones with why, never chosen.
+  for (Scored& sc : scored)
+    if (!std::isfinite(sc.fit.evidence) || !std::isfinite(sc.fit.heldout_chi2))
+      sc.fit.not_ranked = "its held-out evidence or chi^2 is not a finite number";
+  const auto ranked_end = std::stable_partition(scored.begin(), scored.end(), [](const Scored& a) { return a.fit.not_ranked.empty(); });
+  std::sort(scored.begin(), ranked_end, [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
+  for (const auto& sc : scored) d.effects.push_back(sc.fit);
+}
+
+}  // namespace vrelab::validation::internal

@@ -1,0 +1,23 @@
+#pragma once
+// validation/diagnosis/internal/gap.hpp -- the diagnosis' second stage: where the gap between
+// the nominal simulation and the runs lies, and whether it is significant.
+//
+// Takes: the campaign model (identification.hpp: the runs' data, the nominal table) and the
+//        settings' significance level (sigma).
+// Gives: in the Diagnosis, per run the nominal prediction and its sigma from the coefficients
+//        (g), the gap measured - predicted and its sigma (V's diagonal, g), the gap the
+//        coefficient errors cannot take up (g) and its z in the run's own sigma; the nominal
+//        chi^2, the significant runs, the largest |z| and where it is, the gap's power laws in
+//        amplitude and frequency (pooled within groups), the rms z per direction, the share odd
+//        in the static a_IA, the `where` summary and gap_significant (a run beyond the level,
+//        or chi^2 as a normal deviate beyond it). Returns the gap r = measured - predicted (g).
+#include <Eigen/Dense>
+
+#include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/internal/identification.hpp"
+
+namespace vrelab::validation::internal {
+
+Eigen::VectorXd locate_gap(const CampaignModel& m, Diagnosis& d);
+
+}  // namespace vrelab::validation::internal

@@ -1,0 +1,77 @@
+#include "validation/diagnosis/internal/response_cache.hpp"
+
+#include <complex>
+#include <numbers>
+#include <stdexcept>
+
+namespace vrelab::validation::internal {
+
+using plant::PlantConfig;
+
+void ResponseCache::bind(const PlantConfig& plant) {
+  const bool same = bound_ && plant.coefficients.v == plant_.coefficients.v && key(plant.dynamics) == key(plant_.dynamics);
+  if (same) return;
+  plant_ = plant, bound_ = true;
+  tables_.clear(), absorbed_.clear(), cache_.clear(), responders_.clear();
+}
+
+const rectification::LoopResponse& ResponseCache::get(const PlantConfig& cfg, const std::string& key, double f) {
+  // (By key, then frequency: the key is not copied for every look-up.)
+  auto by_key = cache_.find(key);
+  if (by_key == cache_.end()) by_key = cache_.emplace(key, std::map<double, rectification::LoopResponse>()).first;
+  auto it = by_key->second.find(f);
+  if (it == by_key->second.end()) {
+    if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+    if (cfg.servo) {
+      it = by_key->second.emplace(f, responder(cfg, key)(f)).first;
+    } else {
+      PlantConfig with_servo = cfg;
+      with_servo.servo = servo(cfg.dynamics);
+      it = by_key->second.emplace(f, responder(with_servo, key)(f)).first;
+    }
+  }
+  return it->second;
+}
+
+ResponseCache::DynamicsKey ResponseCache::key(const plant::Dynamics& d) {
+  return {d.pendulum_frequency_Hz, d.pendulum_damping_ratio, d.angle_gain_rad_per_s2_per_g, d.loop_bandwidth_Hz,
+          d.phase_margin_deg,      d.integrator,             d.integrator_zero_ratio,       d.antialias_Hz};
+}
+
+const plant::Servo& ResponseCache::servo(const plant::Dynamics& d) {
+  const DynamicsKey k = key(d);
+  auto it = servos_.find(k);
+  if (it == servos_.end()) it = servos_.emplace(k, plant::design_servo(d)).first;
+  return it->second;
+}
+
+// What loop_response reads of a plant (with its servo): the coefficients its linear plant
+// keeps, the locations, the dynamics, the servo, and the linear effects (their
+// transmissibility at a probe frequency; the key names the effect and its values).
+std::vector<double> ResponseCache::linear_part(const PlantConfig& cfg) {
+  std::vector<double> v;
+  for (int c : {plant::K1, plant::k0, plant::delta_OA, plant::delta_PA}) v.push_back(cfg.coefficients[c]);
+  for (const plant::Location l : cfg.location) v.push_back(static_cast<double>(l));
+  const DynamicsKey d = key(cfg.dynamics);
+  std::apply([&](auto... x) { (v.push_back(static_cast<double>(x)), ...); }, d);
+  v.push_back(cfg.torquer_c2_per_g), v.push_back(cfg.torquer_c3_per_g2);
+  const plant::Servo& sv = *cfg.servo;
+  for (double x : {sv.gain_g_per_rad, sv.lead_zero_rad_per_s, sv.lead_pole_rad_per_s, sv.integrator_rad_per_s}) v.push_back(x);
+  for (const auto& e : cfg.effects)
+    if (e->kept_in_linearisation()) {
+      for (int j = 0; j < 3; ++j) {
+        const std::complex<double> t = e->transmissibility(j, 2 * std::numbers::pi * 1234.5);
+        v.push_back(t.real()), v.push_back(t.imag());
+      }
+    }
+  return v;
+}
+
+const rectification::LoopResponder& ResponseCache::responder(const PlantConfig& cfg, const std::string& key) {
+  auto k = std::make_pair(key, linear_part(cfg));
+  auto it = responders_.find(k);
+  if (it == responders_.end()) it = responders_.emplace(k, std::make_unique<rectification::LoopResponder>(cfg)).first;
+  return *it->second;
+}
+
+}  // namespace vrelab::validation::internal

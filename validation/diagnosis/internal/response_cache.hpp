@@ -1,0 +1,67 @@
+#pragma once
+// validation/diagnosis/internal/response_cache.hpp -- the loop responses and tables the
+// diagnosis computes once per identified plant.
+//
+// Takes: the identified plant (coefficients and nominal dynamics), then per request a plant
+//        (the nominal one with an effect's hypothesis applied), a key naming the effect and
+//        its values, and a frequency (Hz).
+// Gives: the plant's loop response at that frequency (rectification::LoopResponse), computed
+//        once per (key, frequency) and per linear part of the plant, with the servo its
+//        dynamics imply designed once per dynamics; and the store of the run tables and of
+//        what the static test takes up (filled by tabulate and identification), forgotten when
+//        a different plant is bound.
+//
+// A plant without a servo of its own gets the one its dynamics imply, designed once per
+// dynamics here rather than in every loop_response (design_servo scans 3000 frequencies:
+// ~85 % of a diagnosis with random runs, whose PSD grid asks for hundreds of frequencies per
+// effect value). The servo is the same function of the same numbers, so the responses are bit
+// for bit those loop_response gives.
+#include <map>
+#include <memory>
+#include <string>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "plant/accelerometer.hpp"
+#include "rectification/prediction/frequency.hpp"
+#include "validation/diagnosis/internal/likelihood.hpp"
+
+namespace vrelab::validation::internal {
+
+// What the static test took up of an effect that acts at rest, per unit of (p - nominal)
+// (taken_up_by_static_test), by effect name: subtracted from the identified coefficients
+// under the effect.
+using Absorbed = std::map<std::string, plant::Coefficients>;
+
+class ResponseCache {
+ public:
+  // The tables (tabulate) and what the static test takes up, per effect and value, for one
+  // identified plant and one set of runs' physics (their sigma is not an input): the
+  // diagnose() wrapper's second pass (the sigma scaled) asks for the same ones again. bind()
+  // forgets everything when the plant differs from the one bound (exactly).
+  void bind(const plant::PlantConfig& plant);
+  std::map<std::string, std::shared_ptr<const Table>> tables_;
+  Absorbed absorbed_;
+
+  // (A response is computed for the first plant that asks for its key and frequency, as
+  // loop_response would compute it; the plant is linearised once for every frequency asked of
+  // a linear part alike (rectification::LoopResponder: the same numbers).)
+  const rectification::LoopResponse& get(const plant::PlantConfig& cfg, const std::string& key, double f);
+
+ private:
+  // Every field of plant::Dynamics (design_servo's only input).
+  using DynamicsKey = std::tuple<double, double, double, double, double, bool, double, double>;
+  static DynamicsKey key(const plant::Dynamics& d);
+  const plant::Servo& servo(const plant::Dynamics& d);
+  // What loop_response reads of a plant (with its servo).
+  static std::vector<double> linear_part(const plant::PlantConfig& cfg);
+  const rectification::LoopResponder& responder(const plant::PlantConfig& cfg, const std::string& key);
+  std::map<std::string, std::map<double, rectification::LoopResponse>, std::less<>> cache_;
+  std::map<std::pair<std::string, std::vector<double>>, std::unique_ptr<rectification::LoopResponder>> responders_;
+  std::map<DynamicsKey, plant::Servo> servos_;
+  plant::PlantConfig plant_;
+  bool bound_ = false;
+};
+
+}  // namespace vrelab::validation::internal

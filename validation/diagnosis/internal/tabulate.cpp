@@ -1,0 +1,255 @@
+#include "validation/diagnosis/internal/tabulate.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "rectification/prediction/frequency.hpp"
+#include "rectification/prediction/gradient.hpp"
+#include "rectification/prediction/random.hpp"
+
+namespace vrelab::validation {
+namespace internal {
+namespace {
+
+using plant::Coefficients;
+using plant::PlantConfig;
+
+// Random runs: the PSD integral on a grid of 0.1 in ln f shared by every table of the same
+// band (rectification/prediction/random.hpp, common_grid; 8 Gauss-Legendre points a piece):
+// the loop responses are then cached across runs. Within 1e-5 of the fine default on GEVS.
+const rectification::RandomQuadrature kRandomRunQuadrature{0.1, true};
+
+// The table's motion as the prediction takes it: a pure sine exactly, else one period of
+// the excitation resolved into harmonics.
+rectification::PeriodicInput periodic_input(const TableMotion& m, double frequency_Hz) {
+  return m.pure_sine() ? rectification::periodic_input(m.sine) : rectification::periodic_input(*m.excitation(), frequency_Hz);
+}
+
+// Reference channels (RunRecord::motion): a sine run's measured tones are its periodic input;
+// a random run's Welch PSD its random part. The table-motion effects are measured in such a
+// run, not applied to it.
+bool measured_sine(const RunRecord& r) { return r.motion && !r.motion->tones.empty(); }
+const vibration::RandomProfile& run_random(const RunRecord& r) {
+  return r.motion && r.motion->random ? *r.motion->random : *r.random;
+}
+rectification::PeriodicInput run_input(const RunRecord& r, const TableMotion& m) {
+  if (!measured_sine(r)) return periodic_input(m, r.frequency_Hz);
+  rectification::PeriodicInput in;
+  in.frequency_Hz = r.frequency_Hz;
+  in.tones = r.motion->tones;
+  return in;
+}
+// (values: every parameter of e.) A run whose table motion was measured (reference channels)
+// already holds what a table-motion effect does.
+void apply_effect(const Effect* e, ParameterValues values, const RunRecord& r, PlantConfig& cfg, TableMotion& m) {
+  if (!e || (motion_used(r) && e->acts_on == ActsOn::table_motion)) return;
+  e->apply(values, cfg, m);  // a random run: what the effect does to the table's motion is not applied
+}
+
+Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e,
+                    const std::vector<double>& values, ResponseCache& cache, const Absorbed& absorbed);
+
+}  // namespace
+
+bool motion_used(const RunRecord& r) { return r.motion && r.motion->used(); }
+
+// The table of every run under (e, values), computed once per plant the cache is bound to.
+// (values: every parameter of e; empty without e.)
+Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e, const std::vector<double>& values,
+               ResponseCache& cache, const Absorbed& absorbed) {
+  cache.bind(nominal);
+  std::string key = e ? e->name : std::string("(nominal)");
+  for (const double v : values) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "=%.17g", v);
+    key += buf;
+  }
+  const auto it = cache.tables_.find(key);
+  if (it != cache.tables_.end() && it->second->pred.size() == static_cast<Eigen::Index>(runs.size())) return *it->second;
+  auto t = std::make_shared<const Table>(tabulate_runs(nominal, runs, e, values, cache, absorbed));
+  cache.tables_[key] = t;
+  return *t;
+}
+
+namespace {
+Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e,
+                    const std::vector<double>& values, ResponseCache& cache, const Absorbed& absorbed) {
+  const double p = values.empty() ? 0.0 : values.front();
+  const int n = static_cast<int>(runs.size());
+  Table t{Eigen::VectorXd(n), Eigen::MatrixXd(n, plant::kNumCoefficients)};
+  std::map<std::string, std::pair<PlantConfig, rectification::PeriodicInput>> film_memo;
+  for (int k = 0; k < n; ++k) {
+    const RunRecord& r = runs[static_cast<std::size_t>(k)];
+    PlantConfig cfg = nominal;
+    TableMotion m = table_motion(r);
+    apply_effect(e, values, r, cfg, m);
+    const PlantConfig with_films = cfg;
+    // A film's linearisation and balance once per (plant, motion) in the table: runs that
+    // differ only in orientation share them (the same function of the same numbers).
+    const rectification::PeriodicInput motion = r.random ? rectification::PeriodicInput{} : run_input(r, m);
+    const std::string film_key = r.random ? std::string() : rectification::film_balance_key(with_films, m.sine, motion);
+    const auto memo = film_key.empty() ? film_memo.end() : film_memo.find(film_key);
+    if (memo != film_memo.end()) cfg = memo->second.first;
+    else if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
+    // The loop responses depend on the effect's value and, for an amplitude-dependent one,
+    // on the run: the key says both.
+    // (The name, a NUL and the numbers' bytes: the same numbers give the same key, as their
+    // %.17g text did, without formatting them for every run of every table.)
+    std::string key;
+    if (e && e->changes_dynamics) {
+      key = e->name;
+      key += '\0';
+      const auto put = [&key](double x) { key.append(reinterpret_cast<const char*>(&x), sizeof x); };
+      put(p), put(cfg.dynamics.pendulum_damping_ratio);
+      for (std::size_t j = 1; j < values.size(); ++j) put(values[j]);
+    }
+    // A squeeze film's linearised plant is this run's own (its damping is in the key): its
+    // responses are kept for the run only, not in the cache (the same numbers: the plant
+    // linearised once, each frequency solved once).
+    const bool own = cfg.dynamics.pendulum_damping_ratio != with_films.dynamics.pendulum_damping_ratio && cfg.servo;
+    std::optional<rectification::LoopResponder> own_responder;
+    std::map<double, rectification::LoopResponse> own_responses;
+    const rectification::ResponseAt h = [&](double f) {
+      if (!own) return cache.get(cfg, key, f);
+      auto it = own_responses.find(f);
+      if (it == own_responses.end()) {
+        if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+        if (!own_responder) own_responder.emplace(cfg);
+        it = own_responses.emplace(f, (*own_responder)(f)).first;
+      }
+      return it->second;
+    };
+    const rectification::PeriodicInput input = r.random                  ? rectification::PeriodicInput{}
+                                               : memo != film_memo.end() ? memo->second.second
+                                                                         : rectification::film_harmonic_balance(with_films, cfg, motion, h);
+    if (!film_key.empty() && memo == film_memo.end()) film_memo.emplace(film_key, std::make_pair(cfg, input));
+    // A random or sine-on-random run: the random part's covariances through the loop, once.
+    std::optional<rectification::RandomResponse> rr;
+    std::optional<vibration::SineVibration> sine;
+    std::optional<rectification::LoopResponse> sine_h;
+    if (r.random) {
+      rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature);
+      if (r.sine_part) sine = measured_sine(r) ? m.sine : r.vibration(), sine_h = h(r.frequency_Hz);
+    }
+    // Coefficients as identified, then the effect's own change of them (if any) on top.
+    const Coefficients shift = [&] {
+      Coefficients z = nominal.coefficients;
+      for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] = cfg.coefficients[i] - nominal.coefficients[i];
+      if (e && e->acts_at_rest) {
+        for (int i = 0; i < plant::kNumCoefficients; ++i) z[i] -= (p - e->fitted().nominal) * absorbed.at(e->name)[i];
+      }
+      return z;
+    }();
+    // A periodic run: what does not depend on the coefficients (the motion through the loop,
+    // the period's averages) once for the gradient's 12 evaluations (the same numbers).
+    std::optional<rectification::PreparedPeriodicRectification> periodic;
+    if (!rr) periodic.emplace(cfg, r.orientation_g, input, h);
+    const auto f = [&](const Coefficients& co) {
+      if (rr) {
+        PlantConfig q = cfg;
+        for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
+        return rectification::random_rectification_at_frequency(q, r.orientation_g, *rr, sine, sine_h).total_g();
+      }
+      Coefficients q;
+      for (int i = 0; i < plant::kNumCoefficients; ++i) q[i] = co[i] + shift[i];
+      return (*periodic)(q).total_g();
+    };
+    const CoefArray g = rectification::prediction_gradient(f, nominal.coefficients);
+    for (int i = 0; i < plant::kNumCoefficients; ++i) t.G(k, i) = g[i];
+    t.pred(k) = f(nominal.coefficients);
+  }
+  return t;
+}
+}  // namespace
+
+// At one value of the effect's first parameter, the others nominal.
+Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e, double p,
+               ResponseCache& cache, const Absorbed& absorbed) {
+  return tabulate(nominal, runs, e, e ? e->values_at(p) : std::vector<double>{}, cache, absorbed);
+}
+
+}  // namespace internal
+
+using plant::Coefficients;
+using plant::PlantConfig;
+using internal::apply_effect;
+using internal::measured_sine;
+using internal::run_input;
+using internal::run_random;
+using internal::kRandomRunQuadrature;
+
+TableMotion table_motion(const RunRecord& r) {
+  TableMotion m;
+  m.sine = r.vibration();
+  if (r.motion && !r.motion->tones.empty()) {
+    // The measured fundamental (transverse parts included); its harmonics are in run_input.
+    for (const auto& [h, W] : r.motion->tones)
+      if (h == 1)
+        for (int i = 0; i < 3; ++i) m.sine.amplitude_g[i] = std::abs(W[i]), m.sine.phase_rad[i] = std::arg(W[i]);
+  }
+  m.commanded_amplitude_g = r.amplitude_g;
+  m.static_gravity_g = r.orientation_g;
+  return m;
+}
+
+vibration::SineVibration RunRecord::vibration() const {
+  vibration::SineVibration v;
+  for (int i = 0; i < 3; ++i) {
+    v.amplitude_g[i] = amplitude_g * std::abs(direction[i]);
+    v.phase_rad[i] = direction[i] < 0 ? std::numbers::pi : 0.0;
+  }
+  v.frequency_Hz = frequency_Hz;
+  return v;
+}
+
+namespace {
+double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effect* e, ParameterValues values);
+}  // namespace
+
+double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effect* e, double p) {
+  const std::vector<double> v = e ? e->values_at(p) : std::vector<double>{};
+  return predict_values(nominal, r, e, v);
+}
+
+double predict_run_g(const PlantConfig& nominal, const RunRecord& r, const Effect& e, ParameterValues values) {
+  return predict_values(nominal, r, &e, values);
+}
+
+namespace {
+double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effect* e, ParameterValues values) {
+  PlantConfig cfg = nominal;
+  TableMotion m = table_motion(r);
+  apply_effect(e, values, r, cfg, m);
+  const PlantConfig with_films = cfg;
+  if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
+  std::map<double, rectification::LoopResponse> responses;
+  std::optional<PlantConfig> loop_cfg;  // cfg with its servo designed once (ResponseCache)
+  const rectification::ResponseAt h = [&](double f) {
+    auto it = responses.find(f);
+    if (it == responses.end()) {
+      if (!loop_cfg) {
+        loop_cfg = cfg;
+        if (!loop_cfg->servo) loop_cfg->servo = plant::design_servo(cfg.dynamics);
+      }
+      it = responses.emplace(f, rectification::loop_response(*loop_cfg, f)).first;
+    }
+    return it->second;
+  };
+  if (r.random) {
+    const rectification::RandomResponse rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature);
+    std::optional<vibration::SineVibration> sine;
+    std::optional<rectification::LoopResponse> sine_h;
+    if (r.sine_part) sine = measured_sine(r) ? m.sine : r.vibration(), sine_h = h(r.frequency_Hz);
+    return rectification::random_rectification_at_frequency(cfg, r.orientation_g, rr, sine, sine_h).total_g();
+  }
+  return rectification::periodic_rectification(cfg, r.orientation_g, rectification::film_harmonic_balance(with_films, cfg, run_input(r, m), h), h)
+      .total_g();
+}
+}  // namespace
+
+}  // namespace vrelab::validation

@@ -1,0 +1,34 @@
+#pragma once
+// validation/diagnosis/internal/verdict.hpp -- the diagnosis' fourth stage: which effect (or
+// pair of effects) explains the gap, and how sure that is.
+//
+// Takes: the campaign model, the evidence stage's ranked candidates and fitters, its scorer,
+//        and the Diagnosis with the gap stage's significance and the nominal's held-out gap.
+// Gives: in the Diagnosis, the targeted test (an effect's held-out evidence beyond the
+//        significance level makes the gap significant), the shrinkage before and after, the
+//        pairs tried when no one effect explains a significant gap, the chosen candidate, the
+//        verdict ("no significant gap", "explained by <name>", "not explained by any known
+//        effect", "ambiguous between ..."), the effects tied with the chosen one, and the
+//        reported effects' sigma widened by their held parameters. Returns the chosen
+//        effect(s), each with its values (one per parameter).
+#include <utility>
+#include <vector>
+
+#include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/internal/evidence.hpp"
+#include "validation/diagnosis/internal/identification.hpp"
+
+namespace vrelab::validation::internal {
+
+using Chosen = std::vector<std::pair<const Effect*, std::vector<double>>>;
+
+// A candidate explains the gap: ranked, held-out evidence beyond significance_sigma^2, and
+// either its held-out chi^2 as a normal deviate below significance_sigma or its held-out gap
+// rms (rms_after_g) at most (1 - explained_shrinkage) of the nominal's (rms_before_g). The
+// held-out gap rms need not shrink: the adjusted residuals leave out the runs' correlations and
+// can grow while chi^2 falls (docs/diagnose.md).
+bool explains(const Scored& sc, double rms_after_g, double rms_before_g, int n, const DiagnoseSettings& s);
+
+Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, Diagnosis& d);
+
+}  // namespace vrelab::validation::internal
