@@ -66,11 +66,11 @@ namespace {
 // reads them back instead of running them again (a killed run resumes; --n may grow); a
 // line whose checksum fails (cut short, edited) is run again.
 std::string blind_header(const validation::BlindSettings& s) {
-  const auto& d = s.diagnose;
-  return fmt::format("# vrelab {} ({}) blind: campaigns diagnosed (index, result, checksum); seed {} model_accuracy {:.17g} "
-                     "significance_sigma {:.17g} explained_shrinkage {:.17g} resimulate_runs {} try_pairs {}\n",
-                     kProgramVersion, kGitDescribe, s.seed, d.model_accuracy, d.significance_sigma, d.explained_shrinkage,
-                     d.resimulate_runs, d.try_pairs);
+  std::string text = fmt::format("# vrelab {} ({}) blind: campaigns diagnosed (index, result, checksum); seed {}",
+                                 kProgramVersion, kGitDescribe, s.seed);
+  core::for_each_field<validation::DiagnoseSettings>(
+      [&](const auto& f) { text += fmt::format(" {} {}", f.name, core::format_value(s.diagnose.*f.member, 17)); });
+  return text + "\n";
 }
 
 std::string line_checksum(const std::string& text) {

@@ -18,6 +18,7 @@
 #endif
 
 #include "app/commands.hpp"
+#include "app/settings_cli.hpp"
 #include "core/dispatch.hpp"
 #ifdef VRELAB_HAVE_MPI
 #include "core/mpi.hpp"
@@ -223,15 +224,8 @@ Command add_diagnose(CLI::App& app) {
   cmd->add_option("--report", o.report_dir, "Write report.md, report.html and diagnosis.json to this folder");
   cmd->add_flag("--check", o.check,
                 "Read and check the folder only (every file, run and setting; exit 2 naming what is bad); no diagnosis");
-  // DiagnoseSettings over the manifest's [diagnose] (docs/data-format.md).
-  cmd->add_option("--significance-sigma", o.settings.significance_sigma,
-                  "A gap is significant beyond this many sigma (5)");
-  cmd->add_option("--model-accuracy", o.settings.model_accuracy, "The simulation's relative accuracy (0.002)");
-  cmd->add_option("--explained-shrinkage", o.settings.explained_shrinkage,
-                  "Held-out gap rms share an effect must remove to explain the gap (0.9)");
-  cmd->add_option("--resimulate-runs", o.settings.resimulate_runs, "Runs re-simulated on the ODE plant (12; 0: none)");
-  cmd->add_flag_callback(
-      "--no-pairs", [&o] { o.settings.try_pairs = false; }, "Do not try two effects at once");
+  // DiagnoseSettings over the manifest's [diagnose] (docs/data-format.md): a flag per field.
+  add_override_flags(cmd, o.settings);
   return {cmd,
           [owned] {
             DiagnoseOptions& d = *owned;
@@ -253,11 +247,9 @@ Command add_blind(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand("blind",
                                      "Campaigns with random hidden effects, "
                                      "diagnosed without their keys, then scored");
-  cmd->add_option("--n", o.settings.n, "Number of campaigns")->capture_default_str();
-  cmd->add_option("--seed", o.settings.seed, "Seed of the draw")->capture_default_str();
+  add_settings_flags(cmd, o.settings);  // --n, --seed, --threads (BlindSettings' fields)
   cmd->add_option("--out", o.out_dir, "Output folder (scores.json, confusion.csv; campaigns.txt: a rerun resumes)")
       ->capture_default_str();
-  cmd->add_option("--threads", o.settings.threads, "Threads (0: all cores; under mpirun per rank, 0 = 1)");
   cmd->add_flag_callback(
       "--no-progress", [&o] { o.progress = false; }, "No progress bar");
   return {cmd,

@@ -25,6 +25,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #include <pybind11/numpy.h>
@@ -276,6 +277,73 @@ auto interruptible(F&& f) -> decltype(f()) {
   if (interrupted) throw py::error_already_set();
   if (failure) std::rethrow_exception(failure);
   return std::move(*result);
+}
+
+template <class T>
+const char* py_type_name() {
+  if constexpr (std::is_same_v<T, bool>) return "bool";
+  else if constexpr (std::is_integral_v<T>) return "int";
+  else return "float";
+}
+
+// Keywords onto DiagnoseSettings overrides: each a field of the description (None: not
+// given); an unknown keyword or a value of the wrong type raises TypeError.
+io::DiagnoseOverrides diagnose_overrides(const char* function, const py::kwargs& kw) {
+  io::DiagnoseOverrides o;
+  for (auto item : kw) {
+    const std::string key = py::str(item.first);
+    const py::handle v = item.second;
+    bool known = false;
+    core::for_each_field<validation::DiagnoseSettings>([&](const auto& f) {
+      using T = typename std::decay_t<decltype(f)>::Type;
+      if (f.name != key) return;
+      known = true;
+      if (v.is_none()) return;
+      const bool ok = std::is_same_v<T, bool> ? py::isinstance<py::bool_>(v)
+                                              : !py::isinstance<py::bool_>(v) && (std::is_integral_v<T> ? py::isinstance<py::int_>(v)
+                                                                                                        : py::isinstance<py::float_>(v) || py::isinstance<py::int_>(v));
+      if (!ok)
+        throw py::type_error(std::string(function) + "(): " + key + " takes a " + py_type_name<T>() + ", got " +
+                             std::string(Py_TYPE(v.ptr())->tp_name));
+      o.set(f.member, v.cast<T>());
+    });
+    if (!known) throw py::type_error(std::string(function) + "() got an unexpected keyword argument '" + key + "'");
+  }
+  return o;
+}
+
+// The keywords' section of diagnose's docstring.
+std::string diagnose_keywords_doc() {
+  const validation::DiagnoseSettings d;
+  std::string doc = "Keywords (the diagnosis' settings, docs/diagnose.md):\n";
+  core::for_each_field<validation::DiagnoseSettings>([&](const auto& f) {
+    using T = typename std::decay_t<decltype(f)>::Type;
+    doc += "  " + std::string(f.name) + " (" + py_type_name<T>() + ", default " + core::format_value(d.*f.member);
+    if (f.range.has_min || f.range.has_max) doc += "; " + core::range_text(f.range, f.unit);
+    doc += "): " + std::string(f.help) + "\n";
+  });
+  return doc;
+}
+
+// DiagnoseSettings' description as a list of dicts (the Python tests iterate it).
+py::list diagnose_settings_description() {
+  const validation::DiagnoseSettings d;
+  py::list out;
+  core::for_each_field<validation::DiagnoseSettings>([&](const auto& f) {
+    using T = typename std::decay_t<decltype(f)>::Type;
+    py::dict e;
+    e["name"] = std::string(f.name);
+    e["type"] = py_type_name<T>();
+    e["unit"] = std::string(f.unit);
+    e["default"] = d.*f.member;
+    e["min"] = f.range.has_min ? py::object(py::float_(f.range.min)) : py::object(py::none());
+    e["max"] = f.range.has_max ? py::object(py::float_(f.range.max)) : py::object(py::none());
+    e["min_open"] = f.range.min_open;
+    e["max_open"] = f.range.max_open;
+    e["help"] = std::string(f.help);
+    out.append(e);
+  });
+  return out;
 }
 
 }  // namespace
@@ -552,21 +620,37 @@ PYBIND11_MODULE(_core, m) {
       .def("report", &io::FolderDiagnosis::FullReport, "The text `vrelab diagnose` prints (without the program's name).")
       .def("brief_report", &io::FolderDiagnosis::BriefReport)
       .def("to_dict", [](const io::FolderDiagnosis& f) { return to_py(io::to_json(f)); }, "`vrelab diagnose --json` as a dict.");
+  // Every DiagnoseSettings field a keyword (its description: name, type, default, range, help).
+  static const std::string diagnose_doc =
+      "diagnose(dir, **settings) -> Diagnosis\n\n"
+      "The sim-to-real gap of a campaign folder in the lab data format (docs/data-format.md): static readings "
+      "(output units) and shaker runs (measured error and sigma, g). Settings given here (keywords, None: not "
+      "given) win over the manifest's [diagnose] table; `vrelab diagnose DIR` takes the same as flags "
+      "(--significance-sigma for significance_sigma; --no-NAME for a flag). Releases the GIL.\n\n" +
+      diagnose_keywords_doc();
   m.def(
       "diagnose",
-      [](const std::string& dir, std::optional<double> model_accuracy, std::optional<double> significance_sigma,
-         std::optional<double> explained_shrinkage, std::optional<int> resimulate_runs, std::optional<bool> try_pairs) {
-        io::DiagnoseOverrides o{model_accuracy, significance_sigma, explained_shrinkage, resimulate_runs, try_pairs};
+      [](const std::string& dir, const py::kwargs& kw) {
+        const io::DiagnoseOverrides o = diagnose_overrides("diagnose", kw);
         return interruptible([&] { return io::diagnose_folder(dir, o); });
       },
-      py::arg("dir"), py::kw_only(), py::arg("model_accuracy") = py::none(), py::arg("significance_sigma") = py::none(),
-      py::arg("explained_shrinkage") = py::none(), py::arg("resimulate_runs") = py::none(), py::arg("try_pairs") = py::none(),
-      "diagnose(dir, *, model_accuracy=None, significance_sigma=None, explained_shrinkage=None, resimulate_runs=None, "
-      "try_pairs=None) -> Diagnosis\n\n"
-      "The sim-to-real gap of a campaign folder in the lab data format (docs/data-format.md): static readings "
-      "(output units) and shaker runs (measured error and sigma, g). Settings given here win over the manifest's "
-      "[diagnose] table. Same as `vrelab diagnose DIR [--model-accuracy F] [--significance-sigma S] "
-      "[--explained-shrinkage F] [--resimulate-runs N] [--no-pairs]`. Releases the GIL.");
+      py::arg("dir"), diagnose_doc.c_str());
+  m.def(
+      "check_campaign",
+      [](const std::string& dir, const py::kwargs& kw) {
+        const io::DiagnoseOverrides o = diagnose_overrides("check_campaign", kw);
+        const io::FolderDiagnosis f = interruptible([&] { return io::read_folder(dir, o); });
+        nlohmann::json j = io::to_json(f.settings);
+        j["from"] = f.settings_from;
+        return to_py(nlohmann::json{{"settings", j}, {"runs", f.campaign.runs.size()}, {"skipped", f.campaign.skipped}});
+      },
+      py::arg("dir"),
+      "check_campaign(dir, **settings) -> dict\n\n"
+      "`vrelab diagnose DIR --check`: the folder read and checked, the settings (keywords as for diagnose) "
+      "resolved over the manifest's [diagnose] and validated; no diagnosis. Returns {'settings': the settings "
+      "used as in diagnose's to_dict(), with 'from'; 'runs': the usable runs; 'skipped': why runs were skipped}.");
+  m.def("diagnose_settings", &diagnose_settings_description,
+        "The diagnosis' settings, one dict a field: name, type, unit, default, min, max, min_open, max_open, help.");
 
   // ------------------------------------------------------------ reproduce
   py::class_<ReproduceResult>(m, "ReproduceResult", "The paper's experiment end to end, written to a folder.")

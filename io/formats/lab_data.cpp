@@ -19,6 +19,7 @@
 #include "io/formats/output.hpp"
 #include "io/formats/raw_hdf5.hpp"
 #include "io/formats/series.hpp"
+#include "io/formats/settings_toml.hpp"
 #include "rectification/measurement/reference.hpp"
 #include "rectification/measurement/series.hpp"
 #include "validation/diagnosis/diagnose.hpp"
@@ -201,25 +202,15 @@ int coefficient_index(const std::string& name) {
   return -1;
 }
 
-// The manifest's [diagnose]: DiagnoseSettings by field name, checked.
+// The manifest's [diagnose]: DiagnoseSettings by field name (its description), checked.
 void read_diagnose_settings(const toml::table& t, const std::string& file, LabManifest& m) {
-  check_keys(t, "diagnose", {"model_accuracy", "significance_sigma", "explained_shrinkage", "resimulate_runs", "try_pairs"}, file);
   m.diagnose_given = true;
   validation::DiagnoseSettings& s = m.diagnose;
-  s.model_accuracy = toml_number(t, "diagnose", "model_accuracy", s.model_accuracy, file);
-  s.significance_sigma = toml_number(t, "diagnose", "significance_sigma", s.significance_sigma, file);
-  s.explained_shrinkage = toml_number(t, "diagnose", "explained_shrinkage", s.explained_shrinkage, file);
-  if (const toml::node* n = t.get("resimulate_runs")) {
-    const auto v = n->value<std::int64_t>();
-    if (!n->is_integer() || *v < 0 || *v > 1000000)
-      throw FormatError(toml_place(file, n, "diagnose", "resimulate_runs"), "expected a whole number of runs, 0 to 1000000");
-    s.resimulate_runs = static_cast<int>(*v);
-  }
-  if (const toml::node* n = t.get("try_pairs")) {
-    if (!n->is_boolean())
-      throw FormatError(toml_place(file, n, "diagnose", "try_pairs"), "expected true or false");
-    s.try_pairs = n->value<bool>().value();
-  }
+  read_settings_table(t, s, [&](const toml::node* n, const std::string& key, const std::string& what) {
+    throw FormatError({.file = file, .line = static_cast<long>(n->source().begin.line), .table = "diagnose", .key = key,
+                       .kind = KeyKind::toml_table},
+                      what);
+  });
   std::string why;
   if (!s.IsValid(&why)) throw FormatError({.file = file, .table = "diagnose", .kind = KeyKind::toml_table}, why);
 }

@@ -30,8 +30,7 @@ struct LabManifest {
   std::string output_unit = "mA";
   double g_m_per_s2 = 9.80665;
   bool dynamics_given = false;  // the manifest has a [dynamics] table
-  // The optional [diagnose] table: DiagnoseSettings' fields by name (model_accuracy,
-  // significance_sigma, explained_shrinkage, resimulate_runs, try_pairs); defaults elsewhere.
+  // The optional [diagnose] table: DiagnoseSettings' fields by name (its Describe); defaults elsewhere.
   validation::DiagnoseSettings diagnose;
   bool diagnose_given = false;
 };

@@ -63,11 +63,14 @@ constexpr const char* kColumns =
     "campaign,verdict,chosen,parameter,value,unit,sigma,shrinkage,shrinkage_in_sigma,rms_before_g,rms_after_g,"
     "significant_runs,runs,settings_from,checksum,wall_s";
 
+// The program and each DiagnoseSettings field as name=value (set here) or name=- (the manifest's).
 std::string fingerprint(const DiagnoseOverrides& o) {
-  auto opt = [](const auto& v) { return v ? fmt::format("{}", *v) : std::string("-"); };
-  return fmt::format("{} {} model_accuracy={} significance_sigma={} explained_shrinkage={} resimulate_runs={} try_pairs={}",
-                     kProgramVersion, kGitDescribe, opt(o.model_accuracy), opt(o.significance_sigma),
-                     opt(o.explained_shrinkage), opt(o.resimulate_runs), opt(o.try_pairs));
+  std::string text = fmt::format("{} {}", kProgramVersion, kGitDescribe);
+  int i = 0;
+  core::for_each_field<validation::DiagnoseSettings>([&](const auto& f) {
+    text += fmt::format(" {}={}", f.name, o.given(i++) ? core::format_value(o.values().*f.member) : std::string("-"));
+  });
+  return text;
 }
 
 // One campaign's row body (without checksum and wall time), or throws.

@@ -79,11 +79,7 @@ FolderDiagnosis read_folder(const std::string& dir, const DiagnoseOverrides& o) 
   validation::DiagnoseSettings& s = f.settings;
   s = f.manifest.diagnose;
   f.settings_from = f.manifest.diagnose_given ? "the manifest's [diagnose]" : "defaults";
-  if (o.model_accuracy) s.model_accuracy = *o.model_accuracy;
-  if (o.significance_sigma) s.significance_sigma = *o.significance_sigma;
-  if (o.explained_shrinkage) s.explained_shrinkage = *o.explained_shrinkage;
-  if (o.resimulate_runs) s.resimulate_runs = *o.resimulate_runs;
-  if (o.try_pairs) s.try_pairs = *o.try_pairs;
+  o.apply(s);
   if (o.any()) f.settings_from += ", set over by the caller";
   std::string why;
   if (!s.IsValid(&why)) throw InputError("diagnose settings: " + why);

@@ -41,15 +41,8 @@ struct CampaignWritten {
 CampaignWritten write_virtual_campaign(const CampaignRequest& request);
 
 // DiagnoseSettings set on top of the manifest's [diagnose] (e.g. from a command line): each
-// one given wins.
-struct DiagnoseOverrides {
-  std::optional<double> model_accuracy, significance_sigma, explained_shrinkage;
-  std::optional<int> resimulate_runs;
-  std::optional<bool> try_pairs;
-  bool any() const {
-    return model_accuracy || significance_sigma || explained_shrinkage || resimulate_runs || try_pairs;
-  }
-};
+// one set (o.set(&validation::DiagnoseSettings::field, value)) wins.
+using DiagnoseOverrides = core::Overrides<validation::DiagnoseSettings>;
 
 struct FolderDiagnosis {
   std::string dir;

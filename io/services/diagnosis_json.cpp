@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "io/formats/output.hpp"
+#include "io/formats/settings_json.hpp"
 #include "rectification/measurement/vrc.hpp"
 
 namespace vrelab::io {
@@ -173,19 +174,9 @@ json criteria_json(const std::vector<validation::BlindCriterion>& criteria) {
 
 }  // namespace
 
-json to_json(const validation::DiagnoseSettings& s) {
-  return {{"model_accuracy", s.model_accuracy},
-          {"significance_sigma", s.significance_sigma},
-          {"explained_shrinkage", s.explained_shrinkage},
-          {"resimulate_runs", s.resimulate_runs},
-          {"try_pairs", s.try_pairs},
-          {"structure_sigma", s.structure_sigma},
-          {"ambiguity_evidence", s.ambiguity_evidence}};
-}
+json to_json(const validation::DiagnoseSettings& s) { return settings_json(s); }
 
-json to_json(const validation::BlindSettings& s) {
-  return {{"n", s.n}, {"seed", s.seed}, {"threads", s.threads}, {"diagnose", to_json(s.diagnose)}};
-}
+json to_json(const validation::BlindSettings& s) { return settings_json(s); }
 
 json to_json(const plant::Dynamics& d) {
   return {{"pendulum_frequency_Hz", d.pendulum_frequency_Hz},

@@ -62,7 +62,8 @@ _find_plot_scripts()
 
 __all__ = [
     "Case", "InputError", "SolverError", "load_case", "case_toml", "identify", "predict", "shake",
-    "sweep", "frequency", "campaign", "diagnose", "diagnose_data", "reproduce", "__version__",
+    "sweep", "frequency", "campaign", "diagnose", "diagnose_data", "check_campaign", "diagnose_settings",
+    "reproduce", "__version__",
 ]
 
 
@@ -195,6 +196,14 @@ def diagnose(dir, **settings):
 
 
 diagnose.__doc__ = _core.diagnose.__doc__
+
+
+def check_campaign(dir, **settings):
+    return _core.check_campaign(os.fspath(dir), **settings)
+
+
+check_campaign.__doc__ = _core.check_campaign.__doc__
+diagnose_settings = _core.diagnose_settings
 
 
 def _write_columns(path, columns):

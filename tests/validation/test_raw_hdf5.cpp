@@ -137,7 +137,7 @@ struct RawCampaign {
 // The diagnosis' JSON without its timings.
 nlohmann::json diagnosis_json(const std::string& dir) {
   io::DiagnoseOverrides o;
-  o.resimulate_runs = 0;  // the ODE re-simulation is the same code either way; seconds saved
+  o.set(&validation::DiagnoseSettings::resimulate_runs, 0);  // the ODE re-simulation is the same code either way; seconds saved
   nlohmann::json j = io::to_json(io::diagnose_folder(dir, o));
   j.erase("wall_s");
   return j;

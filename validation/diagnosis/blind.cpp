@@ -462,14 +462,7 @@ plant::PlantConfig blind_truth(std::mt19937_64& rng) {
   return p;
 }
 
-bool BlindSettings::IsValid(std::string* why) const {
-  std::string w;
-  if (n < 1) w = fmt::format("n = {}: at least one campaign", n);
-  else if (threads < 0) w = fmt::format("threads = {}: must not be negative (0: all cores)", threads);
-  else if (std::string d; !diagnose.IsValid(&d)) w = "diagnose." + d;
-  if (why) *why = w;
-  return w.empty();
-}
+bool BlindSettings::IsValid(std::string* why) const { return core::validate(*this, why); }
 
 namespace {
 

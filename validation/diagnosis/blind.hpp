@@ -38,10 +38,22 @@
 namespace vrelab::validation {
 
 struct BlindSettings {
-  int n = 40;               // campaigns
-  std::uint64_t seed = 7;   // of the draw
-  int threads = 0;          // 0: all cores
-  DiagnoseSettings diagnose;  // each campaign's diagnosis
+  int n = 40;
+  std::uint64_t seed = 7;
+  int threads = 0;
+  DiagnoseSettings diagnose;
+
+  // Each field once (core/settings_description.hpp).
+  template <class V>
+  static void Describe(V& v) {
+    using S = BlindSettings;
+    using core::field;
+    v(field("n", &S::n, "campaigns", core::at_least(1), "Number of campaigns"));
+    v(field("seed", &S::seed, "", core::any_value(), "Seed of the draw"));
+    v(field("threads", &S::threads, "threads", core::at_least(0), "Threads (0: all cores; under mpirun per rank, 0 = 1)"));
+    v(field("diagnose", &S::diagnose, "", core::any_value(), "Each campaign's diagnosis"));
+  }
+  // False with `why` naming the field ("diagnose.x" for a diagnosis setting), its value and rule.
   bool IsValid(std::string* why) const;
 };
 
