@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <numbers>
 #include <regex>
@@ -124,6 +125,14 @@ TEST(RawHdf5, AWriterNotCommittedLeavesNoFile) {
     w.add(0, 1);
   }
   EXPECT_TRUE(fs::is_empty(d.path)) << "a temporary file left behind";
+  // Positive control: the same writer committed leaves the file, and only it.
+  {
+    io::Hdf5SeriesWriter w(p.string(), "mA");
+    w.add(0, 1);
+    w.commit();
+  }
+  EXPECT_TRUE(fs::exists(p));
+  EXPECT_EQ(std::distance(fs::directory_iterator(d.path), fs::directory_iterator{}), 1);
 }
 
 // cases/lab-example with three runs given as raw records (records/<id>.csv): 10 kHz, 0.3 s at
@@ -206,7 +215,7 @@ nlohmann::json diagnosis_json(const std::string& dir) {
   return j;
 }
 
-TEST(RawHdf5, ACampaignAndItsHdf5CopyDiagnoseIdentically) {
+TEST(RawHdf5Campaign, ACampaignAndItsHdf5CopyDiagnoseIdentically) {
   TempDir t;
   const RawCampaign c(t.path / "lab");
   const validation::Campaign a = io::read_campaign(c.dir);
