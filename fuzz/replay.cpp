@@ -2,6 +2,8 @@
 //   vrelab_fuzz_replay <target> <file or folder>...
 // feeds every file (a folder: every file in it) to the target (fuzz/readers.hpp) and fails
 // (exit 1, naming the file) when one escapes the reader as anything but a refusal of bad input.
+// A path that does not exist, or no input at all, fails too (exit 2): a wrong regressions or
+// seeds path would otherwise replay nothing and pass.
 #include <algorithm>
 #include <cstdio>
 #include <exception>
@@ -26,12 +28,20 @@ int main(int argc, char** argv) {
   }
   std::vector<fs::path> files;
   for (int i = 2; i < argc; ++i) {
+    if (!fs::exists(argv[i])) {
+      std::fprintf(stderr, "FAIL %s: no such file or folder\n", argv[i]);
+      return 2;
+    }
     if (fs::is_directory(argv[i])) {
       for (const auto& e : fs::directory_iterator(argv[i]))
         if (e.is_regular_file() && e.path().filename() != "README.md") files.push_back(e.path());
     } else {
       files.emplace_back(argv[i]);
     }
+  }
+  if (files.empty()) {
+    std::fprintf(stderr, "FAIL %s: no inputs in the paths given\n", argv[1]);
+    return 2;
   }
   std::sort(files.begin(), files.end());
   int failed = 0;

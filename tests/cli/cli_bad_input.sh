@@ -48,9 +48,10 @@ expect 0 'least_squares' identify "$cases/ideal-static.toml" --json "$tmp/o/id.j
 [ -s "$tmp/o/id.json" ] || { echo "FAIL: no JSON written"; fail=$((fail + 1)); }
 expect 0 'total' predict "$cases/paper-predict.toml" --json "$tmp/o/p.json"
 expect 0 'vrelab 0' --version
-# A solver failure is reported with the call and the simulated time, exit 2.
+# A solver failure is reported with the call and the simulated time, exit 2: rtol 1e-30 is
+# accepted by the case reader and refused by CVODE itself at its first step.
 sed 's/^\[run\]/[shake]\nrelative_tolerance = 1e-30\n\n[run]/' "$cases/shake-sine.toml" >"$tmp/solver.toml"
-expect 2 'relative_tolerance|solver failure in .* at simulated time' shake "$tmp/solver.toml" --json "$tmp/o/solver.json"
+expect 2 'solver failure in CVode at simulated time t = [0-9.e+-]+ s \(CV_TOO_MUCH_ACC\)' shake "$tmp/solver.toml" --json "$tmp/o/solver.json"
 sed 's/^\[plant\]/[plant]\nphase_margin_deg = 85.0/' "$cases/shake-sine.toml" >"$tmp/design.toml"
 expect 2 'phase_margin_deg' shake "$tmp/design.toml"
 expect 0 'measured vibration error' shake "$cases/shake-sine.toml" --json "$tmp/o/shake.json"

@@ -60,11 +60,15 @@ TEST(LabRandom, RunsAreReadDescribedAndPredictedAsTheShakerMeasuredThem) {
   // Each random run predicted as diagnose predicts it (the truth's plant) within the virtual
   // shaker's 3 sigma (its 16 s record) plus the first-order model's 1 % (test_random_prediction.cpp).
   const plant::PlantConfig t = truth();
+  int predicted_runs = 0;
   for (const auto& r : c.runs) {
     if (!r.random) continue;
     const double predicted = validation::predict_run_g(t, r);
     EXPECT_NEAR(r.measured_g, predicted, 3 * r.sigma_g + 0.01 * std::abs(predicted)) << r.id;
+    ++predicted_runs;
   }
+  // cases/lab-random/runs.csv: 5 of its 15 rows are random (4) or sine on random (1).
+  EXPECT_EQ(predicted_runs, 5);
 }
 
 TEST(LabRandom, BadRandomRowsAreSkippedNamingFileLineAndColumn) {

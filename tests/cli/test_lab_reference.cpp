@@ -141,7 +141,7 @@ const validation::RunRecord& run(const validation::Campaign& c, const std::strin
 
 }  // namespace
 
-TEST(LabReference, TransverseMotionIsMeasuredNotFitted) {
+TEST(LabReferenceCampaign, TransverseMotionIsMeasuredNotFitted) {
   TempDir tmp;
   const char* out = std::getenv("VRELAB_WRITE_LAB_REFERENCE");
   const fs::path dir = out ? fs::path(out) : tmp.path;
@@ -230,7 +230,7 @@ TEST(LabReference, BadReferenceChannelsSkipTheirRunNamingFileLineAndWhy) {
 // Issue 16's mixed campaign (summaries): cases/lab-random's 10 sine and 5 random runs, measured
 // on the virtual shaker (the ODE, 16 s records) with a hidden pickoff nonlinearity p2 = 15/rad,
 // diagnosed to that effect (3 s CPU).
-TEST(LabReference, MixedSineAndRandomCampaignIsDiagnosedToItsHiddenEffect) {
+TEST(LabReferenceCampaign, MixedSineAndRandomCampaignIsDiagnosedToItsHiddenEffect) {
   const validation::Campaign c = io::read_campaign(std::string(VRELAB_CASES_DIR) + "/lab-random");
   ASSERT_TRUE(c.skipped.empty());
   validation::DiagnoseSettings s;
@@ -248,7 +248,7 @@ TEST(LabReference, MixedSineAndRandomCampaignIsDiagnosedToItsHiddenEffect) {
 // runs dropped (a campaign where only some runs have one) the table-motion effects stay
 // candidates, their hypotheses applied to the runs without a reference only: a run with one
 // predicts the same under any value of shaker_transverse_motion.
-TEST(LabReference, PartialReferencesKeepTheTableMotionEffectsForTheOtherRuns) {
+TEST(LabReferenceCampaign, PartialReferencesKeepTheTableMotionEffectsForTheOtherRuns) {
   validation::Campaign c = io::read_campaign(std::string(VRELAB_CASES_DIR) + "/lab-reference");
   ASSERT_TRUE(c.skipped.empty()) << c.skipped.front();
   ASSERT_EQ(c.runs.size(), 18u);

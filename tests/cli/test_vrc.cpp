@@ -69,6 +69,8 @@ TEST(Vrc, ShakeAndMeasureReportTheSameCoefficientAsTheirErrors) {
   run_shake(so, text);
   const json s = json::parse(read_file(so.json_path));
   const double rms = s["input_rms_g"].get<double>();
+  // By hand from the case: a sine of peak [3, 1, 0] g has rms^2 = (9 + 1) / 2 = 5 g^2.
+  EXPECT_NEAR(rms, std::sqrt(5.0), 1e-12);
   EXPECT_NEAR(s["vrc_ug_per_g2"].get<double>(), 1e6 * s["measured_g"].get<double>() / (rms * rms), 1e-9);
   EXPECT_NEAR(s["predicted_eq3_vrc_ug_per_g2"].get<double>(), 1e6 * s["predicted_eq3_g"].get<double>() / (rms * rms), 1e-9);
   // measure: a hand-made record, output 1 g + 50 ug while vibrating; input rms 2 g -> 12.5 ug/g^2.
@@ -122,6 +124,9 @@ TEST(Vrc, MeasureTakesTheInputRmsFromTheRecordsReferenceChannels) {
   run_measure(mo, text);
   const json m = json::parse(read_file(mo.json_path));
   EXPECT_EQ(m["input_rms_source"], "reference_channels");
-  EXPECT_NEAR(m["input_rms_g"].get<double>(), shake["input_rms_g"].get<double>(), 1e-9 * shake["input_rms_g"].get<double>());
+  // By hand from the case: peak [3, 1, 0] g, so rms = sqrt((9 + 1) / 2) = sqrt(5) g exactly
+  // over whole periods; 1e-9 relative: the series file's 10 significant digits.
+  EXPECT_NEAR(m["input_rms_g"].get<double>(), std::sqrt(5.0), 1e-9 * std::sqrt(5.0));
+  EXPECT_NEAR(shake["input_rms_g"].get<double>(), std::sqrt(5.0), 1e-12 * std::sqrt(5.0));
   EXPECT_NEAR(m["vrc_ug_per_g2"].get<double>(), 1e6 * m["measured_g"].get<double>() / std::pow(m["input_rms_g"].get<double>(), 2), 1e-9);
 }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <iterator>
 #include <fstream>
 #include <numbers>
 #include <string>
@@ -98,6 +99,14 @@ TEST(RawHdf5, AWriterNotCommittedLeavesNoFile) {
     w.add(0, 1);
   }
   EXPECT_TRUE(fs::is_empty(d.path)) << "a temporary file left behind";
+  // Positive control: the same writer committed leaves the file, and only it.
+  {
+    io::Hdf5SeriesWriter w(p.string(), "mA");
+    w.add(0, 1);
+    w.commit();
+  }
+  EXPECT_TRUE(fs::exists(p));
+  EXPECT_EQ(std::distance(fs::directory_iterator(d.path), fs::directory_iterator{}), 1);
 }
 
 }  // namespace

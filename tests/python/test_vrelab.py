@@ -3,8 +3,15 @@ CLI's --json, number for number: the same C++ writers make both, so equality is 
 wall-clock times), series round trips into NumPy, the CLI's exit-2 messages as
 vrelab.InputError, and shake on two threads at once.
 
-Run by ctest (python_tests, label fast) with PYTHONPATH at build/python and VRELAB_CLI at the
-program of the same build."""
+The *_equals_cli tests are consistency checks of the binding (the Python call and the CLI
+give the same numbers), not of the physics, which the C++ tests check against independent
+values. The independent numbers here: eq. (3) at 5 Hz against the ODE
+(test_shake_equals_cli), k2 A^2 / 2 by hand (test_sweep_columns), the series' own mean
+difference against the run's measured error (test_shake_series_round_trip...), and the raw
+records' measured errors, CSV against HDF5 (test_campaign_writes_raw_records...).
+
+Run by ctest (python_tests, label python) with PYTHONPATH at build/python and VRELAB_CLI at
+the program of the same build."""
 import json
 import math
 import os
@@ -132,8 +139,15 @@ def test_shake_series_round_trip_equals_the_cli_series_file(tmp_path):
         assert isinstance(s[n], np.ndarray) and s[n].dtype == np.float64 and s[n].shape == (r.samples,)
         # the file holds 10 (inputs) and 13 (output) significant digits
         np.testing.assert_allclose(s[n], data[:, i], rtol=1e-9, atol=1e-12)
-    # the series measures what the run measured: mean over the vibration minus the mean at rest
-    assert (s["time_s"] < 0).sum() > 0 and (s["time_s"] >= 0).sum() > 0
+    # the series measures what the run measured: the mean output over the measuring window
+    # minus the mean at rest (t < 0), over K1 = 1.25 mA/g. Both means are over whole periods of
+    # the same samples (noise and quantisation included), so they agree to rounding (bound 1e-9
+    # relative, ~3e-13 g). The window: whole 80 Hz periods at 20 kHz, 250 samples each.
+    m = d["measurement"]
+    t, u = s["time_s"], s["output_mA"]
+    rest, on = t < 0, (t >= m["settle_s"]) & (t < m["settle_s"] + m["periods"] / 80.0)
+    assert on.sum() == 250 * m["periods"] > 0 and rest.sum() > 0
+    assert (u[on].mean() - u[rest].mean()) / 1.25 == pytest.approx(r.measured_g, rel=1e-9, abs=0)
 
 
 def test_sweep_columns(tmp_path):
@@ -151,6 +165,10 @@ def test_sweep_columns(tmp_path):
     assert r.conditions == 2 and r.written == 2 and not r.failures
     cols = r.columns
     assert all(isinstance(v, np.ndarray) and len(v) == 2 for v in cols.values())
+    # By hand: k2 alone, a 1 g peak along IA, IA horizontal: eq. (3) is k2 A^2 / 2 = 7.5 ug at
+    # both frequencies; the ODE (k2 in the loop, |H|^2 = 1 - O((f / 500 Hz)^2) <= 4e-4 off) within 1 %.
+    np.testing.assert_allclose(cols["predicted_eq3_g"], [7.5e-6, 7.5e-6], rtol=1e-12)
+    np.testing.assert_allclose(cols["measured_g"], [7.5e-6, 7.5e-6], rtol=1e-2)
 
 
 # ---- errors
@@ -375,6 +393,12 @@ def test_campaign_writes_raw_records_as_csv_or_hdf5(tmp_path):
         written[fmt] = columns(out / "runs.csv")
     assert list(written["csv"]["id"]) == list(written["hdf5"]["id"])
     assert [s.replace(".csv", ".h5") for s in written["csv"]["series"]] == list(written["hdf5"]["series"])
+    # The same samples read back from either format give each run the same measured error (the
+    # diagnosis' input, ~230 ug here): the CSV holds the output to 13 significant digits (near
+    # 1 mA), the HDF5 file whole doubles, so the windows' means differ by ~1e-13 g: bound 1e-12 g.
+    measured = {fmt: [r["measured_g"] for r in vrelab.diagnose(str(tmp_path / fmt)).to_dict()["runs"]] for fmt in written}
+    assert len(measured["csv"]) == 2 and all(abs(x) > 1e-5 for x in measured["csv"]), measured
+    assert measured["hdf5"] == pytest.approx(measured["csv"], rel=0, abs=1e-12)
     with pytest.raises(ValueError, match="raw_format must be 'csv' or 'hdf5'"):
         vrelab.campaign(str(raw), str(tmp_path / "bad"), raw_format="h5")
     with pytest.raises(vrelab.InputError, match="--raw-format hdf5: the case writes summaries"):

@@ -170,7 +170,7 @@ OdeCheck ode_check(const PlantConfig& cfg, const Vec3& a, const rectification::V
 // next order is ~ k2 * 2 sigma_I ~ 4e-4 relative for these coefficients at 14 g rms, so the
 // model tolerance is 1 % of the prediction; the ODE's statistical sigma (batch means over
 // 16 blocks of a 4 s record) is added at 3 sigma.
-TEST(RandomAtFrequency, MatchesTheOdeForGevsAndSineOnRandom) {
+TEST(RandomAtFrequencyCampaign, MatchesTheOdeForGevsAndSineOnRandom) {
   const Vec3 a(0.5, std::sqrt(0.75), 0);
   PlantConfig cfg = test::paper_like_plant();
   cfg.coefficients[k_PP] = 4e-6;
@@ -197,7 +197,7 @@ TEST(RandomAtFrequency, MatchesTheOdeForGevsAndSineOnRandom) {
 
 // The effects beyond (1) under random motion on IA and PA: the pickoff nonlinearity and the
 // pendulum geometry (second moments of the angle), and a quadratic readout (Gauss-Hermite).
-TEST(RandomAtFrequency, EffectsMatchTheOde) {
+TEST(RandomAtFrequencyCampaign, EffectsMatchTheOde) {
   const Vec3 a(0.5, std::sqrt(0.75), 0);
   rectification::VibrationRequest v;
   v.type = rectification::VibrationKind::random;

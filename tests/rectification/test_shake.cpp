@@ -112,8 +112,8 @@ TEST(ShakeSampled, TooFewSamplesPerPeriodAreRefused) {
 TEST(ShakeSampled, SinkSeesEverySampleOfTheRecord) {
   rectification::ShakeSettings s;
   s.readout.sample_rate_Hz = 1000;
-  long count = 0;
-  double last_t = -1;
+  long count = 0, vibrating = 0;
+  double last_t = -1e9;
   const auto r = rectification::shake_sine(k2_plant(), Vec3(1, 0, 0), sine(20, 1), s,
                                            [&](double t, const Vec3& in, double) {
                                              EXPECT_GT(t, last_t);
@@ -121,7 +121,14 @@ TEST(ShakeSampled, SinkSeesEverySampleOfTheRecord) {
                                              EXPECT_NEAR(in[IA], t < 0 ? 0.0 : std::sin(2 * M_PI * 20 * t), 1e-12);
                                              last_t = t;
                                              ++count;
+                                             vibrating += t >= 0;
                                            });
+  // The sink was called, on the rest and on the vibration: 1000 Hz / 20 Hz = 50 samples a
+  // period, at least one whole period for each of the 4 batch means (ShakeSettings::blocks),
+  // so at least 200 samples under vibration, and as many at rest (the rest is as long as the
+  // measuring interval).
+  EXPECT_GE(vibrating, 4 * 50);
+  EXPECT_GE(count - vibrating, 4 * 50);
   EXPECT_EQ(count, r.samples);
 }
 

@@ -76,7 +76,7 @@ TEST(BlindScoring, ACoefficientChangeTheStaticTestPinsIsNoGap) {
 // accuracy and the coefficients' share, as diagnose reports it in RunDiagnosis::sigma_g) and
 // 10 sigma / sqrt(sigma^2 + (model_accuracy pred)^2) (V >= its noise part, so V^-1 <= its
 // inverse): exact bounds for (V^-1)_kk. Runs with the smallest and the largest prediction.
-TEST(BlindScoring, AGapOnOneRunIsSeenAtThatRunsSigma) {
+TEST(BlindScoringCampaign, AGapOnOneRunIsSeenAtThatRunsSigma) {
   const DiagnoseSettings s = quick();
   const Campaign without = simulate_campaign(truth_of(9101), {}, small_design(), 9101, 2);
   const Diagnosis d = diagnose(without, s);
@@ -114,7 +114,7 @@ TEST(BlindScoring, AGapOnOneRunIsSeenAtThatRunsSigma) {
 //    moves the effect's fitted parameter by about its sigma, which moves what it leaves by
 //    sigma / value of the gap before (a linear effect): 3 x that. The residuals' shrinkage
 //    with the noise (the old measure) stays far below.
-TEST(BlindScoring, TheGapsHeldOutRmsWithoutTheNoiseIsTheNoiseFreeDiagnosis) {
+TEST(BlindScoringCampaign, TheGapsHeldOutRmsWithoutTheNoiseIsTheNoiseFreeDiagnosis) {
   const DiagnoseSettings s = quick();
   const plant::PlantConfig truth = truth_of(9102);
   const auto rms = [](const std::vector<double>& v) {
@@ -150,6 +150,8 @@ TEST(BlindScoring, TheGapsHeldOutRmsWithoutTheNoiseIsTheNoiseFreeDiagnosis) {
   ASSERT_EQ(gap_g.size(), dq.runs.size());
   double largest = 0;
   for (const RunDiagnosis& rd : dq.runs) largest = std::max(largest, std::abs(rd.heldout_before_g));
+  // A consistency check, not an oracle: heldout_nominal_gap_g and diagnose's heldout_before_g
+  // are the same formula on the same values; it holds blind's copy to diagnose's.
   for (std::size_t k = 0; k < gap_g.size(); ++k) EXPECT_NEAR(gap_g[k], dq.runs[k].heldout_before_g, 1e-9 * largest) << "run " << k;
   const auto [before, after] = gap_rms_without_lab_noise(dn, gap_g);
   const EffectFit& e = dn.effects.front();
@@ -157,6 +159,9 @@ TEST(BlindScoring, TheGapsHeldOutRmsWithoutTheNoiseIsTheNoiseFreeDiagnosis) {
   std::printf("  pickoff 0.5 /rad (fitted %.4g +- %.2g): residuals %.4g -> %.4g g; the gap without the noise %.4g -> %.4g g; "
               "the noise-free campaign diagnosed %.4g -> %.4g g\n",
               e.value, e.sigma, dn.rms_before_g, dn.rms_after_g, before, after, dq.rms_before_g, dq.rms_after_g);
+  // Consistency again (before: the rms of the same gaps diagnose sums); the independent part is
+  // `after` (blind's fit on the noisy runs against diagnose's own fit of the quiet ones,
+  // within the fitted parameter's 3 sigma) and the noise's rms checked above against 0.3 ug.
   EXPECT_NEAR(before, dq.rms_before_g, 1e-9 * dq.rms_before_g);
   EXPECT_NEAR(after, dq.rms_after_g, 3 * fit_share * before);
   EXPECT_GT(1 - after / before, 0.9);

@@ -202,8 +202,8 @@ TEST(GaussianLikelihood, InputsThatAreNoCovarianceGiveNaN) {
 // on the 100 Hz runs with slopes of 1e5 g/Hz; an LDLT of V met negative pivots, ln det V was
 // -inf and the mode's evidence +inf ranked it first: "not explained". With V factored as above
 // every evidence is finite and the pickoff (16.33 +- 0.16, held-out chi^2 137 for 168 runs)
-// explains the gap. A whole campaign (~6 s in Release): in NaturalMisses, label "campaign".
-TEST(NaturalMisses, ALargePickoffIsNotOutrankedByAnInfiniteEvidence) {
+// explains the gap. A whole campaign (~6 s in Release): in NaturalMissesCampaign, label "campaign".
+TEST(NaturalMissesCampaign, ALargePickoffIsNotOutrankedByAnInfiniteEvidence) {
   const int index = 21;
   const BlindResult r = test::replay_blind_campaign(9501, index);
   const BlindCampaign& k = r.campaigns.at(index);

@@ -53,7 +53,7 @@ plant::PlantConfig blind_like_truth(std::uint64_t seed) {
 
 }  // namespace
 
-TEST(Nuisances, ADriftIsEstimatedFromTheRestReadingsRemovedAndNotCalledAnEffect) {
+TEST(NuisancesCampaign, ADriftIsEstimatedFromTheRestReadingsRemovedAndNotCalledAnEffect) {
   // Noise-free rest readings: the line through them is the drift itself (to rounding).
   {
     const Diagnosis d = diagnose(with_drift(2e-6, 0));
@@ -84,7 +84,7 @@ TEST(Nuisances, ADriftIsEstimatedFromTheRestReadingsRemovedAndNotCalledAnEffect)
   EXPECT_FALSE(blind_to_it.nuisance("bias_drift")->estimated);
 }
 
-TEST(Nuisances, AStatedSigmaTooSmallIsFlaggedAndTheGapJudgedWithTheCorrectedOne) {
+TEST(NuisancesCampaign, AStatedSigmaTooSmallIsFlaggedAndTheGapJudgedWithTheCorrectedOne) {
   // The clean campaign's runs scatter 2.5 times their stated sigma.
   Campaign c = clean_campaign();
   std::mt19937_64 rng(153);
@@ -117,7 +117,7 @@ TEST(Nuisances, AStatedSigmaTooSmallIsFlaggedAndTheGapJudgedWithTheCorrectedOne)
   EXPECT_NEAR(y->value, std::sqrt(2.5 * 2.5 - 1), 3 * y->sigma) << y->note;
 }
 
-TEST(Nuisances, JsonCarriesEachNuisanceWithItsNameValueSigmaAndUnit) {
+TEST(NuisancesCampaign, JsonCarriesEachNuisanceWithItsNameValueSigmaAndUnit) {
   const Campaign c = with_drift(1e-6, 0.3e-6);
   const nlohmann::json j = io::to_json(diagnose(c), c);
   for (const char* key : {"gap_significant", "verdict", "explained", "chosen", "effects", "shrinkage", "where", "nuisances",
@@ -136,7 +136,7 @@ TEST(Nuisances, JsonCarriesEachNuisanceWithItsNameValueSigmaAndUnit) {
 // gap is mostly taken up by the coefficients' errors and what is left is weakly structured,
 // so the scatter test alone took it for understated sigma (blind --seed 8001: x1.50 and x1.97
 // applied on its two squeeze films). Seed 160 was not used to develop the diagnosis.
-TEST(Nuisances, ASqueezeFilmWithTheStatedSigmaRightIsNotCalledSigmaUnderstated) {
+TEST(NuisancesCampaign, ASqueezeFilmWithTheStatedSigmaRightIsNotCalledSigmaUnderstated) {
   const std::vector<HiddenEffect> film{{"squeeze_film_damping", 1 / 1.02e-3}};
   const std::uint64_t seed = 162;
   Campaign c = simulate_campaign(blind_like_truth(seed), film, default_design(), seed, 2);
@@ -162,7 +162,7 @@ TEST(Nuisances, ASqueezeFilmWithTheStatedSigmaRightIsNotCalledSigmaUnderstated) 
 // once in 1.5e5 runs). A threshold from the normal quantile (3.0) instead of Student's t (4.28
 // for 8 degrees of freedom) would flag 1.7 % of 10-reading logs (683 expected: fails; seen 635)
 // and 0.31 % of 168-reading ones (125: inside the window, t(166) being nearly normal).
-TEST(Nuisances, TheDriftTestFlagsNoDriftAtItsStatedRate) {
+TEST(NuisancesCampaign, TheDriftTestFlagsNoDriftAtItsStatedRate) {
   const double level = std::erfc(3 / std::sqrt(2.0));  // 2 (1 - Phi(3)), not the code's constant
   constexpr int kTrials = 40000;
   for (const int readings : {10, 168}) {

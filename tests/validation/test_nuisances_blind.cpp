@@ -63,7 +63,7 @@ Campaign lab_campaign(std::uint64_t seed, std::uint64_t noise_seed, double noise
 // blind's lower end of the drift (0.2 ug/h): over 72 runs (3.55 h) the rate's sigma is
 // 0.3 ug / sqrt(sum (t - mean t)^2) = 0.034 ug/h, so 0.2 ug/h is 6 of it: reported,
 // significant, within 3 sigma of the truth, and no effect called.
-TEST(NuisancesBlind, ADriftAtBlindsLowerEndIsReportedWhateverTheGapsVerdict) {
+TEST(NuisancesBlindCampaign, ADriftAtBlindsLowerEndIsReportedWhateverTheGapsVerdict) {
   for (const double drift_ug_per_h : {0.2, -0.2}) {
     const Diagnosis d = diagnose(lab_campaign(9000, 9001, 1.0, drift_ug_per_h * 1e-6));
     const Nuisance* x = d.nuisance("bias_drift");
@@ -82,7 +82,7 @@ TEST(NuisancesBlind, ADriftAtBlindsLowerEndIsReportedWhateverTheGapsVerdict) {
 // expected, Wilson-Hilferty a little less) and well beyond the chi^2 quantile at 3 sigma
 // (1.26 x for 72 runs: missed with probability < 1 %): flagged either way, never explained
 // by an effect, the scale within 3 of its sigma. (At 1.4 x the power is ~95 %: a draw missed.)
-TEST(NuisancesBlind, AnUnderstatedSigmaIsFlaggedWhateverTheGapsVerdict) {
+TEST(NuisancesBlindCampaign, AnUnderstatedSigmaIsFlaggedWhateverTheGapsVerdict) {
   for (const double k : {1.8, 1.5}) {
     const Diagnosis d = diagnose(lab_campaign(9002, 9003, k, 0));
     const Nuisance* x = d.nuisance("sigma_scale");
@@ -100,11 +100,19 @@ TEST(NuisancesBlind, AnUnderstatedSigmaIsFlaggedWhateverTheGapsVerdict) {
 // campaigns all pass with probability 0.96 when the thresholds are what they claim; a
 // threshold set by chance-level structure (say 2 sigma: 7 % a campaign) fails here with
 // probability 0.5. (A Monte Carlo sharp enough for the 2 % is blind's, not a test's.)
-TEST(NuisancesBlind, CleanCampaignsFlagNoNuisance) {
-  int flagged = 0;
+TEST(NuisancesBlindCampaign, CleanCampaignsFlagNoNuisance) {
+  int flagged = 0, judged = 0;
   for (const std::uint64_t seed : {9004, 9005})
     for (std::uint64_t draw = 0; draw < 5; ++draw) {
       const Diagnosis d = diagnose(lab_campaign(seed, 9010 + draw, 1.0, 0));
+      // Both nuisances are looked for and estimated (the log has rest readings and stated
+      // sigmas), so "none flagged" is a judgement, not an empty list.
+      for (const char* name : {"bias_drift", "sigma_scale"}) {
+        const Nuisance* x = d.nuisance(name);
+        ASSERT_NE(x, nullptr) << name;
+        EXPECT_TRUE(x->estimated) << name << ": " << x->note;
+        ++judged;
+      }
       for (const Nuisance& x : d.nuisances) {
         flagged += x.significant;
         EXPECT_FALSE(x.significant) << "truth " << seed << " draw " << draw << ": " << x.name << " " << x.value << " +- " << x.sigma
@@ -112,6 +120,7 @@ TEST(NuisancesBlind, CleanCampaignsFlagNoNuisance) {
       }
       EXPECT_FALSE(d.gap_significant) << d.verdict;
     }
+  EXPECT_EQ(judged, 2 * 10);
   EXPECT_EQ(flagged, 0);
 }
 

@@ -80,7 +80,7 @@ double rk4_power_change_g2(const plant::FixtureRattle& joint, double f0_g, doubl
 // 0.5 %: RK4's step and the loop's DC gain (1 - 8e-10) are well inside it; a wrong sign of the
 // contact's damping, of gravity's share or a missing spike changes it by tens of %. The same joint on a linear instrument rectifies nothing (<x''> = 0: the joint
 // carries the mean), bounded by 1e-9 g against a change of ~1e-4 g with k2.
-TEST(OutOfLibraryJoints, FixtureRattleMatchesTheJointAloneAndRectifiesOnlyThroughTheInstrument) {
+TEST(OutOfLibraryJointsCampaign, FixtureRattleMatchesTheJointAloneAndRectifiesOnlyThroughTheInstrument) {
   const auto joint = std::make_shared<plant::FixtureRattle>(Vec3::UnitX(), 2.0);
   const Vec3 g = Vec3(1, 0, 1).normalized();
   constexpr double k2 = 1.5e-5, A = 4, f = 400;

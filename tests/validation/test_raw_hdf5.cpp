@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <numbers>
 #include <regex>
@@ -143,7 +144,7 @@ nlohmann::json diagnosis_json(const std::string& dir) {
   return j;
 }
 
-TEST(RawHdf5, ACampaignAndItsHdf5CopyDiagnoseIdentically) {
+TEST(RawHdf5Campaign, ACampaignAndItsHdf5CopyDiagnoseIdentically) {
   TempDir t;
   const RawCampaign c(t.path / "lab");
   const validation::Campaign a = io::read_campaign(c.dir);

@@ -5,7 +5,7 @@
 //    rounding) over the band, the directions and the static orientations; the ODE truth with
 //    either sign agrees too; and a mode that turns one axis's phase against another's tells the
 //    signs apart, in the prediction as in the ODE (the same difference); blind compares magnitudes.
-//  - Label "campaign" (suite NaturalMisses): seed 9501's campaign 79 replayed as blind makes it.
+//  - Label "campaign" (suite NaturalMissesCampaign): seed 9501's campaign 79 replayed as blind makes it.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -194,7 +194,7 @@ TEST(TransverseQuadrature, BlindComparesTheMagnitudes) {
 // the fit reported +0.068 +- 0.019 with one build and -0.068 +- 0.019 with the next, which blind
 // judged 5.6 sigma off. Fitted as a magnitude, |q| is within 3 sigma of the truth's |q| and the
 // campaign is scored right.
-TEST(NaturalMisses, ATransverseQuadraturesSizeIsJudgedNotItsSign) {
+TEST(NaturalMissesCampaign, ATransverseQuadraturesSizeIsJudgedNotItsSign) {
   const BlindResult r = test::replay_blind_campaign(9501, 79);
   const BlindCampaign& k = r.campaigns.at(79);
   ASSERT_EQ(k.category, "natural");
