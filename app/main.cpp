@@ -331,8 +331,8 @@ int run_command(const std::vector<Command>& commands, bool root, bool* raised) {
 int main(int argc, char** argv) {
 #ifdef __GLIBC__
   // The diagnosis allocates and frees matrices of 100-250 kB thousands of times a second (a
-  // 168-run campaign's covariance and its factorisation): above glibc's mmap threshold each was
-  // an mmap and munmap, and freed heap tops were trimmed and faulted in again (185 000 page
+  // 168-run campaign's covariance and its factorisation): with glibc's default thresholds each
+  // is an mmap and munmap, and freed heap tops are trimmed and faulted in again (185 000 page
   // faults, ~10 % of a diagnosis in the kernel). Blocks up to 32 MiB come from the heap, and
   // up to 256 MiB of freed heap is kept.
   mallopt(M_MMAP_THRESHOLD, 32 << 20);

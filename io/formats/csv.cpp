@@ -66,8 +66,8 @@ std::optional<double> parse_decimal(std::string_view s) {
     if (digits() == 0) return std::nullopt;
   }
   if (i != s.size()) return std::nullopt;
-  // The grammar is strtod's decimal subset, so strtod reads it exactly as before (the "C"
-  // locale: the program never sets another).
+  // The grammar is strtod's decimal subset, so strtod reads exactly what the grammar accepted
+  // (the "C" locale: the program never sets another).
   const std::string text(s);
   const double x = std::strtod(text.c_str(), nullptr);
   if (!std::isfinite(x)) return std::nullopt;  // 1e999

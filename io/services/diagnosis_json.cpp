@@ -120,7 +120,7 @@ json campaign_row(const validation::BlindCampaign& k) {
               {"called", k.called}, {"simulate_s", k.simulate_s}, {"wall_s", k.wall_s}};
   if (k.category == "single" || k.category == "natural") {
     row["effect_gap_sigma"] = finite_or_null(k.effect_gap_sigma);  // the scored size
-    row["effect_max_sigma"] = k.effect_max_sigma;                   // the old size, beside
+    row["effect_max_sigma"] = k.effect_max_sigma;                   // the largest run's size, beside
   }
   row["gap_rms_before_g"] = finite_or_null(k.gap_rms_before_g);  // held out, the lab's noise removed
   row["gap_rms_after_g"] = finite_or_null(k.gap_rms_after_g);
@@ -480,7 +480,7 @@ std::string blind_html(const validation::BlindResult& r) {
                      f.ambiguous, f.right_among, f.error, f.parameters_off);
   h += "</table>\n";
   {
-    // The two family sizes and the two shrinkages side by side (docs/diagnose.md, "Blind's measures").
+    // The two family sizes and the two shrinkages side by side (docs/blind.md, "Blind's measures").
     const validation::BlindScores& s = r.scores;
     const validation::OldSizeScores& o = s.by_max_run_sigma;
     const auto fam = [](const std::map<std::string, validation::FamilyScore>& m, const std::string& name) {

@@ -133,7 +133,7 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
       // hypothesis the diagnosis fits: which family a campaign is scored in must not depend on
       // the model under test. The scored size is the gap's significance as the nominal model
       // sees it (after what the static test's coefficient uncertainty absorbs; the nominal
-      // model and the static test only); the old one, the largest run's, beside it.
+      // model and the static test only); the largest run's size beside it.
       const Campaign clean = simulate_campaign(truth, {}, default_design(), k.seed, 1);
       for (std::size_t j = 0; j < camp.runs.size(); ++j)
         k.effect_max_sigma =
@@ -351,7 +351,8 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
 // Scores one campaign against its key into r (counts, confusion, the wrong ones).
 // The held-out shrinkages 1 - after / before of the single campaigns: of the residuals' rms
 // (with the runs' noise) in g and in each run's sigma, and of the gap's rms (noise removed), over
-// the scored single family; the first two over the old size's single family too (as before).
+// the scored single family; the first two over the single family by the largest run's size
+// too.
 struct Shrinkages {
   std::vector<double> residual_g, residual_sigma, gap, old_residual_g, old_residual_sigma;
 };
@@ -362,7 +363,7 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
   const std::string& called = k.called;
   score_family(k, k.effect_gap_sigma, s.families, &r.wrong);
   score_family(k, k.effect_max_sigma, s.by_max_run_sigma.families, nullptr);
-  if (k.category == "single" && k.error.empty()) {  // the old size's single family, as before
+  if (k.category == "single" && k.error.empty()) {  // the single family by the largest run's size
     OldSizeScores& o = s.by_max_run_sigma;
     if (k.effect_max_sigma < 5) {
       ++o.small, o.small_right += called == k.hidden[0].name;
@@ -372,7 +373,7 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
       if (d.rms_before_sigma > 0) sh.old_residual_sigma.push_back(1 - d.rms_after_sigma / d.rms_before_sigma);
     }
   } else if (k.category == "single") {
-    ++s.by_max_run_sigma.single;  // an error counts against it, as before
+    ++s.by_max_run_sigma.single;  // an error counts against it
   }
   if (k.category == "sigma_understated" || k.category == "drift" || k.category == "dynamics_off") {
     ++r.confusion[k.category][called];
@@ -489,12 +490,12 @@ std::string unescaped(const std::string& s) {
 
 // The fields: 17 fixed (times, scores' numbers, names), then the verdict, the ambiguous
 // effects (their count, then each), the nuisances (their count, then 8 fields each): what the
-// scoring reads. (Before, the verdict, the nuisances and the ambiguity were not sent, so a
-// nuisance campaign scored "no gap" whatever its diagnosis said.)
+// scoring reads. (Without the verdict, the nuisances and the ambiguity a nuisance campaign
+// would score "no gap" whatever its diagnosis says.)
 // Then the top effect's parameters (their count, then 6 fields each: name, unit, value,
 // sigma, status, at_bound). Last, "gap" and the effect's gap significance, the gap's held-out
-// rms before and after with the lab's noise removed (a line without them was written before
-// they were kept: OutdatedCampaignResult).
+// rms before and after with the lab's noise removed (a line without them is outdated:
+// OutdatedCampaignResult, and the campaign is diagnosed again).
 constexpr std::size_t kFixedResultFields = 17, kNuisanceFields = 8, kParameterFields = 6, kGapFields = 4;
 
 std::string campaign_result_text(const BlindCampaign& k) {

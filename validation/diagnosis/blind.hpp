@@ -1,5 +1,5 @@
 #pragma once
-// validation/diagnosis/blind.hpp -- the blind test of the diagnosis (docs/diagnose.md):
+// validation/diagnosis/blind.hpp -- the blind test of the diagnosis (docs/blind.md):
 // campaigns simulated with random hidden effects, diagnosed without their keys, then scored.
 //
 // Takes: BlindSettings (how many campaigns, the seed of the draw, threads, the diagnosis' settings).
@@ -19,8 +19,8 @@
 // lab's log would. The nuisances are the lab's data acquisition's: applied to the runs'
 // summaries, not to the physics (which stays the ODE's).
 // A single effect (or a natural form) whose gap, as the diagnosis' nominal model sees it, is
-// below 5 sigma (effect_gap_sigma) is reported, not scored; the old size (the largest run's
-// gap in its own sigma, effect_max_sigma) is scored beside it (BlindScores::by_max_run_sigma).
+// below 5 sigma (effect_gap_sigma) is reported, not scored; the largest run's size (the
+// largest run's gap in its own sigma, effect_max_sigma) is scored beside it (BlindScores::by_max_run_sigma).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -79,7 +79,7 @@ struct BlindCampaign {
   // model sees it (less what the static test takes up) against the covariance V it judges the
   // runs by (nominal_gap_significance): the separation of the best test of a known-shape gap.
   // Scored (single, natural) when >= 5. NaN: not computed (other families; an error).
-  // effect_max_sigma (the old size, reported beside it): the largest |with - without| over
+  // effect_max_sigma (the largest run's size, reported beside it): the largest |with - without| over
   // the runs in that run's sigma; it ignores what the coefficients' uncertainty can absorb.
   double effect_max_sigma = 0;
   double effect_gap_sigma = NAN;
@@ -108,7 +108,7 @@ struct FamilyScore {
   int parameters_off = 0;
 };
 
-// The families sized the old way (a single or natural campaign below 5 sigma in every run,
+// The families sized by the largest run (a single or natural campaign below 5 sigma in every run,
 // effect_max_sigma, is "_below_5_sigma"), kept beside the scored ones (effect_gap_sigma).
 struct OldSizeScores {
   int single = 0, single_right = 0, small = 0, small_right = 0;
@@ -129,7 +129,7 @@ struct BlindScores {
   double median_gap_shrinkage = 0;
   int gap_shrinkage_campaigns = 0;  // single campaigns it is the median of
   double median_shrinkage = 0, median_shrinkage_in_sigma = 0;
-  OldSizeScores by_max_run_sigma;  // the old family size, beside
+  OldSizeScores by_max_run_sigma;  // the families by the largest run's size, beside
   std::map<std::string, FamilyScore> families;  // per family (category)
   static double rate(int k, int of) { return of ? static_cast<double>(k) / of : 0.0; }
 };
@@ -221,8 +221,7 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
 // What the diagnosis found for campaign k (not its key, which the draw gives), as one line of
 // text (no newline; numbers to 17 digits: read back exactly), and back into a drawn campaign.
 // read_campaign_result throws std::invalid_argument for a line it cannot read.
-// A line written before the gap's size and noise-free rms were stored (effect_gap_sigma,
-// gap_rms_*_g) throws OutdatedCampaignResult: run_blind diagnoses that campaign again rather
+// A line without the gap's size and noise-free rms (effect_gap_sigma, gap_rms_*_g) throws OutdatedCampaignResult: run_blind diagnoses that campaign again rather
 // than score it without them.
 struct OutdatedCampaignResult : std::invalid_argument {
   using std::invalid_argument::invalid_argument;

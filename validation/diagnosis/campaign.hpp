@@ -13,7 +13,7 @@
 //        hidden effects, plus Gaussian noise of the run's sigma). The nominal dynamics are
 //        the truth's without its hidden effects. Nothing of the truth is in the Campaign.
 // The truth is built by each effect's truth hook (plant modules and shaker decorators), not
-// by the hypothesis the diagnosis fits (docs/diagnose.md, "Truth and hypothesis").
+// by the hypothesis the diagnosis fits (docs/effects.md, "Truth and hypothesis").
 #include <cstdint>
 #include <functional>
 #include <random>
@@ -40,8 +40,8 @@ struct HiddenEffect {
 };
 
 // A blind campaign's draw of the effect's parameter (Effect::draw: the ranges where its gap is
-// several sigma in the default design). The same rng calls for a given seed as before the
-// registry, so blind seeds draw the same truths.
+// several sigma in the default design). Fixed rng calls per effect, so a blind seed draws the
+// same truths.
 HiddenEffect draw_hidden(const Effect& e, std::mt19937_64& rng);
 // The same, then the further parameters away from their defaults (Effect::draw_form; the
 // default form when the effect has none).

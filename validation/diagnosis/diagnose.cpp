@@ -1,5 +1,5 @@
-// The diagnosis as a pipeline of stages, in docs/diagnose.md's order ("What diagnose does",
-// "Lab nuisances"): each stage is a file of validation/diagnosis/internal/ with a header saying
+// The diagnosis as a pipeline of stages, in docs/diagnose.md's order (steps 1-11, "4. Lab
+// nuisances" among them): each stage is a file of validation/diagnosis/internal/ with a header saying
 // what it takes and gives.
 #include "validation/diagnosis/diagnose.hpp"
 

@@ -227,7 +227,7 @@ Nuisance remove_drift(Campaign& c);
 Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {});
 
 // The gap a hidden effect makes, as the diagnosis' nominal model sees it (blind's family size;
-// docs/diagnose.md, "Blind's measures"). `with` and `without` are one virtual-lab campaign
+// docs/blind.md, "Blind's measures"). `with` and `without` are one virtual-lab campaign
 // simulated with and without the effect from the same seed (the same noise draws, in the
 // static readings and in the runs). Each is seen as diagnose sees a campaign before any
 // effect hypothesis: its drift line removed, the coefficients identified from its own static

@@ -46,7 +46,7 @@ Vec3 series_orientation_deg(int series, double angle_deg);
 // cos and sin of an angle in degrees, reduced exactly to [-45, 45] deg first.
 std::pair<double, double> cos_sin_deg(double angle_deg);
 // N equally spaced positions per series, phi = (j - 1) 360/N deg, for the given series
-// (computed in radians, as the shipped results were: the identification decides its rank on
+// (computed in radians, as the shipped results are: the identification decides its rank on
 // the unscaled design, where the 1e-16 rounding columns count as zero).
 std::vector<Position> equally_spaced_positions(int per_series, const std::vector<int>& series = {1, 2, 3});
 Position series_position(int series, double angle_rad);

@@ -94,12 +94,13 @@ class EffectFitter {
   // fitted values over the same free parameters (not the multi-start: the shift is small), and
   // b = (v+ - v-) / 2 (each refit's shift of a phase taken the short way round, within +-pi). For a linear one-parameter
   // effect b = f p (the parameter known to f of itself); errors independent run by run would
-  // give f p / sqrt(N) of N like runs, which a systematic error does not average down. A large
-  // effect seen at hundreds of sigma had sigma from the noise only (a harmonic's phase 4 sigma
-  // off its truth at 0.056 rad); a small one is left as it was (f Delta << sigma_run).
-  // The first-order shift b = C J^T V^-1 f Delta it replaces mixed the objective's Hessian (C)
-  // with the Gauss-Newton slopes J, which overstate a harmonic's phase curvature hundredfold:
-  // phases within 0.04-0.39 rad of their truth were reported +- 5-12 rad (seeds 8801, 8901).
+  // give f p / sqrt(N) of N like runs, which a systematic error does not average down. Without it a
+  // large effect seen at hundreds of sigma has sigma from the noise only (a harmonic's phase 4
+  // sigma off its truth at 0.056 rad); a small one's covariance barely changes (f Delta <<
+  // sigma_run). The refits, not the first-order shift b = C J^T V^-1 f Delta: that mixes the
+  // objective's Hessian (C) with the Gauss-Newton slopes J, which overstate a harmonic's phase
+  // curvature hundredfold, and would report phases within 0.04-0.39 rad of their truth
+  // +- 5-12 rad (seeds 8801, 8901).
   // A refit that fails (the plant refuses a value) or ends on a non-periodic parameter's bound
   // is not used: the other side's shift alone (v -+ v, one-sided) stands for it, and with neither
   // the first-order shift does. Reported only: the folds' fits, the evidence and the verdict do

@@ -149,9 +149,9 @@ std::vector<double> EffectFitter::levenberg_marquardt(const Data& d, const std::
       std::vector<double> up = v, down = v;
       const double x = v[static_cast<std::size_t>(j)];
       // A phase's differences are taken round the circle (central at +-pi too): clamped at
-      // the range's ends, they were one-sided there and without the curvature's rescaling,
-      // so steps of Gauss-Newton's hundredfold curvature crept along (seed 9301, campaign
-      // 54: from the start at -pi, 15 steps ended at 3.13 rad, 63 above the valley at 2.55).
+      // the range's ends, they would be one-sided there and without the curvature's rescaling,
+      // so steps of Gauss-Newton's hundredfold curvature would creep along (seed 9301, campaign
+      // 54: from the start at -pi, 15 such steps end at 3.13 rad, 63 above the valley at 2.55).
       const double x_up = wraps(j) ? x + h : std::min(x + h, hi), x_down = wraps(j) ? x - h : std::max(x - h, lo);
       up[static_cast<std::size_t>(j)] = wraps(j) ? wrapped(j, x_up) : x_up;
       down[static_cast<std::size_t>(j)] = wraps(j) ? wrapped(j, x_down) : x_down;

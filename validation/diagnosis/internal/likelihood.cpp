@@ -19,8 +19,8 @@ Eigen::MatrixXd rows(const Eigen::MatrixXd& m, const std::vector<int>& idx) {
 // prediction, an effect could lower chi^2 by inflating its predictions.
 // (Only the lower triangle is a product, the upper its mirror: every use factorises V, which
 // reads the lower triangle, or takes its diagonal. Each entry is the same sum in the same
-// order as the full product's, so the factorisations are bit for bit as before, at half the
-// product's work.)
+// order as the full product's, so the factorisations equal the full product's bit for bit, at
+// half its work.)
 Eigen::MatrixXd covariance(const Data& d, const Eigen::MatrixXd& G, const std::vector<int>& idx) {
   const Eigen::MatrixXd Gi = rows(G, idx);
   const Eigen::MatrixXd GS = Gi * d.Sigma;

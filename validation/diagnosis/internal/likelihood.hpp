@@ -1,6 +1,7 @@
 #pragma once
 // validation/diagnosis/internal/likelihood.hpp -- the runs' data and their Gaussian likelihood,
-// the diagnosis' shared arithmetic (docs/diagnose.md, "The statistics").
+// the diagnosis' shared arithmetic (docs/diagnose.md, "3. The gap and where it lies":
+// "Covariance" and "The factored likelihood").
 //
 // Takes: the runs' measured vibration errors (g) and variances (g^2: the run's own plus the
 //        simulation's, (model_accuracy x nominal prediction)^2), the static test's coefficient
