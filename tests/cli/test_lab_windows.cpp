@@ -1,8 +1,8 @@
 // Half-open windows read the same way by `measure` and by the lab data's raw records
 // (diagnose): a record whose last sample is at the vibration window's end minus one sample
-// interval covers [from, to); `measure` accepted it while `diagnose` skipped the run ("the
-// record ends at 0.799 s, before on_to_s = 0.8 s"). Both now decide with
-// rectification::record_covers_window_end, and both refuse a record one sample shorter.
+// interval covers [from, to). `measure` and `diagnose` decide with the same
+// rectification::record_covers_window_end, so neither accepts a record the other skips ("the
+// record ends at 0.799 s, before on_to_s = 0.8 s"), and both refuse a record one sample shorter.
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -146,9 +146,9 @@ TEST(FrequencyDependentEq3, HoldsWithoutIntegratorAndBehindAMaskedMechanicalMode
     }
 }
 
-// Issue 15: a mode above the drive (2.5 kHz, driven at 800 Hz) gave |I| = 0: the unscaled
-// (jw - A) spans 1e-4 .. 1e11 (the mode's states are ~1 / w_m^2) and the full-pivot LU's rank
-// threshold dropped real pivots. The mode is a linear stage in front of the loop, so the
+// A mode above the drive (2.5 kHz, driven at 800 Hz; issue 15): the unscaled (jw - A) spans
+// 1e-4 .. 1e11 (the mode's states are ~1 / w_m^2), and a full-pivot LU's rank threshold would
+// drop real pivots and give |I| = 0, so the solve is in the plant's state scales. The mode is a linear stage in front of the loop, so the
 // current with it is the current without it times its transmissibility, written out here
 // (w_m^2 + 2 z w_m s) / (s^2 + 2 z w_m s + w_m^2): checked to 1e-9 relative (rounding of two
 // 13-state solves) for modes from 0.1 to 10 times the drive; and the repro's rectification
@@ -178,7 +178,7 @@ TEST(FrequencyDependentEq3, AModeAboveOrBelowTheDriveFiltersTheLoopsInput) {
   v.frequency_Hz = 800;
   const Vec3 a(0.5, std::sqrt(0.75), 0);
   const double predicted = rectification::sine_rectification_at_frequency(repro, a, v).total_g();
-  EXPECT_GT(predicted, 50e-6);  // about 117 ug (0 before the fix)
+  EXPECT_GT(predicted, 50e-6);  // about 117 ug (0 if real pivots are dropped)
   EXPECT_NEAR(rectification::shake_sine(repro, a, v).measured_g, predicted, 0.01 * predicted);
 }
 

@@ -2,7 +2,7 @@
 // coefficients computed once, the terms for any coefficients. diagnose evaluates a run's
 // prediction at 12 coefficient vectors on one prepared object (its gradient in the
 // coefficients) and relies on each being the prediction of the plant with those coefficients,
-// bit for bit (docs/diagnose.md, "Speed"). The independent path: the one-shot functions on a
+// bit for bit (docs/performance.md, "Diagnosis"). The independent path: the one-shot functions on a
 // plant that carries the second coefficients from the start, so a prepared part that read the
 // coefficients it was built with would show here. Exact equality is the claim (the same
 // floating-point operations), so the tolerance is 0.

@@ -176,7 +176,7 @@ TEST(ShakePeriodic, SteadyStatePathsAgreeWithTheSettledTransient) {
 
 TEST(ShakePeriodic, AStronglyNonlinearLoopFallsBackToTheTransient) {
   // Current saturation clips 4.7 g of demand at 3 g: the linear monodromy does not describe
-  // the loop, the one-period check fails and the transient path measures, as before.
+  // the loop, the one-period check fails and the transient path measures (the fallback).
   PlantConfig cfg = test::paper_like_linear_plant();
   cfg.effects.push_back(std::make_shared<CurrentSaturation>(3.0));
   const auto r = rectification::shake_sine(cfg, Vec3(std::sqrt(0.5), 0, std::sqrt(0.5)), sine(10, 4));

@@ -133,8 +133,8 @@ TEST(EffectRegistry, EveryEffectIsCompleteAndConsistent) {
   }
   EXPECT_EQ(library, static_cast<int>(effect_library().size()));
   EXPECT_EQ(find_effect("no_such_effect"), nullptr);
-  // The diagnosis' order (ties and output order): the library's first entries as before.
-  // (servo_phase_margin became servo_dynamics' margin: docs/diagnose.md, "Loop dynamics".)
+  // The diagnosis' order (ties and output order): the library's first entries are fixed.
+  // (The phase margin is a parameter of servo_dynamics: docs/effects.md, "Loop dynamics".)
   ASSERT_GE(effect_library().size(), 14u);
   EXPECT_EQ(effect_library().front().name, "pickoff_nonlinearity");
   EXPECT_EQ(effect_library()[13].name, "fixture_rocking");
@@ -142,9 +142,9 @@ TEST(EffectRegistry, EveryEffectIsCompleteAndConsistent) {
   EXPECT_THROW(simulate_campaign(truth(), {{"no_such_effect", 1}}, small_design(), 1, 1), std::invalid_argument);
 }
 
-// The blind draws make the rng calls blind made before the registry (a blind seed keeps its
-// truths): a sign first, used or not, then the range; two effects written out as that code had
-// them, and every draw valid.
+// The blind draws make fixed rng calls per effect (a blind seed keeps its truths): a sign
+// first, used or not, then the range; two effects' draws written out here, and every draw
+// valid.
 TEST(EffectRegistry, BlindDrawsKeepTheirRngCalls) {
   const auto log_uniform = [](std::mt19937_64& g, double lo, double hi) {
     return std::exp(std::uniform_real_distribution<double>(std::log(lo), std::log(hi))(g));
@@ -369,8 +369,8 @@ TEST(DiagnoseCampaign, ServoDynamicsAreTellApartFromAResonance) {
 }
 
 // The shaker's 2nd harmonic (20 %): mostly (1 + h^2) on the quadratic terms, which the
-// loop filters at f and 2f. Before the periodic model it was taken for servo_dynamics (a
-// crossover moved) in blind campaigns. Tolerance: 3 fitted sigma plus 1 % (the grid fit's
+// loop filters at f and 2f. Without the periodic model (each tone through the loop at its own
+// frequency) it would pass for servo_dynamics (a crossover moved) in blind campaigns. Tolerance: 3 fitted sigma plus 1 % (the grid fit's
 // refinement and the first-order model).
 TEST(DiagnoseCampaign, HiddenHarmonicDistortionIsFoundAndFitted) {
   const Campaign c = simulate_campaign(truth(), {{"shaker_harmonic_distortion", 0.2}}, small_design(), 37, 2);

@@ -167,7 +167,7 @@ TEST(NaturalFormCampaign, ACleanCampaignIsNotExplainedByTheRicherEffects) {
 // IA, PA and OA over a decade and a half pin the in-phase ratio, the power and the axis; the
 // quadrature part reaches the output only through the quadratic terms (k2 from PA runs, at
 // (r A)^2), which may leave it held: then the in-phase ratio is what the cross terms measure.
-// Seed 6010 (the dev range of session 6).
+// Seed 6010 (a development seed).
 TEST(NaturalFormCampaign, TransverseMotionOutOfPhaseOnTheOtherAxisIsFoundWithItsLaw) {
   const std::vector<double> v = {0.08 * std::cos(0.6), 0.08 * std::sin(0.6), 2, 1};
   const Campaign c = simulate_campaign(truth(), {HiddenEffect("shaker_transverse_motion", v[0], {v[1], v[2], v[3]})},

@@ -2,9 +2,9 @@
 // validation::predict_run_g) against the ODE (its truth hook through the virtual shaker),
 // swept over 10 Hz - 2 kHz (log-spaced) and over its parameter's range: the values blind
 // hides (the extremes of 400 draws of Effect::draw, each sign drawn) and, for a parameter the
-// fit explores on a grid, the grid's ends (the fit must be right where it looks). Issue 15:
-// a mode above the drive was predicted as no response at all; a test at two frequencies and
-// one value could not see it. The run: 4 g along IA+PA (every effect acts), the static a_IA
+// fit explores on a grid, the grid's ends (the fit must be right where it looks). A test at
+// two frequencies and one value cannot see a prediction that fails on part of the band (a
+// mode above the drive predicted as no response at all; issue 15). The run: 4 g along IA+PA (every effect acts), the static a_IA
 // +0.71 g, the paper-like instrument. Compared: the change each makes (with the effect less
 // without), so the first-order model's own error without any effect (< 0.01 ug here) is not
 // charged to the effect; the prediction as the diagnosis makes it (from the statically
@@ -161,7 +161,7 @@ Identified identified(const Effect& e, const std::vector<double>& values) {
   at_rest.instrument = truth;
   e.truth(values, at_rest);
   // An effect of the table's motion or of the runs' acquisition leaves the static test's
-  // instrument, and so its identification, as it was.
+  // instrument, and so its identification, unchanged.
   out.with.coefficients = e.acts_on == ActsOn::instrument ? identified_by_static_test(at_rest.instrument) : base;
   if (e.acts_at_rest) {
     const std::vector<Position> positions = equally_spaced_positions(12);

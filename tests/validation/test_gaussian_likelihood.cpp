@@ -4,8 +4,8 @@
 // lemma and Sherman-Morrison in long double where one slope column puts V's entries 1e19 above
 // the runs' variances (a mechanical mode fitted on other runs, sitting on a run's frequency),
 // which a factorisation of V in double cannot hold; and the invariance of V under a slope
-// column scaled by s and its variance by 1/s^2. Last, the campaign where the dense LDLT's
-// ln det V was -inf (seed 9501, campaign 21; label "campaign").
+// column scaled by s and its variance by 1/s^2. Last, a campaign where a dense LDLT of V
+// gives ln det V = -inf (seed 9501, campaign 21; label "campaign").
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -198,9 +198,9 @@ TEST(GaussianLikelihood, InputsThatAreNoCovarianceGiveNaN) {
 }
 
 // Seed 9501, campaign 21: a pickoff nonlinearity of 16.3 /rad (a 1458-sigma gap), replayed as
-// blind makes it. On the fold that leaves 4 g out, mechanical_mode fitted to the 1-2 g runs sat
-// on the 100 Hz runs with slopes of 1e5 g/Hz; an LDLT of V met negative pivots, ln det V was
-// -inf and the mode's evidence +inf ranked it first: "not explained". With V factored as above
+// blind makes it. On the fold that leaves 4 g out, mechanical_mode fitted to the 1-2 g runs sits
+// on the 100 Hz runs with slopes of 1e5 g/Hz; an LDLT of V meets negative pivots, ln det V is
+// -inf and the mode's evidence +inf would rank it first: "not explained". With V factored as above
 // every evidence is finite and the pickoff (16.33 +- 0.16, held-out chi^2 137 for 168 runs)
 // explains the gap. A whole campaign (~6 s in Release): in NaturalMissesCampaign, label "campaign".
 TEST(NaturalMissesCampaign, ALargePickoffIsNotOutrankedByAnInfiniteEvidence) {

@@ -208,8 +208,8 @@ TEST(PaperTable, AveragesRepeatsAndRejectsOtherSets) {
 // Issue 13, item 1: a 4-position tumble per series (0, 90, 180, 270 deg) sees no product of
 // two axes, so with k1_asym, k3, k4 and k_PP held the 9 free coefficients have rank 6 (k_IP,
 // k_IO and k_PO affect no reading). cos 90 deg computed in radians is 6e-17, and column
-// scaling made those rounding columns full size: rank 9 was reported and k_IP came out
-// from rounding. Angles in degrees are exact at multiples of 90 deg, and the rank is decided
+// scaling would make those rounding columns full size (rank 9 reported, k_IP from
+// rounding). Angles in degrees are exact at multiples of 90 deg, and the rank is decided
 // on the unscaled design.
 TEST(Identifiability, AFourPositionTumbleHasRank6NotRoundingColumns) {
   for (double deg : {0.0, 90.0, 180.0, 270.0, -90.0, 450.0, 720.0}) {

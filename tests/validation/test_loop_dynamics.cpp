@@ -1,9 +1,9 @@
-// Loop dynamics in their natural form (issue 15; docs/diagnose.md, "Loop dynamics"):
+// Loop dynamics in their natural form (issue 15; docs/effects.md, "Loop dynamics"):
 // servo_dynamics fits the crossover, the phase margin and the pendulum frequency against the
 // manifest's together. The campaigns are made by the ODE plant with the truth's dynamics set
 // directly in its PlantConfig (the servo designed for them, plant/accelerometer.cpp), never
-// through the hypothesis; the manifest states other ones. Seeds 6150-6153 (this session's
-// development range) were not used to develop the fit. The campaign tests diagnose a whole
+// through the hypothesis; the manifest states other ones. Seeds 6150-6153 (a development
+// range) were not used to develop the fit. The campaign tests diagnose a whole
 // simulated campaign (5-7 s each in Release): label "campaign" (tests/CMakeLists.txt).
 #include <gtest/gtest.h>
 
@@ -193,17 +193,17 @@ TEST(LoopDynamics, BlindScoresDynamicsOffByEveryFittedParameter) {
 }
 
 // The issue's case: crossover x0.96, pendulum frequency x1.03 and margin +3 deg off the
-// manifest together (a lab's estimate). Before, two one-parameter loop effects could not take
-// up three departures and the gap was "not explained".
+// manifest together (a lab's estimate). One effect with three parameters takes up the three
+// departures; two one-parameter loop effects could not (the gap "not explained").
 TEST(LoopDynamicsCampaign, CrossoverMarginAndPendulumOffTheManifestAreFittedTogether) {
   const Departure x{0.96, 3.0, 1.03};
   expect_loop_found(diagnose(campaign_off_manifest(x, 6150)), x);
 }
 
 // A single servo change is still called by its name: the crossover alone (x1.3), the
-// further parameters found at their nominal (or held); the margin alone (-15 deg, what
-// servo_phase_margin was), the crossover found at 1. Neither is "ambiguous": one effect
-// carries the loop's dynamics (docs/diagnose.md, "Loop dynamics").
+// further parameters found at their nominal (or held); the margin alone (-15 deg), the
+// crossover found at 1. Neither is "ambiguous": one effect carries the loop's dynamics
+// (docs/effects.md, "Loop dynamics").
 TEST(LoopDynamicsCampaign, ASingleServoChangeIsCalledServoDynamics) {
   const Departure crossover{1.3, 0, 1};
   expect_loop_found(diagnose(campaign_off_manifest(crossover, 6151)), crossover);

@@ -56,10 +56,10 @@ FittedParameter expect_harmonic_within_3_sigma(std::uint64_t seed, int index, co
 
 }  // namespace
 
-// Seed 8601, campaign 19: a 3rd harmonic, ratio 0.1855 at 0.143 rad. Its phase was reported
-// 0.219 +- 0.0094 rad (7.6 sigma off) although -2 ln L at the truth was 0.29 above the
-// minimum: the sigma came from second differences over a 1e-3 rad step, below the
-// simulation's rounding in -2 ln L. With the objective's Hessian over steps the likelihood
+// Seed 8601, campaign 19: a 3rd harmonic, ratio 0.1855 at 0.143 rad. A sigma from second
+// differences over a 1e-3 rad step, below the simulation's rounding in -2 ln L, would report
+// its phase 0.219 +- 0.0094 rad (7.6 sigma off) although -2 ln L at the truth is 0.29 above
+// the minimum. With the objective's Hessian over steps the likelihood
 // resolves, the phase's sigma is what -2 ln L says (~0.3 rad) and the truth lies within 3 sigma.
 TEST(NaturalMissesCampaign, AThirdHarmonicsPhaseSigmaIsWhatTheLikelihoodSays) {
   const BlindResult r = replay(8601, 19);
@@ -80,11 +80,11 @@ TEST(NaturalMissesCampaign, AThirdHarmonicsPhaseSigmaIsWhatTheLikelihoodSays) {
   EXPECT_EQ(r.scores.families.at("natural").right, 1);
 }
 
-// Seed 8701, campaign 43: a 3rd harmonic, ratio 0.2317 at 2.255 rad, was called "not
-// explained": on the fold that leaves 2 g out, Levenberg-Marquardt from the best start (0 rad)
-// ended in the phase's other valley (0.30 rad, 36 above the one at 2.3 rad that the start at
-// pi/2 leads to), and the held-out 2 g runs failed it. Every start within 25 of the best now
-// descends; the lowest wins. Checked: the gap explained by the 3rd harmonic (held-out runs
+// Seed 8701, campaign 43: a 3rd harmonic, ratio 0.2317 at 2.255 rad. On the fold that leaves
+// 2 g out, Levenberg-Marquardt from the best start (0 rad) ends in the phase's other valley
+// (0.30 rad, 36 above the one at 2.3 rad that the start at pi/2 leads to), and the held-out
+// 2 g runs fail it: descended from that start alone, the gap would be "not explained". So
+// every start within 25 of the best descends; the lowest wins. Checked: the gap explained by the 3rd harmonic (held-out runs
 // included), its phase in the truth's valley (within 3 sigma of 2.255 rad,
 // not the other valley's 0.30 rad) and blind's score.
 TEST(NaturalMissesCampaign, AThirdHarmonicsPhaseIsFoundInItsValleyAndExplainsTheGap) {
@@ -109,9 +109,10 @@ TEST(NaturalMissesCampaign, AThirdHarmonicsPhaseIsFoundInItsValleyAndExplainsThe
 }
 
 // Seed 8801, campaign 7: a 3rd harmonic, ratio 0.1322 at 2.327 rad, fitted 0.1445 at 1.940 rad
-// (the Hessian's sigma 0.0064 and 0.27 rad) but reported +- 0.033 and +- 11.7 rad: the
-// hypothesis' accuracy term was the first-order shift C J^T V^-1 f Delta, whose Gauss-Newton
-// slopes J overstate the phase's curvature hundredfold against the Hessian's C. Two refits of
+// (the Hessian's sigma 0.0064 and 0.27 rad). With the first-order shift C J^T V^-1 f Delta
+// as the hypothesis' accuracy term, whose Gauss-Newton slopes J overstate the phase's
+// curvature hundredfold against the Hessian's C, it would be reported +- 0.033 and
+// +- 11.7 rad. Two refits of
 // the data shifted by +-f Delta move the phase by ~0.01 rad and the ratio by ~0.006 (the
 // effect's change is not linear in the ratio at this phase): the sigma claims something (3
 // sigma of the phase below pi, the ratio's sigma below its prior width) and the truth lies
@@ -126,35 +127,36 @@ TEST(NaturalMissesCampaign, AThirdHarmonicsSigmaWithTheHypothesisAccuracyClaimsS
   EXPECT_GE(ratio.sigma, 0.01 * ratio.value);
 }
 
-// Seed 9301, campaign 54: a 2nd harmonic, ratio 0.2166 at 2.530 rad, was fitted 0.186 +- 0.010
-// at 3.126 +- 0.08 rad (the phase 7 sigma off). The first-order prediction is right there (its
-// change against the ODE's, the truth's coefficients, over 168 runs x 18 phases round the
-// circle: within 0.11 of a run's sigma in every run, sum of squares <= 0.05, printed while
-// developing this); the descent was not: from the best start, -pi, Levenberg-Marquardt took
-// the phase's differences clamped at the range's ends (one-sided, no curvature rescaling) and
-// crept 0.016 rad in 15 steps, to 3.126 rad, where -2 ln L profiled over the phase is 63 above
-// its valley at 2.55 rad. Taken round the circle, the descent reaches the valley.
+// Seed 9301, campaign 54: a 2nd harmonic, ratio 0.2166 at 2.530 rad. The first-order
+// prediction is right there (its change against the ODE's, the truth's coefficients, over
+// 168 runs x 18 phases round the circle: within 0.11 of a run's sigma in every run, sum of
+// squares <= 0.05, printed while developing this); the descent must take the phase's
+// differences round the circle. Clamped at the range's ends (one-sided, no curvature
+// rescaling), Levenberg-Marquardt from the best start, -pi, would creep 0.016 rad in 15 steps,
+// to 3.126 rad, where -2 ln L profiled over the phase is 63 above its valley at 2.55 rad
+// (fitted 0.186 +- 0.010 at 3.126 +- 0.08 rad, the phase 7 sigma off). Taken round the circle,
+// the descent reaches the valley.
 TEST(NaturalMissesCampaign, ASecondHarmonicsPhaseDescendsAcrossPi) {
   expect_harmonic_within_3_sigma(9301, 54, "shaker_harmonic_distortion", "second_harmonic_ratio", "second_harmonic_phase_rad");
 }
 
-// Seed 8901, campaign 90: a 2nd harmonic, ratio 0.1418 at 0.969 rad, was fitted with its phase
-// held at 0 and its ratio 0.072 +- 0.015 (4.7 sigma off). -2 ln L profiled over the phase has
-// its valley at 0.8-1.0 rad, 37 below the phase held at 0: the data pin it. From the best
-// start (pi/2) the descent stopped at 1.52 rad on the valley's flank, where -2 ln L is concave
-// along the phase: without a curvature to step by, Gauss-Newton's (hundredfold a phase's)
-// made the steps crawl, and the Hessian there, not positive definite, had the phase held. With
-// a trust step where the objective is not convex, the descent reaches the valley.
+// Seed 8901, campaign 90: a 2nd harmonic, ratio 0.1418 at 0.969 rad. -2 ln L profiled over
+// the phase has its valley at 0.8-1.0 rad, 37 below the phase held at 0: the data pin it.
+// From the best start (pi/2) the descent meets the valley's flank at 1.52 rad, where -2 ln L
+// is concave along the phase: without a curvature to step by, Gauss-Newton's (hundredfold a
+// phase's) would make the steps crawl and stop there, and the Hessian there, not positive
+// definite, would have the phase held at 0 and the ratio fitted 0.072 +- 0.015 (4.7 sigma
+// off). With a trust step where the objective is not convex, the descent reaches the valley.
 TEST(NaturalMissesCampaign, ASecondHarmonicsPhaseIsFoundFromTheFlankOfItsValley) {
   expect_harmonic_within_3_sigma(8901, 90, "shaker_harmonic_distortion", "second_harmonic_ratio", "second_harmonic_phase_rad");
 }
 
 // Seed 9601, campaign 30: a mechanical mode at 719.5 Hz, damping 0.076, along IA (a 7405 sigma
-// gap), was fitted 720.4 +- 0.26 Hz (3.5 sigma off) although -2 ln L at the truth is 23.6 below
-// the fit's and the prediction is right (0.08 % of the ODE's change at most). The frequency and
+// gap); the prediction is right (0.08 % of the ODE's change at most). The frequency and
 // damping lie in a narrow curved valley (correlation -0.998): differences over the slopes'
-// steps (0.72 Hz, 5e-4) span ~50 and ~10 conditional sigma across it and gave the slope along
-// the frequency the wrong sign, so the descent stopped on the valley's flank. With the
+// steps (0.72 Hz, 5e-4) span ~50 and ~10 conditional sigma across it and give the slope along
+// the frequency the wrong sign, so a descent by them stops on the valley's flank (720.4 +-
+// 0.26 Hz, 3.5 sigma off, although -2 ln L at the truth is 23.6 below there). With the
 // differences over a fraction of the conditional sigma, the objective's own Hessian and a
 // line search along its Newton step, the descent reaches the valley's floor.
 TEST(NaturalMissesCampaign, AResonancesFrequencyAndDampingAreFoundInTheirNarrowValley) {

@@ -7,13 +7,13 @@
 // the first-order model's own error without a film is not charged to it.
 //
 // Tolerance: |HB - ODE| <= 2 % |ODE change| + 0.02 ug. The harmonic balance solves the
-// film's nonlinear damping up to the 31st harmonic on 256 points a period (with 15 harmonics
-// on 128 points it was 11 % off at 3000 /rad, 96 Hz, where the swing reaches the film's clamp
+// film's nonlinear damping up to the 31st harmonic on 256 points a period (15 harmonics on
+// 128 points would be 11 % off at 3000 /rad, 96 Hz, where the swing reaches the film's clamp
 // at 0.95 theta_gap and its kink feeds high harmonics; 1 % with 31); what is left is the
 // first-order model's treatment of the coefficients' terms on that
 // motion, which test_effect_sweep.cpp bounds at 1 % for every other effect (<= 0.4 % seen),
 // and the ODE's own quadrature (1e-9 relative). 2 %: twice the other effects' bound, for the
-// rectification of a motion whose angle now has harmonics of a few tens of % near contact.
+// rectification of a motion whose angle has harmonics of a few tens of % near contact.
 // The floor 0.02 ug is test_effect_sweep.cpp's. The describing function (the harmonics left
 // out) errs by up to 75 % here (96 Hz, 3000 /rad): the test checks the harmonic balance is
 // at least 5 times closer there, so a balance that dropped the harmonics would fail.
