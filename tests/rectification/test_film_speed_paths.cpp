@@ -34,7 +34,8 @@ using namespace vrelab::plant;
 
 namespace {
 
-// The describing function as the film computed it before the tables (the reference).
+// The describing function by the direct sum, without the tables: a sin, a cos and a pow per
+// point (the reference).
 double direct_damping_factor(double theta_amplitude, double gap) {
   constexpr int kN = 128;
   double sum = 0;
@@ -244,7 +245,7 @@ TEST(FilmSpeedPaths, FilmBalanceKeyIsEqualExactlyForTheSamePlantAndMotion) {
 // Parts of variable length next to each other: 9 table tones (52 bytes each: h and three
 // complex amplitudes) and no loop tone, against no table tone and 13 loop tones (36 bytes
 // each: h, current, angle) made of the same 468 bytes. Without the parts' counts the keys
-// were these same bytes after the same prefix: equal.
+// would be these same bytes after the same prefix: equal.
 TEST(FilmSpeedPaths, FilmBalanceKeyTellsPartsOfVariableLengthApart) {
   PlantConfig p;
   p.coefficients[K1] = 1.0;

@@ -49,8 +49,8 @@ double max_run_sigma(const Campaign& a, const Campaign& b) {
 // A departure that is exactly a change of k2 (the truth's, so the static test sees it too): the
 // static test pins k2 (its 1 g readings carry k2 a_IA^2), identifies the change, and the
 // nominal prediction follows it; the gap the diagnosis can see is what is left, the ODE's
-// departure from a prediction linear in the coefficients: ~0. The old size (the largest run's
-// |with - without| over its sigma) calls it tens of sigma. The same noise draws in both
+// departure from a prediction linear in the coefficients: ~0. The largest run's size (the largest
+// run's |with - without| over its sigma) calls it tens of sigma. The same noise draws in both
 // campaigns (one seed): nothing of the noise is in the difference.
 TEST(BlindScoring, ACoefficientChangeTheStaticTestPinsIsNoGap) {
   const plant::PlantConfig truth = truth_of(9100);
@@ -113,7 +113,7 @@ TEST(BlindScoringCampaign, AGapOnOneRunIsSeenAtThatRunsSigma) {
 //    values; heldout_nominal_gap_g reproduces diagnose's heldout_before_g). After: the noise
 //    moves the effect's fitted parameter by about its sigma, which moves what it leaves by
 //    sigma / value of the gap before (a linear effect): 3 x that. The residuals' shrinkage
-//    with the noise (the old measure) stays far below.
+//    with the noise (the diagnosis' rms_before_g and rms_after_g) stays far below.
 TEST(BlindScoringCampaign, TheGapsHeldOutRmsWithoutTheNoiseIsTheNoiseFreeDiagnosis) {
   const DiagnoseSettings s = quick();
   const plant::PlantConfig truth = truth_of(9102);
@@ -169,8 +169,8 @@ TEST(BlindScoringCampaign, TheGapsHeldOutRmsWithoutTheNoiseIsTheNoiseFreeDiagnos
   EXPECT_THROW(gap_rms_without_lab_noise(dn, std::vector<double>(3, 0.0)), std::invalid_argument);
 }
 
-// The result line carries the gap's size and noise-free rms, read back exactly; a line from
-// before they were kept is refused as outdated (run_blind diagnoses it again), a garbled one
+// The result line carries the gap's size and noise-free rms, read back exactly; a line without
+// them is refused as outdated (run_blind diagnoses it again), a garbled one
 // as unreadable.
 TEST(BlindScoring, TheResultLineCarriesTheGapsSizeAndNoiseFreeRms) {
   BlindCampaign k;
@@ -198,11 +198,11 @@ TEST(BlindScoring, TheResultLineCarriesTheGapsSizeAndNoiseFreeRms) {
 // The scoring by both sizes, from result lines alone (nothing simulated): blind's draw 9103's
 // first 12 campaigns, the three single ones (slots 9-11) given sizes and verdicts by hand. A
 // squeeze-film-like campaign 55 sigma in one run but 3 sigma as the lab sees it, not found: a
-// miss by the old size, not scored by the new. One 4 sigma in every run but 8 as the lab sees
-// it, found: scored right by the new size only. One large by both, found. The gap shrinkage's
-// median is over the new size's single family (campaigns 10, 11: 0.5 and 0.9 -> 0.9, the
-// upper median of two as blind takes it); the residuals' old median over the old size's
-// family (campaigns 9, 11).
+// miss by the largest run's size, not scored by the gap's. One 4 sigma in every run but 8 as
+// the lab sees it, found: scored right by the gap's size only. One large by both, found. The
+// gap shrinkage's median is over the gap size's single family (campaigns 10, 11: 0.5 and 0.9
+// -> 0.9, the upper median of two as blind takes it); the residuals' median (with the noise)
+// over the largest-run size's family (campaigns 9, 11).
 TEST(BlindScoring, SinglesAreScoredByTheGapAsTheLabSeesItTheOldSizeBeside) {
   BlindSettings s;
   s.n = 12, s.seed = 9103, s.threads = 1;

@@ -23,7 +23,7 @@ namespace {
 // acceleration) a 2 g PA sine at 250 Hz rectifies k_PP A^2 |T|^2 / 2 with the base-excited
 // transmissibility T = (w_m^2 + 2 z w_m s) / (s^2 + 2 z w_m s + w_m^2) of a 300 Hz mode at
 // z = 0.02 (|T| = 3.27, written out here), against k_PP A^2 / 2 without it; an IA sine is left
-// exactly as it was. Tolerance 0.1 % + 1e-11 g: the solver's 1e-10 relative; a mode on IA
+// exactly unchanged. Tolerance 0.1 % + 1e-11 g: the solver's 1e-10 relative; a mode on IA
 // instead (the default form) would leave the PA run unchanged (a 970 % miss).
 TEST(NaturalBlind, AModeAlongPaMovesThePendulumsBaseAlongPa) {
   plant::PlantConfig c = test::paper_like_linear_plant();

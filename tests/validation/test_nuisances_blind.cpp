@@ -1,8 +1,8 @@
 // Lab nuisances reported whatever the gap's verdict (issue 15), on campaigns whose truth is
 // drawn through blind's own path (validation::blind_truth) with a known drift or a known
 // scatter over the stated sigma, and on clean ones; and the blind result line that carries
-// the nuisances to the scoring (blind --seed 8101 scored its drift and sigma-understated
-// campaigns "no gap" because the line dropped them). Seeds 9000-9019 were picked for these
+// the nuisances to the scoring (a line without them would have blind --seed 8101 score its
+// drift and sigma-understated campaigns "no gap"). Seeds 9000-9019 were picked for these
 // tests and not used to develop the thresholds (those are distribution quantiles:
 // docs/diagnose.md, "Lab nuisances").
 #include <gtest/gtest.h>

@@ -110,8 +110,8 @@ class EffectFitter {
   // What a held further parameter's uncertainty does to the fitted parameters (docs/diagnose.md,
   // "Natural forms"). Held at its nominal because the data do not pin it there, it is
   // not known to be there: the fitted parameters' values depend on where it is (a 2nd
-  // harmonic's ratio fitted with its phase held at 0 came out 0.072 +- 0.015 for a truth of
-  // 0.142 at 0.97 rad: seed 8901, campaign 90, before the descent's trust step). It is
+  // harmonic's ratio fitted with its phase held at 0 comes out 0.072 +- 0.015 for a truth of
+  // 0.142 at 0.97 rad: seed 8901, campaign 90, with a descent that has no trust step). It is
   // marginalised over its range: at kHeldPoints values x spread evenly across the range (a
   // phase's round the circle, its nominal 0 among them), the fitted parameters are refitted
   // with it held at x (the first by its one-parameter fit, then the others with it by
