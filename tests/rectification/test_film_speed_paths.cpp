@@ -1,8 +1,8 @@
 // The squeeze film's fast prediction (docs/performance.md, "Diagnosis"): tables of
 // sines and phasors computed once, one pow per distinct |sin| in the describing function.
 // These pin the fast paths against an independent computation:
-//  - damping_factor against the direct 128-point sum (a sin, a cos and a pow per point): the claim is the same floating-point operations on the same
-//    numbers, so the tolerance is 0;
+//  - damping_factor against the direct 128-point sum (a sin, a cos and a pow per point): the
+//    claim is the same floating-point operations on the same numbers, so the tolerance is 0;
 //  - the periodic rectification of current harmonics up to h = 31 inside the loop (the film's
 //    harmonics: 187 points, the phasor tables of 67-187 points) against the closed form of a
 //    cubic's mean, <u^3> = -(3/4) Im(B conj(A)^2) for u = Im(A e^{j15 phi}) + Im(B e^{j30 phi})

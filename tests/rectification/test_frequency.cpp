@@ -148,8 +148,9 @@ TEST(FrequencyDependentEq3, HoldsWithoutIntegratorAndBehindAMaskedMechanicalMode
 
 // A mode above the drive (2.5 kHz, driven at 800 Hz; issue 15): the unscaled (jw - A) spans
 // 1e-4 .. 1e11 (the mode's states are ~1 / w_m^2), and a full-pivot LU's rank threshold would
-// drop real pivots and give |I| = 0, so the solve is in the plant's state scales. The mode is a linear stage in front of the loop, so the
-// current with it is the current without it times its transmissibility, written out here
+// drop real pivots and give |I| = 0, so the solve is in the plant's state scales. The mode is
+// a linear stage in front of the loop, so the current with it is the current without it
+// times its transmissibility, written out here
 // (w_m^2 + 2 z w_m s) / (s^2 + 2 z w_m s + w_m^2): checked to 1e-9 relative (rounding of two
 // 13-state solves) for modes from 0.1 to 10 times the drive; and the repro's rectification
 // against the ODE (1 %, the issue's bound; 1e-4 seen).

@@ -370,8 +370,8 @@ TEST(DiagnoseCampaign, ServoDynamicsAreTellApartFromAResonance) {
 
 // The shaker's 2nd harmonic (20 %): mostly (1 + h^2) on the quadratic terms, which the
 // loop filters at f and 2f. Without the periodic model (each tone through the loop at its own
-// frequency) it would pass for servo_dynamics (a crossover moved) in blind campaigns. Tolerance: 3 fitted sigma plus 1 % (the grid fit's
-// refinement and the first-order model).
+// frequency) it would pass for servo_dynamics (a crossover moved) in blind campaigns.
+// Tolerance: 3 fitted sigma plus 1 % (the grid fit's refinement and the first-order model).
 TEST(DiagnoseCampaign, HiddenHarmonicDistortionIsFoundAndFitted) {
   const Campaign c = simulate_campaign(truth(), {{"shaker_harmonic_distortion", 0.2}}, small_design(), 37, 2);
   const Diagnosis d = diagnose(c);

@@ -4,11 +4,12 @@
 // hides (the extremes of 400 draws of Effect::draw, each sign drawn) and, for a parameter the
 // fit explores on a grid, the grid's ends (the fit must be right where it looks). A test at
 // two frequencies and one value cannot see a prediction that fails on part of the band (a
-// mode above the drive predicted as no response at all; issue 15). The run: 4 g along IA+PA (every effect acts), the static a_IA
-// +0.71 g, the paper-like instrument. Compared: the change each makes (with the effect less
-// without), so the first-order model's own error without any effect (< 0.01 ug here) is not
-// charged to the effect; the prediction as the diagnosis makes it (from the statically
-// identified coefficients, what the static test took up given back).
+// mode above the drive predicted as no response at all; issue 15). The run: 4 g along IA+PA
+// (every effect acts), the static a_IA +0.71 g, the paper-like instrument. Compared: the
+// change each makes (with the effect less without), so the first-order model's own error
+// without any effect (< 0.01 ug here) is not charged to the effect; the prediction as the
+// diagnosis makes it (from the statically identified coefficients, what the static test took
+// up given back).
 //
 // Tolerance, per effect: |predicted - ODE| <= rel |ODE change| + floor. The floor, 0.02 ug,
 // is 1/15 of a campaign run's sigma (0.3 ug) and ~4x the first-order model's own error on

@@ -84,9 +84,9 @@ TEST(NaturalMissesCampaign, AThirdHarmonicsPhaseSigmaIsWhatTheLikelihoodSays) {
 // 2 g out, Levenberg-Marquardt from the best start (0 rad) ends in the phase's other valley
 // (0.30 rad, 36 above the one at 2.3 rad that the start at pi/2 leads to), and the held-out
 // 2 g runs fail it: descended from that start alone, the gap would be "not explained". So
-// every start within 25 of the best descends; the lowest wins. Checked: the gap explained by the 3rd harmonic (held-out runs
-// included), its phase in the truth's valley (within 3 sigma of 2.255 rad,
-// not the other valley's 0.30 rad) and blind's score.
+// every start within 25 of the best descends; the lowest wins. Checked: the gap explained by
+// the 3rd harmonic (held-out runs included), its phase in the truth's valley (within 3 sigma
+// of 2.255 rad, not the other valley's 0.30 rad) and blind's score.
 TEST(NaturalMissesCampaign, AThirdHarmonicsPhaseIsFoundInItsValleyAndExplainsTheGap) {
   const BlindResult r = replay(8701, 43);
   const BlindCampaign& k = r.campaigns.at(43);

@@ -20,7 +20,8 @@
 // summaries, not to the physics (which stays the ODE's).
 // A single effect (or a natural form) whose gap, as the diagnosis' nominal model sees it, is
 // below 5 sigma (effect_gap_sigma) is reported, not scored; the largest run's size (the
-// largest run's gap in its own sigma, effect_max_sigma) is scored beside it (BlindScores::by_max_run_sigma).
+// largest run's gap in its own sigma, effect_max_sigma) is scored beside it
+// (BlindScores::by_max_run_sigma).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -79,8 +80,9 @@ struct BlindCampaign {
   // model sees it (less what the static test takes up) against the covariance V it judges the
   // runs by (nominal_gap_significance): the separation of the best test of a known-shape gap.
   // Scored (single, natural) when >= 5. NaN: not computed (other families; an error).
-  // effect_max_sigma (the largest run's size, reported beside it): the largest |with - without| over
-  // the runs in that run's sigma; it ignores what the coefficients' uncertainty can absorb.
+  // effect_max_sigma (the largest run's size, reported beside it): the largest
+  // |with - without| over the runs in that run's sigma; it ignores what the coefficients'
+  // uncertainty can absorb.
   double effect_max_sigma = 0;
   double effect_gap_sigma = NAN;
   // The held-out gap rms without the lab's noise (the noise-free shrinkage's two terms, g):
@@ -221,8 +223,9 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
 // What the diagnosis found for campaign k (not its key, which the draw gives), as one line of
 // text (no newline; numbers to 17 digits: read back exactly), and back into a drawn campaign.
 // read_campaign_result throws std::invalid_argument for a line it cannot read.
-// A line without the gap's size and noise-free rms (effect_gap_sigma, gap_rms_*_g) throws OutdatedCampaignResult: run_blind diagnoses that campaign again rather
-// than score it without them.
+// A line without the gap's size and noise-free rms (effect_gap_sigma, gap_rms_*_g) throws
+// OutdatedCampaignResult: run_blind diagnoses that campaign again rather than score it
+// without them.
 struct OutdatedCampaignResult : std::invalid_argument {
   using std::invalid_argument::invalid_argument;
 };

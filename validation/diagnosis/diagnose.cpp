@@ -1,6 +1,6 @@
 // The diagnosis as a pipeline of stages, in docs/diagnose.md's order (steps 1-11, "4. Lab
-// nuisances" among them): each stage is a file of validation/diagnosis/internal/ with a header saying
-// what it takes and gives.
+// nuisances" among them): each stage is a file of validation/diagnosis/internal/ with a header
+// saying what it takes and gives.
 #include "validation/diagnosis/diagnose.hpp"
 
 #include <cstdio>

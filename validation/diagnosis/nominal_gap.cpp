@@ -65,9 +65,9 @@ NominalView nominal_view(const Campaign& c, const DiagnoseSettings& s) {
 // brings, for more than significance_sigma^2 = 25; for a one-parameter effect of the true
 // shape that fall is (g^T V^-1 y)^2 / g^T V^-1 g, expected g^T V^-1 g + 1: a gap at 5 is the
 // one the diagnosis' own test finds about half the time, no yardstick asks for more. The
-// largest |g_k| / sigma_k of any one run (the largest run's size) counts neither the take-up nor the
-// runs' joint power: a squeeze film 55 sigma in one run whose shape trades with k2/k3 is a few
-// sigma here; an effect below 5 sigma in every run but present in all is more.
+// largest |g_k| / sigma_k of any one run (the largest run's size) counts neither the take-up
+// nor the runs' joint power: a squeeze film 55 sigma in one run whose shape trades with k2/k3
+// is a few sigma here; an effect below 5 sigma in every run but present in all is more.
 double nominal_gap_significance(const Campaign& with, const Campaign& without, const DiagnoseSettings& s) {
   if (with.runs.size() != without.runs.size())
     throw std::invalid_argument("nominal_gap_significance: the campaigns have different runs");

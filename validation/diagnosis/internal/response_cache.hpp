@@ -13,9 +13,9 @@
 //
 // A plant without a servo of its own gets the one its dynamics imply, designed once per
 // dynamics here rather than in every loop_response (design_servo scans 3000 frequencies:
-// designed in every loop_response it would be ~85 % of a diagnosis with random runs, whose PSD grid asks for hundreds of frequencies per
-// effect value). The servo is the same function of the same numbers, so the responses are bit
-// for bit those loop_response gives.
+// designed in every loop_response it would be ~85 % of a diagnosis with random runs, whose PSD
+// grid asks for hundreds of frequencies per effect value). The servo is the same function of
+// the same numbers, so the responses are bit for bit those loop_response gives.
 #include <map>
 #include <memory>
 #include <string>
