@@ -1,9 +1,6 @@
 #include "io/formats/case_file.hpp"
 
 #include <algorithm>
-#include <functional>
-#include <map>
-#include <memory>
 #include <cctype>
 #include <cmath>
 #include <cstdint>
@@ -17,13 +14,10 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "io/formats/case_file_internal.hpp"
 #include "plant/physical.hpp"
 
-namespace vrelab::io {
-namespace {
-
-constexpr double kArcsec = std::numbers::pi / (180.0 * 3600.0);
-constexpr double kDeg = std::numbers::pi / 180.0;
+namespace vrelab::io::internal {
 
 std::size_t edit_distance(std::string_view a, std::string_view b) {
   std::vector<std::size_t> prev(b.size() + 1), cur(b.size() + 1);
@@ -36,6 +30,32 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
   }
   return prev[b.size()];
 }
+
+// Physical ranges of model (1)'s coefficients. K1 in (0, 1e6] output units per g (mA/g, V/g:
+// navigation instruments are ~1); every other coefficient within 1 in its unit (1 g of bias,
+// 1/g, 1/g^2, 1 rad: orders beyond any accelerometer, whose values are <= 1e-2). Beyond these
+// the results overflow (K1 = 1e308 gave inf with exit 0) or mean nothing.
+constexpr double kMaxK1 = 1e6, kMaxCoefficient = 1.0;
+void check_coefficient(const Table& t, int i, double x) {
+  const std::string_view name = plant::coefficient_name(i);
+  if (i == plant::K1 && !(x > 0 && x <= kMaxK1))
+    t.fail(t.raw().get(name), name, fmt::format("must lie in (0, {:g}] output units per g, got {:g}", kMaxK1, x));
+  if (i != plant::K1 && !(std::abs(x) <= kMaxCoefficient))
+    t.fail(t.raw().get(name), name,
+           fmt::format("must lie in [-{0:g}, {0:g}] in its unit (beyond any accelerometer), got {1:g}", kMaxCoefficient, x));
+}
+
+// Vibration amplitudes: at most 1000 g (shakers reach ~100 g); beyond, eq. (3)'s k3 a^3 and the
+// plant's states leave any meaning (and overflow near 1e100 g).
+constexpr double kMaxAmplitude_g = 1e3;
+void check_amplitude(const Table& t, std::string_view key, double a) {
+  if (!(a <= kMaxAmplitude_g))
+    t.fail(t.raw().get(key), key, fmt::format("amplitudes must be at most {:g} g, got {:g} g", kMaxAmplitude_g, a));
+}
+
+namespace {
+
+constexpr double kArcsec = std::numbers::pi / (180.0 * 3600.0);
 
 nlohmann::json to_json(const toml::node& n) {
   if (auto t = n.as_table()) {
@@ -59,366 +79,44 @@ nlohmann::json to_json(const toml::node& n) {
   return std::string("<date/time>");
 }
 
-// One TOML table with the keys it allows; every access marks the key as used.
-class Table {
- public:
-  Table(const toml::table& t, std::string name, const std::string& file)
-      : t_(t), name_(std::move(name)), file_(file) {}
-
-  bool has(std::string_view key) const { return t_.contains(key); }
-  int line(const toml::node* n) const { return n ? static_cast<int>(n->source().begin.line) : 0; }
-
-  // The key's place (the node's line, else the table's) and why it is wrong.
-  [[noreturn]] void fail(const toml::node* n, std::string_view key, const std::string& what) const {
-    throw FormatError({.file = file_, .line = line(n ? n : &t_), .table = name_, .key = std::string(key), .kind = KeyKind::toml_key},
-                      what);
-  }
-
-  const toml::node* get(std::string_view key, bool required) {
-    used_.insert(std::string(key));
-    const toml::node* n = t_.get(key);
-    if (!n && required) {
-      // A required key missing is most often a typo of it (k_2 for k2, frequency_hz for
-      // frequency_Hz): name the key the file has, on its line, with the match.
-      for (auto&& [k, v] : t_) {
-        const std::string have(k.str());
-        if (used_.count(have)) continue;
-        if (normalised(have) == normalised(key) || (key.size() > 3 && edit_distance(have, key) == 1))
-          fail(&v, have, "unknown key (did you mean '" + std::string(key) + "'?); " + std::string(key) +
-                             " is required");
-      }
-      fail(nullptr, key, "missing (required)");
-    }
-    return n;
-  }
-  // Lower case without '_' and '-': keys that differ only so are the same key mistyped.
-  static std::string normalised(std::string_view k) {
-    std::string out;
-    for (char ch : k)
-      if (ch != '_' && ch != '-') out += static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-    return out;
-  }
-
-  double number_of(const toml::node* n, std::string_view key) const {
-    if (!n->is_number()) fail(n, key, std::string("expected a number, got ") + type_name(*n));
-    const double x = n->value<double>().value();
-    if (!std::isfinite(x)) fail(n, key, "must be a finite number, got " + std::to_string(x));
-    return x;
-  }
-  double number(std::string_view key) { return number_of(get(key, true), key); }
-  std::optional<double> opt_number(std::string_view key) {
-    const toml::node* n = get(key, false);
-    return n ? std::optional<double>(number_of(n, key)) : std::nullopt;
-  }
-  double non_negative(std::string_view key, double fallback) {
-    const auto x = opt_number(key);
-    if (x && *x < 0) fail(t_.get(key), key, "must not be negative, got " + std::to_string(*x));
-    return x.value_or(fallback);
-  }
-  std::int64_t integer(std::string_view key, bool required, std::int64_t fallback, std::int64_t min,
-                       std::int64_t max = std::numeric_limits<std::int32_t>::max()) {
-    const toml::node* n = get(key, required);
-    if (!n) return fallback;
-    if (!n->is_integer()) fail(n, key, std::string("expected an integer, got ") + type_name(*n));
-    const std::int64_t v = n->as_integer()->get();
-    if (v < min) fail(n, key, "must be at least " + std::to_string(min) + ", got " + std::to_string(v));
-    if (v > max) fail(n, key, "must be at most " + std::to_string(max) + ", got " + std::to_string(v));
-    return v;
-  }
-  std::string string(std::string_view key, std::string fallback) {
-    const toml::node* n = get(key, false);
-    if (!n) return fallback;
-    if (!n->is_string()) fail(n, key, std::string("expected a string, got ") + type_name(*n));
-    return n->as_string()->get();
-  }
-  Vec3 vec3_of(const toml::node* n, std::string_view key) const {
-    const toml::array* a = n->as_array();
-    if (!a || a->size() != 3) fail(n, key, "expected an array of 3 numbers [IA, PA, OA]");
-    Vec3 v;
-    for (int i = 0; i < 3; ++i) v[i] = number_of(a->get(static_cast<std::size_t>(i)), key);
-    return v;
-  }
-  Vec3 vec3(std::string_view key) { return vec3_of(get(key, true), key); }
-  std::optional<Vec3> opt_vec3(std::string_view key) {
-    const toml::node* n = get(key, false);
-    return n ? std::optional<Vec3>(vec3_of(n, key)) : std::nullopt;
-  }
-  std::optional<Table> subtable(std::string_view key, bool required) {
-    const toml::node* n = get(key, required);
-    if (!n) return std::nullopt;
-    if (!n->is_table()) fail(n, key, std::string("expected a table, got ") + type_name(*n));
-    return Table(*n->as_table(), name_.empty() ? std::string(key) : name_ + "." + std::string(key), file_);
-  }
-
-  // Any key not read is a typo or a key of another version: say so, with the closest match.
-  void check_unknown(const std::vector<std::string_view>& allowed) const {
-    for (auto&& [k, v] : t_) {
-      const std::string key(k.str());
-      if (used_.count(key)) continue;
-      std::string best;
-      std::size_t best_d = 4;
-      for (auto a : allowed) {
-        const std::size_t d = edit_distance(key, a);
-        if (d < best_d) best_d = d, best = std::string(a);
-      }
-      std::string msg = "unknown key";
-      if (!best.empty()) msg += " (did you mean '" + best + "'?)";
-      fail(&v, key, msg);
-    }
-  }
-
-  const toml::table& raw() const { return t_; }
-  const std::string& name() const { return name_; }
-  const std::string& file() const { return file_; }
-
- private:
-  static const char* type_name(const toml::node& n) {
-    switch (n.type()) {
-      case toml::node_type::string: return "a string";
-      case toml::node_type::integer: return "an integer";
-      case toml::node_type::floating_point: return "a number";
-      case toml::node_type::boolean: return "a boolean";
-      case toml::node_type::array: return "an array";
-      case toml::node_type::table: return "a table";
-      default: return "a date or time";
-    }
-  }
-  const toml::table& t_;
-  std::string name_;
-  std::string file_;
-  std::set<std::string> used_;
-};
-
-// Physical ranges of model (1)'s coefficients. K1 in (0, 1e6] output units per g (mA/g, V/g:
-// navigation instruments are ~1); every other coefficient within 1 in its unit (1 g of bias,
-// 1/g, 1/g^2, 1 rad: orders beyond any accelerometer, whose values are <= 1e-2). Beyond these
-// the results overflow (K1 = 1e308 gave inf with exit 0) or mean nothing.
-constexpr double kMaxK1 = 1e6, kMaxCoefficient = 1.0;
-void check_coefficient(const Table& t, int i, double x) {
-  const std::string_view name = plant::coefficient_name(i);
-  if (i == plant::K1 && !(x > 0 && x <= kMaxK1))
-    t.fail(t.raw().get(name), name, fmt::format("must lie in (0, {:g}] output units per g, got {:g}", kMaxK1, x));
-  if (i != plant::K1 && !(std::abs(x) <= kMaxCoefficient))
-    t.fail(t.raw().get(name), name,
-           fmt::format("must lie in [-{0:g}, {0:g}] in its unit (beyond any accelerometer), got {1:g}", kMaxCoefficient, x));
+// A static orientation is gravity in sensor axes, in units of the local g: |a| = 1 g. Within
+// 1e-3: a vector typed with four digits (0.7071) is off by ~1e-4, while a norm of 0 g (no
+// gravity) or 10 g (a centrifuge, or m/s^2 typed for g) is not a static test on the earth.
+constexpr double kGravityNormTolerance = 1e-3;
+void check_gravity(const Table& t, const toml::node* n, std::string_view key, const Vec3& a) {
+  if (!(std::abs(a.norm() - 1) <= kGravityNormTolerance))
+    t.fail(n, key,
+           fmt::format("a static orientation is gravity in sensor axes [IA, PA, OA], |a| = 1 g (within {:g}); got |a| = {:.6g} g",
+                       kGravityNormTolerance, a.norm()));
 }
 
-void read_coefficients(Table t, Case& c) {
-  plant::Coefficients k;
-  std::vector<std::string_view> names;
-  for (int i = 0; i < plant::kNumCoefficients; ++i) {
-    names.push_back(plant::coefficient_name(i));
-    k[i] = t.number(plant::coefficient_name(i));
-    check_coefficient(t, i, k[i]);
-  }
-  t.check_unknown(names);
-  c.coefficients = k;
-}
-
-// Vibration amplitudes: at most 1000 g (shakers reach ~100 g); beyond, eq. (3)'s k3 a^3 and the
-// plant's states leave any meaning (and overflow near 1e100 g).
-constexpr double kMaxAmplitude_g = 1e3;
-void check_amplitude(const Table& t, std::string_view key, double a) {
-  if (!(a <= kMaxAmplitude_g))
-    t.fail(t.raw().get(key), key, fmt::format("amplitudes must be at most {:g} g, got {:g} g", kMaxAmplitude_g, a));
-}
-
-vibration::SineVibration read_sine_part(Table& t, bool frequency_required) {
-  vibration::SineVibration v;
-  v.amplitude_g = t.vec3("amplitude_g");
-  v.phase_rad = t.opt_vec3("phase_deg").value_or(Vec3::Zero()) * kDeg;
-  v.frequency_Hz = frequency_required ? t.number("frequency_Hz") : t.non_negative("frequency_Hz", 0.0);
-  if (frequency_required && !(v.frequency_Hz > 0)) t.fail(t.raw().get("frequency_Hz"), "frequency_Hz", "must be positive");
-  for (int i = 0; i < 3; ++i) check_amplitude(t, "amplitude_g", v.amplitude_g[i]);
-  for (int i = 0; i < 3; ++i)
-    if (v.amplitude_g[i] < 0)
-      t.fail(t.raw().get("amplitude_g"), "amplitude_g",
-             "amplitudes must not be negative (reverse an axis with phase_deg = 180)");
-  return v;
-}
-
-// A PSD table: rows [frequency_Hz, g2_per_Hz] or {frequency_Hz = f, slope_dB_per_octave = s}.
-vibration::PsdTable read_psd(Table& t, std::string_view key, const toml::node* n) {
+std::vector<Vec3> vec3_list(Table& t, std::string_view key, bool unit) {
+  std::vector<Vec3> out;
+  const toml::node* n = t.get(key, false);
+  if (!n) return out;
   const toml::array* a = n->as_array();
-  if (!a || a->size() < 2) t.fail(n, key, "expected at least two rows [frequency_Hz, g2_per_Hz]");
-  vibration::PsdTable table;
-  std::size_t row = 0;
+  if (!a || a->empty()) t.fail(n, key, "expected a non-empty array of [IA, PA, OA] vectors");
   for (auto&& x : *a) {
-    ++row;
-    const std::string where = std::string(key) + " row " + std::to_string(row);
-    if (const toml::array* r = x.as_array()) {
-      if (r->size() != 2) t.fail(&x, where, "a row is [frequency_Hz, g2_per_Hz]");
-      table.rows.push_back(vibration::PsdRow::level(t.number_of(r->get(0), where), t.number_of(r->get(1), where)));
-    } else if (const toml::table* rt = x.as_table()) {
-      const toml::node* f = rt->get("frequency_Hz");
-      const toml::node* sl = rt->get("slope_dB_per_octave");
-      if (!f || !sl || rt->size() != 2) t.fail(&x, where, "a slope row is {frequency_Hz = f, slope_dB_per_octave = s}");
-      table.rows.push_back(vibration::PsdRow::slope(t.number_of(f, where), t.number_of(sl, where)));
+    Vec3 v = t.vec3_of(&x, key);
+    if (unit) {
+      if (!(v.norm() > 0)) t.fail(&x, key, "a direction must not be zero");
+      v.normalize();
     } else {
-      t.fail(&x, where, "a row is [frequency_Hz, g2_per_Hz] or {frequency_Hz, slope_dB_per_octave}");
+      check_gravity(t, &x, key, v);  // every unnormalised list is of orientations_g
     }
+    out.push_back(v);
   }
-  try {
-    vibration::validate(table);
-  } catch (const std::invalid_argument& e) {
-    t.fail(n, key, e.what());
-  }
-  return table;
+  return out;
 }
 
-// Random part: PSD tables per axis (psd_IA, psd_PA, psd_OA) or a Gaussian rms_g.
-void read_random_part(Table& t, VibrationSpec& v, bool psd_required) {
-  vibration::RandomProfile profile;
-  bool any = false;
-  const char* names[3] = {"psd_IA", "psd_PA", "psd_OA"};
-  for (int i = 0; i < 3; ++i)
-    if (const toml::node* n = t.get(names[i], false)) {
-      profile.psd[static_cast<std::size_t>(i)] = read_psd(t, names[i], n);
-      any = true;
-    }
-  const std::string coupling = t.string("coupling", "common");
-  if (coupling != "common" && coupling != "independent")
-    t.fail(t.raw().get("coupling"), "coupling", "must be \"common\" (one direction) or \"independent\"");
-  profile.coupling = coupling == "common" ? vibration::AxisCoupling::common : vibration::AxisCoupling::independent;
-  if (any) {
-    if (t.has("rms_g")) t.fail(t.raw().get("rms_g"), "rms_g", "give PSD tables or rms_g, not both");
-    v.psd = profile;
-    v.gaussian = vibration::gaussian_equivalent(profile);
-    v.duration_s = t.opt_number("duration_s").value_or(v.duration_s);
-    if (!(v.duration_s > 0)) t.fail(t.raw().get("duration_s"), "duration_s", "must be positive");
-    return;
-  }
-  if (psd_required) t.fail(nullptr, "psd_IA", "a shaken random profile needs PSD tables psd_IA / psd_PA / psd_OA");
-  vibration::RandomVibration g;
-  g.rms_g = t.vec3("rms_g");
-  for (int i = 0; i < 3; ++i) check_amplitude(t, "rms_g", std::abs(g.rms_g[i]));
-  if (const toml::node* n = t.get("correlation", false)) {
-    const toml::array* rows = n->as_array();
-    if (!rows || rows->size() != 3) t.fail(n, "correlation", "expected a 3 x 3 array of numbers");
-    for (int i = 0; i < 3; ++i) g.correlation.row(i) = t.vec3_of(rows->get(static_cast<std::size_t>(i)), "correlation");
-  }
-  for (int i = 0; i < 3; ++i)
-    if (g.rms_g[i] < 0) t.fail(t.raw().get("rms_g"), "rms_g", "rms values must not be negative");
-  try {
-    vibration::validate(g);
-  } catch (const std::invalid_argument& e) {
-    t.fail(t.raw().get("correlation"), "correlation", e.what());
-  }
-  v.gaussian = g;
-}
-
-void read_vibration(Table t, Case& c) {
-  VibrationSpec v;
-  v.line = t.line(&t.raw());
-  const std::string type = t.string("type", "");
-  const auto kind = rectification::parse_vibration_kind(type);
-  if (!kind)
-    t.fail(t.raw().get("type"), "type",
-           "must be \"sine\", \"random\", \"sine_on_random\" or \"swept_sine\", got \"" + type + "\"");
-  v.type = *kind;
-  if (v.type == VibrationKind::sine) {
-    v.sine = read_sine_part(t, false);
-    t.check_unknown({"type", "amplitude_g", "phase_deg", "frequency_Hz"});
-  } else if (v.type == VibrationKind::random) {
-    read_random_part(t, v, false);
-    t.check_unknown({"type", "rms_g", "correlation", "psd_IA", "psd_PA", "psd_OA", "coupling", "duration_s"});
-  } else if (v.type == VibrationKind::sine_on_random) {
-    v.sine = read_sine_part(t, true);
-    read_random_part(t, v, false);
-    t.check_unknown({"type", "amplitude_g", "phase_deg", "frequency_Hz", "rms_g", "correlation", "psd_IA", "psd_PA",
-                     "psd_OA", "coupling", "duration_s"});
-  } else {  // swept_sine
-    vibration::SweptSine s;
-    s.amplitude_g = t.vec3("amplitude_g");
-    s.phase_rad = t.opt_vec3("phase_deg").value_or(Vec3::Zero()) * kDeg;
-    s.start_frequency_Hz = t.number("start_frequency_Hz");
-    s.end_frequency_Hz = t.number("end_frequency_Hz");
-    const std::string law = t.string("law", "log");
-    if (law != "log" && law != "linear") t.fail(t.raw().get("law"), "law", "must be \"log\" or \"linear\"");
-    s.law = law == "log" ? vibration::SweepLaw::logarithmic : vibration::SweepLaw::linear;
-    if (law == "log")
-      s.rate_octaves_per_min = t.number("rate_octaves_per_min");
-    else
-      s.rate_Hz_per_s = t.number("rate_Hz_per_s");
-    try {
-      vibration::validate(s);
-    } catch (const std::invalid_argument& e) {
-      t.fail(nullptr, "swept_sine", e.what());
-    }
-    v.swept = s;
-    v.sine.amplitude_g = s.amplitude_g;
-    v.sine.phase_rad = s.phase_rad;
-    v.duration_s = vibration::sweep_duration_s(s);
-    t.check_unknown({"type", "amplitude_g", "phase_deg", "start_frequency_Hz", "end_frequency_Hz", "law",
-                     "rate_octaves_per_min", "rate_Hz_per_s"});
-  }
-  c.vibration = v;
-}
-
-int axis_index(Table& t, std::string_view key, const std::string& name) {
-  if (name == "IA") return IA;
-  if (name == "PA") return PA;
-  if (name == "OA") return OA;
-  t.fail(t.raw().get(key), key, "axes are \"IA\", \"PA\" or \"OA\", got \"" + name + "\"");
-}
-
-void read_shaker(Table t, Case& c) {
-  ShakerSpec& s = c.shaker;
-  if (auto x = t.opt_number("stroke_limit_m")) s.limits.stroke_peak_to_peak_m = *x;
-  if (auto x = t.opt_number("velocity_limit_m_per_s")) s.limits.velocity_peak_m_per_s = *x;
-  if (!(s.limits.stroke_peak_to_peak_m > 0)) t.fail(t.raw().get("stroke_limit_m"), "stroke_limit_m", "must be positive");
-  if (!(s.limits.velocity_peak_m_per_s > 0))
-    t.fail(t.raw().get("velocity_limit_m_per_s"), "velocity_limit_m_per_s", "must be positive");
-  if (auto x = t.subtable("transverse", false)) {
-    vibration::TransverseSpec ts;
-    ts.from_axis = axis_index(*x, "from_axis", x->string("from_axis", "IA"));
-    ts.to_axis = axis_index(*x, "to_axis", x->string("to_axis", "PA"));
-    ts.ratio = x->non_negative("ratio", 0.0);
-    ts.phase_rad = x->opt_number("phase_deg").value_or(0.0) * kDeg;
-    try {
-      vibration::validate(ts);
-    } catch (const std::invalid_argument& e) {
-      x->fail(nullptr, "transverse", e.what());
-    }
-    x->check_unknown({"from_axis", "to_axis", "ratio", "phase_deg"});
-    s.transverse = ts;
-  }
-  if (const toml::node* n = t.get("harmonics", false)) {
-    const toml::array* a = n->as_array();
-    if (!a) t.fail(n, "harmonics", "expected an array of {order = 2, ratio = 0.05, phase_deg = 0}");
-    for (auto&& x : *a) {
-      const toml::table* h = x.as_table();
-      if (!h) t.fail(&x, "harmonics", "each harmonic is {order = 2, ratio = 0.05, phase_deg = 0}");
-      Table ht(*h, "shaker.harmonics", t.file());
-      vibration::Harmonic hm;
-      const toml::node* order = h->get("order");
-      if (!order || !order->is_integer()) t.fail(&x, "harmonics", "order must be an integer >= 2");
-      hm.order = static_cast<int>(order->as_integer()->get());
-      const toml::node* ratio = h->get("ratio");
-      if (!ratio || !ratio->is_number()) t.fail(&x, "harmonics", "ratio must be a number");
-      hm.ratio = ratio->value<double>().value();
-      if (const toml::node* ph = h->get("phase_deg")) hm.phase_rad = ph->value<double>().value_or(0.0) * kDeg;
-      for (auto&& [k, v] : *h)
-        if (k.str() != "order" && k.str() != "ratio" && k.str() != "phase_deg")
-          t.fail(&v, "harmonics", "unknown key '" + std::string(k.str()) + "' in a harmonic");
-      s.harmonics.push_back(hm);
-    }
-    try {
-      vibration::validate(s.harmonics);
-    } catch (const std::invalid_argument& e) {
-      t.fail(n, "harmonics", e.what());
-    }
-  }
-  if (auto x = t.subtable("rocking", false)) {
-    vibration::RockingSpec r;
-    r.axis = x->opt_vec3("axis").value_or(Vec3::UnitZ());
-    r.amplitude_rad = x->non_negative("amplitude_rad", 0.0);
-    r.phase_rad = x->opt_number("phase_deg").value_or(0.0) * kDeg;
-    if (auto arm = x->opt_vec3("lever_arm_m")) r.lever_arm_m = *arm;
-    x->check_unknown({"axis", "amplitude_rad", "phase_deg", "lever_arm_m"});
-    s.rocking = r;  // static gravity and g are filled in when the run is built
-  }
-  t.check_unknown({"stroke_limit_m", "velocity_limit_m_per_s", "transverse", "harmonics", "rocking"});
+std::vector<double> number_list(Table& t, std::string_view key) {
+  std::vector<double> out;
+  const toml::node* n = t.get(key, false);
+  if (!n) return out;
+  const toml::array* a = n->as_array();
+  if (!a || a->empty()) t.fail(n, key, "expected a non-empty array of numbers");
+  for (auto&& x : *a) out.push_back(t.number_of(&x, key));
+  return out;
 }
 
 void read_dividing_head(Table t, Case& c) {
@@ -503,253 +201,6 @@ void read_identification(Table t, Case& c) {
     }
   }
   t.check_unknown({"fixed"});
-}
-
-bool boolean(Table& t, std::string_view key, bool fallback) {
-  const toml::node* n = t.get(key, false);
-  if (!n) return fallback;
-  if (!n->is_boolean()) t.fail(n, key, "expected true or false");
-  return n->as_boolean()->get();
-}
-
-// The plant modules beyond model (1) a case can switch on: one entry per
-// [plant.effects.<name>] table, with its own keys (a plant module's construction parameters,
-// not the diagnosis' effect parameters of validation/diagnosis/effect.hpp, hence a reader of
-// its own). Adding a plant module a case can use is a class in plant/effects/ and an entry here.
-using EffectReader = std::function<std::shared_ptr<const plant::Effect>(Table&)>;
-const std::map<std::string, EffectReader>& effect_readers() {
-  static const std::map<std::string, EffectReader> readers{
-      {"pickoff_nonlinearity",
-       [](Table& t) {
-         auto e = std::make_shared<plant::PickoffNonlinearity>(t.number("p2_per_rad"));
-         t.check_unknown({"p2_per_rad"});
-         return e;
-       }},
-      {"pendulum_geometry",
-       [](Table& t) {
-         t.check_unknown({});
-         return std::make_shared<plant::PendulumGeometry>();
-       }},
-      {"current_saturation",
-       [](Table& t) {
-         const double limit = t.number("limit_g");
-         if (!(limit > 0)) t.fail(t.raw().get("limit_g"), "limit_g", "must be positive");
-         t.check_unknown({"limit_g"});
-         return std::make_shared<plant::CurrentSaturation>(limit);
-       }},
-      {"mechanical_mode",
-       [](Table& t) {
-         const double f = t.number("frequency_Hz"), z = t.number("damping_ratio");
-         if (!(f > 0)) t.fail(t.raw().get("frequency_Hz"), "frequency_Hz", "must be positive");
-         if (!(z > 0)) t.fail(t.raw().get("damping_ratio"), "damping_ratio", "must be positive");
-         const Vec3 axes = t.opt_vec3("axes").value_or(Vec3(1, 0, 0));
-         t.check_unknown({"frequency_Hz", "damping_ratio", "axes"});
-         return std::make_shared<plant::MechanicalMode>(f, z, axes);
-       }},
-  };
-  return readers;
-}
-
-void read_effects(Table& t, Case& c) {
-  if (auto eff = t.subtable("effects", false)) {
-    std::vector<std::string_view> names;
-    for (const auto& [name, reader] : effect_readers()) names.push_back(name);
-    for (auto&& [k, v] : eff->raw()) {
-      const auto it = effect_readers().find(std::string(k.str()));
-      if (it == effect_readers().end()) eff->check_unknown(names);
-      auto sub = eff->subtable(k.str(), true);
-      try {
-        c.plant.effects.push_back(it->second(*sub));
-      } catch (const std::invalid_argument& e) {
-        eff->fail(&v, k.str(), e.what());
-      }
-    }
-  }
-}
-
-// The loop the [plant] keys set must be stable: checked here (the linearised loop's poles at
-// rest), so the message names the file, the table and the keys that set the loop, not only
-// "not stable" from deep inside a run.
-void check_loop_stable(Table& t, const Case& c, const std::vector<std::string_view>& loop_keys) {
-  try {
-    const plant::Accelerometer rest(c.plant, c.orientation_g.value_or(Vec3::UnitX()));
-    (void)rest.slowest_time_constant_s(rest.linearise());
-  } catch (const std::invalid_argument& e) {
-    std::string given;
-    for (auto k : loop_keys)
-      if (const toml::node* n = t.raw().get(k))
-        given += fmt::format("{}{} = {}", given.empty() ? "" : ", ", k,
-                             n->is_number() ? fmt::format("{:g}", n->value<double>().value()) : std::string("..."));
-    std::string all;
-    for (auto k : loop_keys) all += (all.empty() ? "" : ", ") + std::string(k);
-    t.fail(nullptr, "", std::string(e.what()) + "; the loop is set by " + all +
-                            (given.empty() ? " (all at their defaults" : " (given here: " + given) +
-                            ") and any [plant.effects] table");
-  }
-}
-
-// type = "physical": SI parameters (plant/physical.hpp); the model (1) coefficients follow.
-void read_physical_plant(Table& t, Case& c) {
-  if (c.coefficients)
-    t.fail(t.raw().get("type"), "type",
-           "a physical plant implies its coefficients: remove the [coefficients] table (or use \"from_coefficients\")");
-  plant::PhysicalParameters p;
-  struct Key {
-    const char* name;
-    double* value;
-  };
-  const Key keys[] = {{"inertia_kg_m2", &p.inertia_kg_m2},
-                      {"damping_N_m_s_per_rad", &p.damping_N_m_s_per_rad},
-                      {"hinge_stiffness_N_m_per_rad", &p.hinge_stiffness_N_m_per_rad},
-                      {"pendulosity_kg_m", &p.pendulosity_kg_m},
-                      {"pickoff_V_per_rad", &p.pickoff_V_per_rad},
-                      {"servo_gain_A_per_V", &p.servo_gain_A_per_V},
-                      {"lead_zero_Hz", &p.lead_zero_Hz},
-                      {"lead_pole_Hz", &p.lead_pole_Hz},
-                      {"integrator_Hz", &p.integrator_Hz},
-                      {"torquer_N_m_per_A", &p.torquer_N_m_per_A},
-                      {"torquer_n2_per_A", &p.torquer_n2_per_A},
-                      {"torquer_n3_per_A2", &p.torquer_n3_per_A2},
-                      {"bias_torque_N_m", &p.bias_torque_N_m},
-                      {"load_ohm", &p.load_ohm},
-                      {"antialias_Hz", &p.antialias_Hz}};
-  std::vector<std::string_view> allowed{"type", "effects"};
-  for (const Key& k : keys) {
-    *k.value = t.opt_number(k.name).value_or(*k.value);
-    allowed.push_back(k.name);
-  }
-  std::string why;
-  if (!p.IsValid(&why)) {
-    const std::string key = why.substr(0, why.find(' '));
-    t.fail(t.raw().get(key), key, why.substr(why.find(' ') + 1));
-  }
-  c.plant = plant::plant_from_physical(p, c.g_m_per_s2);
-  read_effects(t, c);
-  check_loop_stable(t, c, {"inertia_kg_m2", "damping_N_m_s_per_rad", "hinge_stiffness_N_m_per_rad", "pendulosity_kg_m",
-                           "pickoff_V_per_rad", "servo_gain_A_per_V", "lead_zero_Hz", "lead_pole_Hz", "integrator_Hz",
-                           "torquer_N_m_per_A", "antialias_Hz"});
-  t.check_unknown(allowed);
-  c.coefficients = plant::implied_coefficients(p, c.g_m_per_s2);
-  c.physical = p;
-  if (!c.output_unit_given) c.output_unit = "V";  // the load resistor's voltage
-}
-
-void read_plant(Table t, Case& c) {
-  const std::string type = t.string("type", "from_coefficients");
-  if (type == "physical") return read_physical_plant(t, c);
-  if (type != "from_coefficients")
-    t.fail(t.raw().get("type"), "type", "must be \"from_coefficients\" or \"physical\", got \"" + type + "\"");
-  if (!c.coefficients) t.fail(t.raw().get("type"), "type", "a [plant] is built from [coefficients], which is missing");
-  plant::Dynamics& d = c.plant.dynamics;
-  d.pendulum_frequency_Hz = t.opt_number("pendulum_frequency_Hz").value_or(d.pendulum_frequency_Hz);
-  d.pendulum_damping_ratio = t.opt_number("pendulum_damping_ratio").value_or(d.pendulum_damping_ratio);
-  d.angle_gain_rad_per_s2_per_g = t.opt_number("angle_gain_rad_per_s2_per_g").value_or(d.angle_gain_rad_per_s2_per_g);
-  d.loop_bandwidth_Hz = t.opt_number("loop_bandwidth_Hz").value_or(d.loop_bandwidth_Hz);
-  d.phase_margin_deg = t.opt_number("phase_margin_deg").value_or(d.phase_margin_deg);
-  d.integrator = boolean(t, "integrator", d.integrator);
-  d.integrator_zero_ratio = t.opt_number("integrator_zero_ratio").value_or(d.integrator_zero_ratio);
-  d.antialias_Hz = t.non_negative("antialias_Hz", d.antialias_Hz);
-  std::string why;
-  if (!d.IsValid(&why)) {
-    const std::string key = why.substr(0, why.find(' '));  // IsValid's message starts with the key
-    t.fail(t.raw().get(key), key, why.substr(why.find(' ') + 1));
-  }
-  try {
-    plant::design_servo(d);
-  } catch (const std::invalid_argument& e) {
-    t.fail(t.raw().get("phase_margin_deg"), "phase_margin_deg", e.what());
-  }
-  if (auto loc = t.subtable("location", false)) {
-    for (auto&& [k, v] : loc->raw()) {
-      const auto idx = plant::coefficient_from_name(k.str());
-      if (idx && *idx == plant::K1) loc->fail(&v, k.str(), "K1 has no place to act (it is the scale factor)");
-      if (!idx) {
-        std::vector<std::string_view> names;
-        for (int i = 1; i < plant::kNumCoefficients; ++i) names.push_back(plant::coefficient_name(i));
-        loc->check_unknown(names);
-      }
-      const std::string where = loc->string(k.str(), "");
-      const plant::Location l = where == "input" ? plant::Location::input
-                                : where == "loop" ? plant::Location::loop
-                                                  : plant::Location::output;
-      if ((where != "input" && where != "loop" && where != "output") || !plant::location_allowed(*idx, l))
-        loc->fail(&v, k.str(), std::string("must be ") + (*idx <= plant::k4 ? "\"input\", \"loop\" or \"output\""
-                                                                            : "\"input\" or \"output\" (it needs a_PA or a_OA)") +
-                                   ", got \"" + where + "\"");
-      c.plant.location[*idx] = l;
-    }
-  }
-  read_effects(t, c);
-  c.plant.coefficients = *c.coefficients;
-  check_loop_stable(t, c, {"pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g",
-                           "loop_bandwidth_Hz", "phase_margin_deg", "integrator_zero_ratio", "antialias_Hz",
-                           "location"});
-  t.check_unknown({"type", "pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g",
-                   "loop_bandwidth_Hz", "phase_margin_deg", "integrator", "integrator_zero_ratio", "antialias_Hz",
-                   "location", "effects"});
-}
-
-void read_readout(Table t, Case& c) {
-  rectification::Readout& r = c.shake.readout;
-  r.sample_rate_Hz = t.number("sample_rate_Hz");
-  if (!(r.sample_rate_Hz > 0)) t.fail(t.raw().get("sample_rate_Hz"), "sample_rate_Hz", "must be positive");
-  r.noise_sigma_g = t.non_negative("noise_sigma_ug", 0.0) * 1e-6;
-  r.quantisation_lsb_g = t.non_negative("quantisation_lsb_ug", 0.0) * 1e-6;
-  t.check_unknown({"sample_rate_Hz", "noise_sigma_ug", "quantisation_lsb_ug"});
-}
-
-void read_shake(Table t, Case& c) {
-  rectification::ShakeSettings& s = c.shake;
-  s.relative_tolerance = t.opt_number("relative_tolerance").value_or(s.relative_tolerance);
-  s.settle_decay = t.opt_number("settle_decay").value_or(s.settle_decay);
-  s.blocks = static_cast<int>(t.integer("blocks", false, s.blocks, 2, 1000));
-  s.min_measure_s = t.non_negative("min_measure_s", s.min_measure_s);
-  std::string why;
-  if (!s.IsValid(&why)) {
-    const std::string key = why.substr(0, why.find(' '));  // IsValid's message starts with the key
-    t.fail(t.raw().get(key), key, why.substr(why.find(' ') + 1));
-  }
-  t.check_unknown({"relative_tolerance", "settle_decay", "blocks", "min_measure_s"});
-}
-
-// A static orientation is gravity in sensor axes, in units of the local g: |a| = 1 g. Within
-// 1e-3: a vector typed with four digits (0.7071) is off by ~1e-4, while a norm of 0 g (no
-// gravity) or 10 g (a centrifuge, or m/s^2 typed for g) is not a static test on the earth.
-constexpr double kGravityNormTolerance = 1e-3;
-void check_gravity(const Table& t, const toml::node* n, std::string_view key, const Vec3& a) {
-  if (!(std::abs(a.norm() - 1) <= kGravityNormTolerance))
-    t.fail(n, key,
-           fmt::format("a static orientation is gravity in sensor axes [IA, PA, OA], |a| = 1 g (within {:g}); got |a| = {:.6g} g",
-                       kGravityNormTolerance, a.norm()));
-}
-
-std::vector<Vec3> vec3_list(Table& t, std::string_view key, bool unit) {
-  std::vector<Vec3> out;
-  const toml::node* n = t.get(key, false);
-  if (!n) return out;
-  const toml::array* a = n->as_array();
-  if (!a || a->empty()) t.fail(n, key, "expected a non-empty array of [IA, PA, OA] vectors");
-  for (auto&& x : *a) {
-    Vec3 v = t.vec3_of(&x, key);
-    if (unit) {
-      if (!(v.norm() > 0)) t.fail(&x, key, "a direction must not be zero");
-      v.normalize();
-    } else {
-      check_gravity(t, &x, key, v);  // every unnormalised list is of orientations_g
-    }
-    out.push_back(v);
-  }
-  return out;
-}
-
-std::vector<double> number_list(Table& t, std::string_view key) {
-  std::vector<double> out;
-  const toml::node* n = t.get(key, false);
-  if (!n) return out;
-  const toml::array* a = n->as_array();
-  if (!a || a->empty()) t.fail(n, key, "expected a non-empty array of numbers");
-  for (auto&& x : *a) out.push_back(t.number_of(&x, key));
-  return out;
 }
 
 void read_sweep(Table t, Case& c) {
@@ -939,8 +390,12 @@ void read_campaign(Table t, Case& c) {
 }
 
 }  // namespace
+}  // namespace vrelab::io::internal
+
+namespace vrelab::io {
 
 Case read_case(const std::string& path) {
+  using namespace internal;  // Table and the tables' readers (case_file_internal.hpp)
   if (std::filesystem::is_directory(path))
     throw FormatError({.file = path}, "cannot open the case file: is a directory (give the .toml file)");
   if (!std::filesystem::exists(path)) throw FormatError({.file = path}, "cannot open the case file (no such file)");

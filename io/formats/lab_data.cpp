@@ -290,10 +290,8 @@ rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, co
   return mm;
 }
 
-}  // namespace
-
-validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest_out) {
-  const std::string mpath = (fs::path(dir) / "manifest.toml").string();
+// The manifest parsed, its top-level tables checked and the keys every campaign states there.
+toml::table parse_manifest(const std::string& mpath) {
   if (!fs::is_regular_file(mpath)) throw FormatError({.file = mpath}, "cannot open the manifest (no such file)");
   toml::table root;
   try {
@@ -317,8 +315,11 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       throw FormatError({.file = mpath}, fmt::format("missing {} (docs/data-format.md)", list));
     }
   }
-  validation::Campaign c;
-  LabManifest m;
+  return root;
+}
+
+// The manifest's [campaign]: the name, and format_version 1.
+void read_manifest_campaign(const toml::table& root, const std::string& mpath, LabManifest& m) {
   if (auto* t = root["campaign"].as_table()) {
     check_keys(*t, "campaign", {"name", "format_version"}, mpath);
     m.name = (*t)["name"].value_or(m.name);
@@ -331,7 +332,10 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     if (const toml::node* nm = t->get("name"); nm && !nm->is_string())
       throw FormatError(toml_place(mpath, nm, "campaign", "name"), "expected a string");
   }
-  c.name = m.name;
+}
+
+// The manifest's [instrument]: the output unit and the site's g.
+void read_manifest_instrument(const toml::table& root, const std::string& mpath, LabManifest& m) {
   if (auto* t = root["instrument"].as_table()) {
     check_keys(*t, "instrument", {"output_unit", "g_m_per_s2"}, mpath);
     const toml::node* u = t->get("output_unit");
@@ -342,13 +346,16 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     m.output_unit = *u->value<std::string>();
     m.g_m_per_s2 = toml_number(*t, "instrument", "g_m_per_s2", m.g_m_per_s2, mpath);
   }
+}
+
+// The manifest's [dynamics]: the nominal loop as the manufacturer states it, checked.
+void read_manifest_dynamics(const toml::table& root, const std::string& mpath, LabManifest& m, plant::Dynamics& d) {
   if (auto* t = root["dynamics"].as_table()) {
     m.dynamics_given = true;
     check_keys(*t, "dynamics",
                {"pendulum_frequency_Hz", "pendulum_damping_ratio", "angle_gain_rad_per_s2_per_g", "loop_bandwidth_Hz",
                 "phase_margin_deg", "integrator", "integrator_zero_ratio"},
                mpath);
-    plant::Dynamics& d = c.dynamics;
     d.pendulum_frequency_Hz = toml_number(*t, "dynamics", "pendulum_frequency_Hz", d.pendulum_frequency_Hz, mpath);
     d.pendulum_damping_ratio = toml_number(*t, "dynamics", "pendulum_damping_ratio", d.pendulum_damping_ratio, mpath);
     d.angle_gain_rad_per_s2_per_g = toml_number(*t, "dynamics", "angle_gain_rad_per_s2_per_g", d.angle_gain_rad_per_s2_per_g, mpath);
@@ -359,6 +366,10 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
     std::string why;
     if (!d.IsValid(&why)) throw FormatError(toml_place(mpath, nullptr, "dynamics", ""), why);
   }
+}
+
+// The manifest's [identification] fixed: the coefficients held, by name.
+void read_manifest_fixed(const toml::table& root, const std::string& mpath, validation::Campaign& c) {
   if (auto* t = root["identification"].as_table()) {
     check_keys(*t, "identification", {"fixed"}, mpath);
     if (auto* f = (*t)["fixed"].as_table())
@@ -370,18 +381,27 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
         c.fixed[i] = v.value<double>().value();
       }
   }
-  if (auto* t = root["diagnose"].as_table()) read_diagnose_settings(*t, mpath, m);
+}
+
+// The manifest's [files]: the static readings' and the runs' files, relative to the folder.
+struct ManifestFiles {
   std::string static_file = "static.csv", runs_file = "runs.csv";
+};
+ManifestFiles read_manifest_files(const toml::table& root, const std::string& mpath) {
+  ManifestFiles files;
   if (auto* t = root["files"].as_table()) {
     check_keys(*t, "files", {"static", "runs"}, mpath);
-    static_file = (*t)["static"].value_or(static_file);
-    runs_file = (*t)["runs"].value_or(runs_file);
+    files.static_file = (*t)["static"].value_or(files.static_file);
+    files.runs_file = (*t)["runs"].value_or(files.runs_file);
   }
+  return files;
+}
 
-  // Static readings: every row must be usable (the identification needs them all).
-  const Csv st = read_csv((fs::path(dir) / static_file).string());
-  require_unit(st, "output_", m.output_unit);
-  require_unit(st, "sigma_", m.output_unit);
+// The static readings: every row must be usable (the identification needs them all).
+void read_static_readings(const std::string& path, const std::string& unit, validation::Campaign& c) {
+  const Csv st = read_csv(path);
+  require_unit(st, "output_", unit);
+  require_unit(st, "sigma_", unit);
   const bool by_vector = st.has("a_IA_g");
   if (by_vector) require_columns(st, {"a_IA_g", "a_PA_g", "a_OA_g"});
   else require_columns(st, {"series", "angle_deg"}, " (give a_IA_g, a_PA_g, a_OA_g or series, angle_deg)");
@@ -407,212 +427,283 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
       if (s != 1 && s != 2 && s != 3) throw FormatError(cell("series"), "must be 1, 2 or 3");
       r.orientation_g = validation::series_orientation(static_cast<int>(s), get("angle_deg") * std::numbers::pi / 180);
     }
-    r.output = get("output_" + m.output_unit);
-    const double sigma = get("sigma_" + m.output_unit);
+    r.output = get("output_" + unit);
+    const double sigma = get("sigma_" + unit);
     const bool has_count = st.has("count") && st.column.at("count") < row.second.size() && !row.second[st.column.at("count")].empty();
     const double count = has_count ? get("count") : 1.0;
     if (count != std::floor(count))
       throw FormatError(cell("count", static_cast<long>(st.column.at("count") + 1)),
                         fmt::format("{} is not a whole number of readings", row.second[st.column.at("count")]));
-    if (!(sigma > 0)) throw FormatError(cell("sigma_" + m.output_unit), "must be positive");
+    if (!(sigma > 0)) throw FormatError(cell("sigma_" + unit), "must be positive");
     if (!(count >= 1)) throw FormatError(cell("count"), "must be at least 1");
     r.sigma_output = sigma / std::sqrt(count);
     r.where = fmt::format("{}:{}", st.path, row.first);
     c.statics.push_back(r);
   }
   if (c.statics.empty()) throw FormatError({.file = st.path}, "no static readings");
+}
 
-  // The runs: a bad one is skipped with why.
-  const Csv rn = read_csv((fs::path(dir) / runs_file).string());
-  require_columns(rn, {"id", "frequency_Hz", "amplitude_g", "d_IA", "d_PA", "d_OA", "a_IA_g", "a_PA_g", "a_OA_g"});
-  const bool summaries = rn.has("measured_ug"), series = rn.has("series");
-  if (!summaries && !series)
-    throw FormatError({.file = rn.path}, "the header needs measured_ug and sigma_ug (summaries) or series (raw records)");
-  if (summaries) require_columns(rn, {"sigma_ug"});
-  if (series) require_columns(rn, {"rest_from_s", "rest_to_s", "on_from_s", "on_to_s"});
-  // K1 for raw records: the static readings' least-squares scale factor.
-  double K1 = 0;
-  if (series) {
-    std::vector<validation::Position> pos;
-    std::vector<validation::Reading> rd;
-    std::vector<double> w;
-    for (std::size_t i = 0; i < c.statics.size(); ++i) {
-      pos.push_back(validation::vector_position(c.statics[i].orientation_g.normalized()));
-      rd.push_back({static_cast<int>(i), c.statics[i].output});
-      w.push_back(1 / std::pow(c.statics[i].sigma_output, 2));
-    }
-    K1 = validation::least_squares(pos, rd, w, c.fixed).estimate.value[plant::K1];
+// K1 for raw records: the static readings' least-squares scale factor.
+double static_scale_factor(const validation::Campaign& c) {
+  std::vector<validation::Position> pos;
+  std::vector<validation::Reading> rd;
+  std::vector<double> w;
+  for (std::size_t i = 0; i < c.statics.size(); ++i) {
+    pos.push_back(validation::vector_position(c.statics[i].orientation_g.normalized()));
+    rd.push_back({static_cast<int>(i), c.statics[i].output});
+    w.push_back(1 / std::pow(c.statics[i].sigma_output, 2));
   }
-  for (const auto& row : rn.rows) {
-    const std::string idc = rn.column.at("id") < row.second.size() ? row.second[rn.column.at("id")] : "";
-    const std::string label = fmt::format("{}:{} (run '{}')", rn.path, row.first, idc);
-    const std::string named = fmt::format("run '{}'", idc);  // `why` already names the file and line
-    std::optional<FormatError> why;
-    auto get = [&](const std::string& col) { return number(rn, row, col, &why); };
+  return validation::least_squares(pos, rd, w, c.fixed).estimate.value[plant::K1];
+}
+
+// The runs table with what its header gives: summaries (measured_ug, sigma_ug) and/or raw
+// records (series with their windows), and K1 for the raw records.
+struct RunsTable {
+  Csv csv;
+  bool summaries = false, series = false;
+  double K1 = 0;
+};
+RunsTable read_runs_table(const std::string& path, const validation::Campaign& c) {
+  RunsTable t;
+  t.csv = read_csv(path);
+  const Csv& rn = t.csv;
+  require_columns(rn, {"id", "frequency_Hz", "amplitude_g", "d_IA", "d_PA", "d_OA", "a_IA_g", "a_PA_g", "a_OA_g"});
+  t.summaries = rn.has("measured_ug"), t.series = rn.has("series");
+  if (!t.summaries && !t.series)
+    throw FormatError({.file = rn.path}, "the header needs measured_ug and sigma_ug (summaries) or series (raw records)");
+  if (t.summaries) require_columns(rn, {"sigma_ug"});
+  if (t.series) require_columns(rn, {"rest_from_s", "rest_to_s", "on_from_s", "on_to_s"});
+  if (t.series) t.K1 = static_scale_factor(c);
+  return t;
+}
+
+// One row of the runs table as it is read: its cells, its place for messages (`label` with the
+// file and line, `named` for a `why` that already names them) and why the last number asked for
+// was not one.
+struct RunRow {
+  const Csv& csv;
+  const std::pair<int, std::vector<std::string>>& row;
+  std::string id, label, named;
+  std::optional<FormatError> why;
+
+  std::optional<double> get(const std::string& col) { return number(csv, row, col, &why); }
+  std::string cell(const std::string& col) const {
+    return csv.has(col) && csv.column.at(col) < row.second.size() ? row.second[csv.column.at(col)] : std::string();
+  }
+  std::string missing() const { return named + ": " + why->what(); }
+};
+
+// The run's kind (optional column, default sine) and, for a random one, its PSD file; the
+// reason when the row is skipped.
+std::optional<std::string> read_run_kind(const RunRow& rr, const std::string& dir, VibrationKind& kind_out,
+                                         validation::RunRecord& r) {
+  const std::string kind_text = rr.cell("kind");
+  const auto kind = kind_text.empty() ? VibrationKind::sine : rectification::parse_vibration_kind(kind_text);
+  if (!kind || kind == VibrationKind::swept_sine)
+    return fmt::format("{}:{}: column kind: must be sine, random or sine_on_random, got '{}'", rr.csv.path, rr.row.first,
+                       kind_text);
+  kind_out = *kind;
+  if (kind != VibrationKind::sine) {
+    const std::string coupling = rr.cell("coupling").empty() ? "common" : rr.cell("coupling");
+    if (coupling != "common" && coupling != "independent")
+      return fmt::format("{}:{}: column coupling: must be common or independent, got '{}'", rr.csv.path, rr.row.first,
+                         coupling);
+    if (rr.cell("psd").empty())
+      return fmt::format("{}:{}: column psd: a {} run needs its PSD file", rr.csv.path, rr.row.first,
+                         rectification::to_string(*kind));
+    try {
+      r.random = read_psd_file((fs::path(dir) / rr.cell("psd")).string(), coupling);
+    } catch (const FormatError& e) {
+      return rr.label + ": " + e.what();
+    }
+    r.sine_part = kind == VibrationKind::sine_on_random;
+  }
+  return std::nullopt;
+}
+
+// The run's motion (a sine's frequency, amplitude and direction from the row; a random run's
+// from its PSD) and its static orientation; the reason when the row is skipped.
+std::optional<std::string> read_run_motion(RunRow& rr, VibrationKind kind, validation::RunRecord& r) {
+  const auto o0 = rr.get("a_IA_g"), o1 = rr.get("a_PA_g"), o2 = rr.get("a_OA_g");
+  if (!o0 || !o1 || !o2) return rr.missing();
+  if (kind == VibrationKind::random) {
+    // No sine: frequency, amplitude and direction describe the PSD (its mean frequency,
+    // sqrt(2) x its rms, each axis's rms share); the row's cells are not read.
+    Vec3 rms = Vec3::Zero();
+    double moment1 = 0;
+    for (int i = 0; i < 3; ++i)
+      if (const auto& t = r.random->psd[static_cast<std::size_t>(i)]) {
+        rms[i] = vibration::rms_g(*t);
+        moment1 += vibration::psd_moment(vibration::resolve(*t), 1);
+      }
+    r.frequency_Hz = moment1 / rms.squaredNorm(), r.amplitude_g = std::sqrt(2.0) * rms.norm(), r.direction = rms.normalized();
+    r.orientation_g = Vec3(*o0, *o1, *o2);
+  } else {
+    const auto f = rr.get("frequency_Hz"), a = rr.get("amplitude_g"), d0 = rr.get("d_IA"), d1 = rr.get("d_PA"),
+               d2 = rr.get("d_OA");
+    if (!f || !a || !d0 || !d1 || !d2) return rr.missing();
+    const Vec3 d(*d0, *d1, *d2);
+    if (!(*f > 0) || !(*a > 0) || !(d.norm() > 0))
+      return rr.label + ": frequency, amplitude and direction must be positive / non-zero";
+    r.frequency_Hz = *f, r.amplitude_g = *a, r.direction = d.normalized(), r.orientation_g = Vec3(*o0, *o1, *o2);
+  }
+  return std::nullopt;
+}
+
+// The run's orientation is gravity and its id new; the reason when the row is skipped.
+std::optional<std::string> check_run(const RunRow& rr, const validation::RunRecord& r,
+                                     const std::vector<validation::RunRecord>& earlier) {
+  if (std::abs(r.orientation_g.norm() - 1) > 0.01)
+    return fmt::format("{}: the static orientation has |a| = {:.4g} g; gravity is 1 g (a_*_g in g)", rr.label,
+                       r.orientation_g.norm());
+  if (std::any_of(earlier.begin(), earlier.end(), [&](const validation::RunRecord& x) { return x.id == rr.id; }))
+    return rr.label + ": the id is used by an earlier run";
+  return std::nullopt;
+}
+
+// The windows of a run's raw record from its row (the vibration window as given in *on_to_s);
+// the reason when the row is skipped.
+std::optional<std::string> record_windows(RunRow& rr, const validation::RunRecord& r, double K1,
+                                          rectification::SeriesWindows& win, double* on_to_s) {
+  const auto rf = rr.get("rest_from_s"), rt = rr.get("rest_to_s"), of = rr.get("on_from_s"), ot = rr.get("on_to_s");
+  if (!rf || !rt || !of || !ot) return rr.missing();
+  *on_to_s = *ot;
+  win.baseline_from_s = *rf, win.baseline_to_s = *rt, win.on_from_s = *of, win.on_to_s = *ot;
+  win.frequency_Hz = r.frequency_Hz, win.K1 = K1;
+  // Batch means over whole periods: up to 8 blocks of equal whole numbers of periods (the
+  // vibration window shortened to a multiple of the blocks). A random run (random or sine
+  // on random, not periodic): 8 blocks over the window as given.
+  if (r.random) win.frequency_Hz = 0, win.blocks = 8;
+  const long periods = r.random ? 8 : static_cast<long>(std::floor((*ot - *of) * r.frequency_Hz + 1e-9));
+  if (periods < 2)
+    return fmt::format("{}: the vibration window holds {} whole period(s) of {:g} Hz; at least 2 are needed", rr.label,
+                       periods, r.frequency_Hz);
+  if (!r.random) {
+    win.blocks = static_cast<int>(std::min<long>(8, periods));
+    win.on_to_s = *of + static_cast<double>(periods / win.blocks * win.blocks) / r.frequency_Hz;
+  }
+  return std::nullopt;
+}
+
+// A run's raw record measured over its windows, and the table's motion from its reference
+// channels; throws std::invalid_argument or FormatError for a record that cannot be used.
+void measure_record(const std::string& spath, const rectification::SeriesWindows& win, double on_to_s,
+                    const std::string& unit, validation::RunRecord& r) {
+  win.validate();
+  rectification::SeriesMeasurer meas(win);
+  // Reference channels (docs/data-format.md, "Reference channels"): the table's motion
+  // over the vibration window, analysed as it streams (harmonics, or Welch's PSD).
+  rectification::ReferenceWindow rwin;
+  rwin.from_s = win.on_from_s, rwin.to_s = rectification::used_on_to_s(win);
+  rwin.frequency_Hz = r.random ? (r.sine_part ? r.frequency_Hz : 0.0) : r.frequency_Hz;
+  rwin.sine_on_random = r.random && r.sine_part;
+  std::optional<rectification::ReferenceAnalyzer> refan;
+  const ReferenceSink reference = [&](double t_s, const std::array<double, 3>& ref_g, const std::array<bool, 3>& present) {
+    if (!refan) refan.emplace(rwin);
+    refan->add(t_s, ref_g, present);
+  };
+  // The record, CSV or HDF5 by its extension (io/formats/series.hpp): time_s, output_<unit> and
+  // the optional reference channels.
+  double last_t = -INFINITY, first_dt = 0;
+  read_series(
+      spath, "output_" + unit,
+      [&](double t, double u) {
+        if (std::isfinite(last_t) && first_dt == 0) first_dt = t - last_t;  // as SeriesMeasurer detects it
+        last_t = t;
+        meas.add(t, u);
+      },
+      reference);
+  // Half-open windows, decided as `measure` does (rectification/measurement/series.hpp).
+  if (!rectification::record_covers_window_end(rectification::used_on_to_s(win), last_t, first_dt))
+    throw std::invalid_argument(fmt::format("{}: the record ends at {:g} s, before on_to_s = {:g} s", spath, last_t, on_to_s));
+  const rectification::SeriesResult res = meas.finish();
+  r.measured_g = res.measured_g, r.sigma_g = res.sigma_g;
+  if (refan) {
+    try {
+      r.motion = measured_motion(r, refan->finish());
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(fmt::format("{}: {}", spath, e.what()));
+    }
+  }
+}
+
+// The run's vibration error from its raw record `file`; the reason when the row is skipped.
+std::optional<std::string> read_run_record(RunRow& rr, const RunsTable& runs, const std::string& dir,
+                                           const std::string& file, const std::string& unit, validation::RunRecord& r) {
+  rectification::SeriesWindows win;
+  double on_to_s = 0;
+  if (auto skip = record_windows(rr, r, runs.K1, win, &on_to_s)) return skip;
+  const std::string spath = (fs::path(dir) / file).string();
+  try {
+    measure_record(spath, win, on_to_s, unit, r);
+  } catch (const std::invalid_argument& e) {
+    return rr.label + ": " + e.what();
+  } catch (const FormatError& e) {
+    return rr.label + ": " + e.what();
+  }
+  return std::nullopt;
+}
+
+// The run's vibration error from the row's summary (measured_ug, sigma_ug); the reason when
+// the row is skipped.
+std::optional<std::string> read_run_summary(RunRow& rr, const RunsTable& runs, validation::RunRecord& r) {
+  if (!runs.summaries) return rr.label + ": neither a series nor measured_ug";
+  const auto mu = rr.get("measured_ug"), su = rr.get("sigma_ug");
+  if (!mu || !su) return rr.missing();
+  if (!(*su > 0)) return rr.label + ": sigma_ug must be positive";
+  r.measured_g = *mu * 1e-6, r.sigma_g = *su * 1e-6;
+  return std::nullopt;
+}
+
+// One row of the runs table into `r`: the reason when the row is skipped (a bad run is
+// skipped with why, the others read).
+std::optional<std::string> read_run(const RunsTable& runs, const std::pair<int, std::vector<std::string>>& row,
+                                    const std::string& dir, const std::string& unit,
+                                    const std::vector<validation::RunRecord>& earlier, validation::RunRecord& r) {
+  const Csv& rn = runs.csv;
+  const std::string idc = rn.column.at("id") < row.second.size() ? row.second[rn.column.at("id")] : "";
+  RunRow rr{.csv = rn,
+            .row = row,
+            .id = idc,
+            .label = fmt::format("{}:{} (run '{}')", rn.path, row.first, idc),
+            .named = fmt::format("run '{}'", idc),  // `why` already names the file and line
+            .why = std::nullopt};
+  r.id = idc;
+  r.where = fmt::format("{}:{}", rn.path, row.first);
+  VibrationKind kind = VibrationKind::sine;
+  if (auto skip = read_run_kind(rr, dir, kind, r)) return skip;
+  if (auto skip = read_run_motion(rr, kind, r)) return skip;
+  if (auto skip = check_run(rr, r, earlier)) return skip;
+  const std::string file = runs.series && rn.column.at("series") < row.second.size() ? row.second[rn.column.at("series")] : "";
+  if (auto skip = file.empty() ? read_run_summary(rr, runs, r) : read_run_record(rr, runs, dir, file, unit, r)) return skip;
+  // Optional: the run's time and the rest reading before it (a bias drift, docs/data-format.md).
+  if (rn.has("time_h"))
+    if (const auto t = rr.get("time_h")) r.time_h = *t;
+  if (rn.has("rest_ug"))
+    if (const auto x = rr.get("rest_ug")) r.rest_g = *x * 1e-6;
+  return std::nullopt;
+}
+
+}  // namespace
+
+validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest_out) {
+  const std::string mpath = (fs::path(dir) / "manifest.toml").string();
+  const toml::table root = parse_manifest(mpath);
+  validation::Campaign c;
+  LabManifest m;
+  read_manifest_campaign(root, mpath, m);
+  c.name = m.name;
+  read_manifest_instrument(root, mpath, m);
+  read_manifest_dynamics(root, mpath, m, c.dynamics);
+  read_manifest_fixed(root, mpath, c);
+  if (auto* t = root["diagnose"].as_table()) read_diagnose_settings(*t, mpath, m);
+  const ManifestFiles files = read_manifest_files(root, mpath);
+  read_static_readings((fs::path(dir) / files.static_file).string(), m.output_unit, c);
+  const RunsTable runs = read_runs_table((fs::path(dir) / files.runs_file).string(), c);
+  for (const auto& row : runs.csv.rows) {
     validation::RunRecord r;
-    r.id = idc;
-    r.where = fmt::format("{}:{}", rn.path, row.first);
-    // The run's kind (optional column, default sine) and, for random ones, the PSD file.
-    auto cell = [&](const std::string& col) {
-      return rn.has(col) && rn.column.at(col) < row.second.size() ? row.second[rn.column.at(col)] : std::string();
-    };
-    const std::string kind_text = cell("kind");
-    const auto kind = kind_text.empty() ? VibrationKind::sine : rectification::parse_vibration_kind(kind_text);
-    if (!kind || kind == VibrationKind::swept_sine) {
-      c.skipped.push_back(fmt::format("{}:{}: column kind: must be sine, random or sine_on_random, got '{}'", rn.path,
-                                      row.first, kind_text));
-      continue;
-    }
-    if (kind != VibrationKind::sine) {
-      const std::string coupling = cell("coupling").empty() ? "common" : cell("coupling");
-      if (coupling != "common" && coupling != "independent") {
-        c.skipped.push_back(fmt::format("{}:{}: column coupling: must be common or independent, got '{}'", rn.path,
-                                        row.first, coupling));
-        continue;
-      }
-      if (cell("psd").empty()) {
-        c.skipped.push_back(fmt::format("{}:{}: column psd: a {} run needs its PSD file", rn.path, row.first,
-                                        rectification::to_string(*kind)));
-        continue;
-      }
-      try {
-        r.random = read_psd_file((fs::path(dir) / cell("psd")).string(), coupling);
-      } catch (const FormatError& e) {
-        c.skipped.push_back(label + ": " + e.what());
-        continue;
-      }
-      r.sine_part = kind == VibrationKind::sine_on_random;
-    }
-    const auto o0 = get("a_IA_g"), o1 = get("a_PA_g"), o2 = get("a_OA_g");
-    if (!o0 || !o1 || !o2) {
-      c.skipped.push_back(named + ": " + why->what());
-      continue;
-    }
-    if (kind == VibrationKind::random) {
-      // No sine: frequency, amplitude and direction describe the PSD (its mean frequency,
-      // sqrt(2) x its rms, each axis's rms share); the row's cells are not read.
-      Vec3 rms = Vec3::Zero();
-      double moment1 = 0;
-      for (int i = 0; i < 3; ++i)
-        if (const auto& t = r.random->psd[static_cast<std::size_t>(i)]) {
-          rms[i] = vibration::rms_g(*t);
-          moment1 += vibration::psd_moment(vibration::resolve(*t), 1);
-        }
-      r.frequency_Hz = moment1 / rms.squaredNorm(), r.amplitude_g = std::sqrt(2.0) * rms.norm(), r.direction = rms.normalized();
-      r.orientation_g = Vec3(*o0, *o1, *o2);
-    } else {
-      const auto f = get("frequency_Hz"), a = get("amplitude_g"), d0 = get("d_IA"), d1 = get("d_PA"), d2 = get("d_OA");
-      if (!f || !a || !d0 || !d1 || !d2) {
-        c.skipped.push_back(named + ": " + why->what());
-        continue;
-      }
-      const Vec3 d(*d0, *d1, *d2);
-      if (!(*f > 0) || !(*a > 0) || !(d.norm() > 0)) {
-        c.skipped.push_back(label + ": frequency, amplitude and direction must be positive / non-zero");
-        continue;
-      }
-      r.frequency_Hz = *f, r.amplitude_g = *a, r.direction = d.normalized(), r.orientation_g = Vec3(*o0, *o1, *o2);
-    }
-    if (std::abs(r.orientation_g.norm() - 1) > 0.01) {
-      c.skipped.push_back(fmt::format("{}: the static orientation has |a| = {:.4g} g; gravity is 1 g (a_*_g in g)", label,
-                                      r.orientation_g.norm()));
-      continue;
-    }
-    if (std::any_of(c.runs.begin(), c.runs.end(), [&](const validation::RunRecord& x) { return x.id == idc; })) {
-      c.skipped.push_back(label + ": the id is used by an earlier run");
-      continue;
-    }
-    const std::string file = series && rn.column.at("series") < row.second.size() ? row.second[rn.column.at("series")] : "";
-    if (!file.empty()) {
-      const auto rf = get("rest_from_s"), rt = get("rest_to_s"), of = get("on_from_s"), ot = get("on_to_s");
-      if (!rf || !rt || !of || !ot) {
-        c.skipped.push_back(named + ": " + why->what());
-        continue;
-      }
-      rectification::SeriesWindows win;
-      win.baseline_from_s = *rf, win.baseline_to_s = *rt, win.on_from_s = *of, win.on_to_s = *ot;
-      win.frequency_Hz = r.frequency_Hz, win.K1 = K1;
-      // Batch means over whole periods: up to 8 blocks of equal whole numbers of periods (the
-      // vibration window shortened to a multiple of the blocks). A random run (random or sine
-      // on random, not periodic): 8 blocks over the window as given.
-      if (r.random) win.frequency_Hz = 0, win.blocks = 8;
-      const long periods = r.random ? 8 : static_cast<long>(std::floor((*ot - *of) * r.frequency_Hz + 1e-9));
-      if (periods < 2) {
-        c.skipped.push_back(fmt::format("{}: the vibration window holds {} whole period(s) of {:g} Hz; at least 2 are needed",
-                                        label, periods, r.frequency_Hz));
-        continue;
-      }
-      if (!r.random) {
-        win.blocks = static_cast<int>(std::min<long>(8, periods));
-        win.on_to_s = *of + static_cast<double>(periods / win.blocks * win.blocks) / r.frequency_Hz;
-      }
-      const std::string spath = (fs::path(dir) / file).string();
-      try {
-        win.validate();
-        rectification::SeriesMeasurer meas(win);
-        // Reference channels (docs/data-format.md, "Reference channels"): the table's motion
-        // over the vibration window, analysed as it streams (harmonics, or Welch's PSD).
-        rectification::ReferenceWindow rwin;
-        rwin.from_s = win.on_from_s, rwin.to_s = rectification::used_on_to_s(win);
-        rwin.frequency_Hz = r.random ? (r.sine_part ? r.frequency_Hz : 0.0) : r.frequency_Hz;
-        rwin.sine_on_random = r.random && r.sine_part;
-        std::optional<rectification::ReferenceAnalyzer> refan;
-        const ReferenceSink reference = [&](double t_s, const std::array<double, 3>& ref_g, const std::array<bool, 3>& present) {
-          if (!refan) refan.emplace(rwin);
-          refan->add(t_s, ref_g, present);
-        };
-        // The record, CSV or HDF5 by its extension (io/formats/series.hpp): time_s, output_<unit> and
-        // the optional reference channels.
-        double last_t = -INFINITY, first_dt = 0;
-        read_series(
-            spath, "output_" + m.output_unit,
-            [&](double t, double u) {
-              if (std::isfinite(last_t) && first_dt == 0) first_dt = t - last_t;  // as SeriesMeasurer detects it
-              last_t = t;
-              meas.add(t, u);
-            },
-            reference);
-        // Half-open windows, decided as `measure` does (rectification/measurement/series.hpp).
-        if (!rectification::record_covers_window_end(rectification::used_on_to_s(win), last_t, first_dt))
-          throw std::invalid_argument(fmt::format("{}: the record ends at {:g} s, before on_to_s = {:g} s", spath, last_t, *ot));
-        const rectification::SeriesResult res = meas.finish();
-        r.measured_g = res.measured_g, r.sigma_g = res.sigma_g;
-        if (refan) {
-          try {
-            r.motion = measured_motion(r, refan->finish());
-          } catch (const std::invalid_argument& e) {
-            throw std::invalid_argument(fmt::format("{}: {}", spath, e.what()));
-          }
-        }
-      } catch (const std::invalid_argument& e) {
-        c.skipped.push_back(label + ": " + e.what());
-        continue;
-      } catch (const FormatError& e) {
-        c.skipped.push_back(label + ": " + e.what());
-        continue;
-      }
-    } else {
-      if (!summaries) {
-        c.skipped.push_back(label + ": neither a series nor measured_ug");
-        continue;
-      }
-      const auto mu = get("measured_ug"), su = get("sigma_ug");
-      if (!mu || !su) {
-        c.skipped.push_back(named + ": " + why->what());
-        continue;
-      }
-      if (!(*su > 0)) {
-        c.skipped.push_back(label + ": sigma_ug must be positive");
-        continue;
-      }
-      r.measured_g = *mu * 1e-6, r.sigma_g = *su * 1e-6;
-    }
-    // Optional: the run's time and the rest reading before it (a bias drift, docs/data-format.md).
-    if (rn.has("time_h"))
-      if (const auto t = get("time_h")) r.time_h = *t;
-    if (rn.has("rest_ug"))
-      if (const auto x = get("rest_ug")) r.rest_g = *x * 1e-6;
-    c.runs.push_back(r);
+    if (const auto skip = read_run(runs, row, dir, m.output_unit, c.runs, r)) c.skipped.push_back(*skip);
+    else c.runs.push_back(r);
   }
   if (manifest_out) *manifest_out = m;
   return c;

@@ -266,21 +266,11 @@ DepartureAnalysis analyse_departure(const ReproduceResult& res, const ReproduceS
   return a;
 }
 
-}  // namespace
+using Covariance = std::array<CoefArray, plant::kNumCoefficients>;
 
-ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const ReproduceSettings& s,
-                          const std::function<void(const std::string&)>& log, std::ostream* progress) {
-  auto say = [&](const std::string& m) {
-    if (log) log(m);
-  };
-  std::string why;
-  if (!s.IsValid(&why)) throw std::invalid_argument("reproduce: " + why);
-  const int threads = core::thread_count(s.threads);
-  ReproduceResult out;
-  out.truth = truth_plant.coefficients;
-
-  // 1. The static test on the plant, settled in each position.
-  say("static test: the plant settled in each position of the dividing head");
+// 1. The static test on the plant, settled in each position; the coefficients least squares
+// identifies, their uncertainty, and the simulation a lab would build from them.
+void identify_statically(const plant::PlantConfig& truth_plant, const ReproduceSettings& s, ReproduceResult& out) {
   StaticTestSettings st;
   st.fixed = s.fixed;
   st.seed = s.seed;
@@ -291,85 +281,164 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
   const MethodResult& ls = out.static_test.methods.back();  // least squares is always last
   out.identified = ls.estimate.value;
   out.identified_uncertainty = ls.first_order;
-  const auto& cov = ls.first_order.covariance;
   // The simulation a lab would build: identified coefficients, nominal dynamics, no effects.
   out.nominal = truth_plant;
   out.nominal.coefficients = out.identified;
   out.nominal.effects.clear();
+}
+
+// The confirmation record's running integral (rectangle rule at the sampling step), its fit
+// over the measuring time (offset, slope and 3 harmonics) and the integral without the swing.
+void fit_running_integral(ConfirmationRecord& c, double frequency_Hz) {
+  const std::size_t n = c.t_s.size();
+  c.integral_g_s.assign(n, 0.0);
+  for (std::size_t i = 1; i < n; ++i)
+    c.integral_g_s[i] = c.integral_g_s[i - 1] + (c.output[i] / c.K1 - c.rest_mean_g) * (c.t_s[i] - c.t_s[i - 1]);
+  constexpr int kHarmonics = 3;
+  const double w = 2 * std::numbers::pi * frequency_Hz;
+  auto row = [&](double t) {
+    Eigen::RowVectorXd r(2 + 2 * kHarmonics);
+    r(0) = 1, r(1) = t;
+    for (int h = 1; h <= kHarmonics; ++h) r(2 * h) = std::cos(h * w * t), r(2 * h + 1) = std::sin(h * w * t);
+    return r;
+  };
+  std::vector<std::size_t> fit;
+  for (std::size_t i = 0; i < n; ++i)
+    if (c.t_s[i] >= c.t_measure_start_s) fit.push_back(i);
+  c.integral_without_oscillation_g_s = c.integral_g_s;
+  if (fit.size() > 4 * (2 + 2 * kHarmonics)) {
+    Eigen::MatrixXd A(static_cast<Eigen::Index>(fit.size()), 2 + 2 * kHarmonics);
+    Eigen::VectorXd y(A.rows());
+    for (Eigen::Index k = 0; k < A.rows(); ++k) {
+      A.row(k) = row(c.t_s[fit[static_cast<std::size_t>(k)]]);
+      y(k) = c.integral_g_s[fit[static_cast<std::size_t>(k)]];
+    }
+    const Eigen::VectorXd beta = A.colPivHouseholderQr().solve(y);
+    c.integral_slope_g = beta(1);
+    c.oscillation_amplitude_g_s = std::hypot(beta(2), beta(3));
+    // Taken off from t = 0 on, as p(t) - p(0): the swing starts with the vibration.
+    const auto p = [&](double t) { return row(t).segment(2, 2 * kHarmonics).dot(beta.segment(2, 2 * kHarmonics)); };
+    const double p0 = p(0.0);
+    for (std::size_t i = 0; i < n; ++i)
+      if (c.t_s[i] >= 0) c.integral_without_oscillation_g_s[i] -= p(c.t_s[i]) - p0;
+  }
+}
+
+// 2. The confirmation run: the sampled record kept for the figure, its rest level and running
+// integral, and eq. (3)'s prediction for it from the identified coefficients.
+void confirmation_run(const plant::PlantConfig& truth_plant, const ReproduceSettings& s, const plant::PlantConfig& nominal,
+                      const Covariance& cov, ConfirmationRecord& c) {
+  rectification::ShakeSettings cs = s.shake;
+  cs.min_measure_s = s.confirmation_record_s;
+  c.K1 = truth_plant.coefficients[plant::K1];
+  const vibration::SineVibration v =
+      sine_of(s.confirmation_direction.v.normalized(), s.confirmation_amplitude_g, s.frequency_Hz);
+  c.shake = rectification::shake_sine(truth_plant, s.confirmation_orientation.v, v, cs,
+                                      [&c](double t, const Vec3&, double u) {
+                                        c.t_s.push_back(t);
+                                        c.output.push_back(u);
+                                      });
+  double rest = 0;
+  long n_rest = 0;
+  for (std::size_t i = 0; i < c.t_s.size() && c.t_s[i] < 0; ++i, ++n_rest) rest += c.output[i] / c.K1;
+  c.rest_mean_g = n_rest > 0 ? rest / static_cast<double>(n_rest) : c.shake.baseline_g;
+  c.t_measure_start_s = c.shake.settle_s;
+  c.t_end_s = c.t_s.empty() ? 0.0 : c.t_s.back();
+  fit_running_integral(c, s.frequency_Hz);
+  RunResult r;
+  r.orientation_g = s.confirmation_orientation.v, r.direction_unit = s.confirmation_direction.v.normalized();
+  r.amplitude_g = s.confirmation_amplitude_g, r.frequency_Hz = s.frequency_Hz;
+  predict_run(r, nominal, cov);
+  c.predicted = r.predicted;
+}
+
+// The shake settings of section k: each section draws its readout noise from its own seed
+// range (run i of section k: seed + k * 1000003 + i), so no two runs share a noise record.
+rectification::ShakeSettings section_shake(const ReproduceSettings& s, int k) {
+  rectification::ShakeSettings x = s.shake;
+  x.readout.seed = s.shake.readout.seed + static_cast<std::uint64_t>(k) * 1000003u;
+  return x;
+}
+
+// c fitted from the second instrument's runs (each predicted from the identified coefficients
+// on the way): generalised least squares for c in residual = -c |w|^2 / 2; the runs share the
+// prediction's coefficient errors, so V = diag(sigma_m^2) + G Sigma G^T.
+void fit_invisible_shift(InvisibleResult& inv, const plant::PlantConfig& nominal, const Coefficients& identified,
+                         const Covariance& cov) {
+  const int n = static_cast<int>(inv.runs.size());
+  Eigen::MatrixXd G(n, plant::kNumCoefficients), S(plant::kNumCoefficients, plant::kNumCoefficients);
+  Eigen::VectorXd x(n), res(n), sm2(n);
+  for (int i = 0; i < plant::kNumCoefficients; ++i)
+    for (int j = 0; j < plant::kNumCoefficients; ++j) S(i, j) = cov[i][j];
+  for (int k = 0; k < n; ++k) {
+    RunResult& r = inv.runs[static_cast<std::size_t>(k)];
+    predict_run(r, nominal, cov);
+    const vibration::SineVibration v = sine_of(r.direction_unit, r.amplitude_g, r.frequency_Hz);
+    const CoefArray g = rectification::prediction_gradient(
+        [&](const Coefficients& c) { return rectification::sine_rectification(c, r.orientation_g, v).total_g(); },
+        identified);
+    for (int i = 0; i < plant::kNumCoefficients; ++i) G(k, i) = g[i];
+    x(k) = -r.amplitude_g * r.amplitude_g / 2;
+    res(k) = r.residual_g();
+    sm2(k) = r.sigma_measured_g * r.sigma_measured_g;
+  }
+  const Eigen::MatrixXd V = Eigen::MatrixXd(sm2.asDiagonal()) + G * S * G.transpose();
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(V);
+  const double info = x.dot(ldlt.solve(x));
+  inv.c_fit_per_g = x.dot(ldlt.solve(res)) / info;
+  inv.c_fit_sigma_per_g = 1 / std::sqrt(info);
+}
+
+// 5. The instrument no static test can tell from the first (k0 up by c; k2, k_PP and k_OO
+// down by c): how far apart their static readings are, its shaker runs along IA, PA and OA,
+// and c fitted from them.
+void invisible_shift(const plant::PlantConfig& truth_plant, const ReproduceSettings& s, const ReproduceResult& out,
+                     const Covariance& cov, int threads, std::ostream* progress,
+                     const std::function<void(const std::string&)>& say, InvisibleResult& inv) {
+  inv.c_per_g = s.invisible_shift_per_g;
+  plant::PlantConfig other = truth_plant;
+  other.coefficients[plant::k0] += inv.c_per_g;
+  for (int i : {plant::k2, plant::k_PP, plant::k_OO}) other.coefficients[i] -= inv.c_per_g;
+  for (const Position& p : s.positions)
+    inv.max_static_difference_g =
+        std::max(inv.max_static_difference_g,
+                 std::abs(plant::settled_output_g(other, p.nominal_g) - plant::settled_output_g(truth_plant, p.nominal_g)));
+  const std::vector<NamedVector> axes = {{"IA", Vec3(1, 0, 0)}, {"PA", Vec3(0, 1, 0)}, {"OA", Vec3(0, 0, 1)}};
+  say("invisible shift: 3 x " + std::to_string(s.amplitudes_g.size()) + " shaker runs on the second instrument");
+  const rectification::SweepGrid ig = grid_of({s.frequency_Hz}, s.amplitudes_g, axes, {s.confirmation_orientation});
+  inv.runs = shake_grid(other, section_shake(s, 3), ig, axes, {s.confirmation_orientation}, threads, progress,
+                        "invisible shift");
+  fit_invisible_shift(inv, out.nominal, out.identified, cov);
+}
+
+}  // namespace
+
+ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const ReproduceSettings& s,
+                          const std::function<void(const std::string&)>& log, std::ostream* progress) {
+  const std::function<void(const std::string&)> say = [&](const std::string& m) {
+    if (log) log(m);
+  };
+  std::string why;
+  if (!s.IsValid(&why)) throw std::invalid_argument("reproduce: " + why);
+  const int threads = core::thread_count(s.threads);
+  ReproduceResult out;
+  out.truth = truth_plant.coefficients;
+
+  // 1. The static test on the plant, settled in each position.
+  say("static test: the plant settled in each position of the dividing head");
+  identify_statically(truth_plant, s, out);
+  const Covariance& cov = out.static_test.methods.back().first_order.covariance;  // least squares'
   const plant::PlantConfig& nominal = out.nominal;
 
   // 2. The confirmation run: the sampled record kept for the figure.
   say("confirmation run");
-  {
-    ConfirmationRecord& c = out.confirmation;
-    rectification::ShakeSettings cs = s.shake;
-    cs.min_measure_s = s.confirmation_record_s;
-    c.K1 = truth_plant.coefficients[plant::K1];
-    const vibration::SineVibration v =
-        sine_of(s.confirmation_direction.v.normalized(), s.confirmation_amplitude_g, s.frequency_Hz);
-    c.shake = rectification::shake_sine(truth_plant, s.confirmation_orientation.v, v, cs,
-                                        [&c](double t, const Vec3&, double u) {
-                                          c.t_s.push_back(t);
-                                          c.output.push_back(u);
-                                        });
-    double rest = 0;
-    long n_rest = 0;
-    for (std::size_t i = 0; i < c.t_s.size() && c.t_s[i] < 0; ++i, ++n_rest) rest += c.output[i] / c.K1;
-    c.rest_mean_g = n_rest > 0 ? rest / static_cast<double>(n_rest) : c.shake.baseline_g;
-    c.t_measure_start_s = c.shake.settle_s;
-    c.t_end_s = c.t_s.empty() ? 0.0 : c.t_s.back();
-    // The running integral (rectangle rule at the sampling step) and its fit.
-    const std::size_t n = c.t_s.size();
-    c.integral_g_s.assign(n, 0.0);
-    for (std::size_t i = 1; i < n; ++i)
-      c.integral_g_s[i] = c.integral_g_s[i - 1] + (c.output[i] / c.K1 - c.rest_mean_g) * (c.t_s[i] - c.t_s[i - 1]);
-    constexpr int kHarmonics = 3;
-    const double w = 2 * std::numbers::pi * s.frequency_Hz;
-    auto row = [&](double t) {
-      Eigen::RowVectorXd r(2 + 2 * kHarmonics);
-      r(0) = 1, r(1) = t;
-      for (int h = 1; h <= kHarmonics; ++h) r(2 * h) = std::cos(h * w * t), r(2 * h + 1) = std::sin(h * w * t);
-      return r;
-    };
-    std::vector<std::size_t> fit;
-    for (std::size_t i = 0; i < n; ++i)
-      if (c.t_s[i] >= c.t_measure_start_s) fit.push_back(i);
-    c.integral_without_oscillation_g_s = c.integral_g_s;
-    if (fit.size() > 4 * (2 + 2 * kHarmonics)) {
-      Eigen::MatrixXd A(static_cast<Eigen::Index>(fit.size()), 2 + 2 * kHarmonics);
-      Eigen::VectorXd y(A.rows());
-      for (Eigen::Index k = 0; k < A.rows(); ++k) {
-        A.row(k) = row(c.t_s[fit[static_cast<std::size_t>(k)]]);
-        y(k) = c.integral_g_s[fit[static_cast<std::size_t>(k)]];
-      }
-      const Eigen::VectorXd beta = A.colPivHouseholderQr().solve(y);
-      c.integral_slope_g = beta(1);
-      c.oscillation_amplitude_g_s = std::hypot(beta(2), beta(3));
-      // Taken off from t = 0 on, as p(t) - p(0): the swing starts with the vibration.
-      const auto p = [&](double t) { return row(t).segment(2, 2 * kHarmonics).dot(beta.segment(2, 2 * kHarmonics)); };
-      const double p0 = p(0.0);
-      for (std::size_t i = 0; i < n; ++i)
-        if (c.t_s[i] >= 0) c.integral_without_oscillation_g_s[i] -= p(c.t_s[i]) - p0;
-    }
-    RunResult r;
-    r.orientation_g = s.confirmation_orientation.v, r.direction_unit = s.confirmation_direction.v.normalized();
-    r.amplitude_g = s.confirmation_amplitude_g, r.frequency_Hz = s.frequency_Hz;
-    predict_run(r, nominal, cov);
-    c.predicted = r.predicted;
-  }
+  confirmation_run(truth_plant, s, nominal, cov, out.confirmation);
 
   // 3. The amplitude study.
   const rectification::SweepGrid grid = grid_of({s.frequency_Hz}, s.amplitudes_g, s.directions, s.orientations);
   say("amplitude study: " + std::to_string(grid.size()) + " shaker runs");
-  // Each section draws its readout noise from its own seed range (run i of section k:
-  // seed + k * 1000003 + i), so no two runs share a noise record.
-  const auto section = [&s](int k) {
-    rectification::ShakeSettings x = s.shake;
-    x.readout.seed = s.shake.readout.seed + static_cast<std::uint64_t>(k) * 1000003u;
-    return x;
-  };
   out.amplitude_runs =
-      shake_grid(truth_plant, section(1), grid, s.directions, s.orientations, threads, progress, "amplitude study");
+      shake_grid(truth_plant, section_shake(s, 1), grid, s.directions, s.orientations, threads, progress, "amplitude study");
   for (RunResult& r : out.amplitude_runs) predict_run(r, nominal, cov);
 
   // 4. The departure in frequency.
@@ -378,54 +447,15 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
     const rectification::SweepGrid fg = grid_of(s.departure_frequencies_Hz, {s.confirmation_amplitude_g},
                                                 {s.confirmation_direction}, {s.confirmation_orientation});
     out.frequency_runs =
-        shake_grid(truth_plant, section(2), fg, {s.confirmation_direction}, {s.confirmation_orientation}, threads,
-                   progress, "frequency departure");
+        shake_grid(truth_plant, section_shake(s, 2), fg, {s.confirmation_direction}, {s.confirmation_orientation},
+                   threads, progress, "frequency departure");
     std::sort(out.frequency_runs.begin(), out.frequency_runs.end(),
               [](const RunResult& a, const RunResult& b) { return a.frequency_Hz < b.frequency_Hz; });
     for (RunResult& r : out.frequency_runs) predict_run(r, nominal, cov);
   }
 
   // 5. The instrument no static test can tell from the first.
-  if (s.invisible_shift_per_g != 0) {
-    InvisibleResult& inv = out.invisible;
-    inv.c_per_g = s.invisible_shift_per_g;
-    plant::PlantConfig other = truth_plant;
-    other.coefficients[plant::k0] += inv.c_per_g;
-    for (int i : {plant::k2, plant::k_PP, plant::k_OO}) other.coefficients[i] -= inv.c_per_g;
-    for (const Position& p : s.positions)
-      inv.max_static_difference_g =
-          std::max(inv.max_static_difference_g,
-                   std::abs(plant::settled_output_g(other, p.nominal_g) - plant::settled_output_g(truth_plant, p.nominal_g)));
-    const std::vector<NamedVector> axes = {{"IA", Vec3(1, 0, 0)}, {"PA", Vec3(0, 1, 0)}, {"OA", Vec3(0, 0, 1)}};
-    say("invisible shift: 3 x " + std::to_string(s.amplitudes_g.size()) + " shaker runs on the second instrument");
-    const rectification::SweepGrid ig = grid_of({s.frequency_Hz}, s.amplitudes_g, axes, {s.confirmation_orientation});
-    inv.runs = shake_grid(other, section(3), ig, axes, {s.confirmation_orientation}, threads, progress,
-                          "invisible shift");
-    // Generalised least squares for c in residual = -c |w|^2 / 2: the runs share the
-    // prediction's coefficient errors, so V = diag(sigma_m^2) + G Sigma G^T.
-    const int n = static_cast<int>(inv.runs.size());
-    Eigen::MatrixXd G(n, plant::kNumCoefficients), S(plant::kNumCoefficients, plant::kNumCoefficients);
-    Eigen::VectorXd x(n), res(n), sm2(n);
-    for (int i = 0; i < plant::kNumCoefficients; ++i)
-      for (int j = 0; j < plant::kNumCoefficients; ++j) S(i, j) = cov[i][j];
-    for (int k = 0; k < n; ++k) {
-      RunResult& r = inv.runs[static_cast<std::size_t>(k)];
-      predict_run(r, nominal, cov);
-      const vibration::SineVibration v = sine_of(r.direction_unit, r.amplitude_g, r.frequency_Hz);
-      const CoefArray g = rectification::prediction_gradient(
-          [&](const Coefficients& c) { return rectification::sine_rectification(c, r.orientation_g, v).total_g(); },
-          out.identified);
-      for (int i = 0; i < plant::kNumCoefficients; ++i) G(k, i) = g[i];
-      x(k) = -r.amplitude_g * r.amplitude_g / 2;
-      res(k) = r.residual_g();
-      sm2(k) = r.sigma_measured_g * r.sigma_measured_g;
-    }
-    const Eigen::MatrixXd V = Eigen::MatrixXd(sm2.asDiagonal()) + G * S * G.transpose();
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(V);
-    const double info = x.dot(ldlt.solve(x));
-    inv.c_fit_per_g = x.dot(ldlt.solve(res)) / info;
-    inv.c_fit_sigma_per_g = 1 / std::sqrt(info);
-  }
+  if (s.invisible_shift_per_g != 0) invisible_shift(truth_plant, s, out, cov, threads, progress, say, out.invisible);
   out.amplitude = analyse_amplitude(out.amplitude_runs, s);
   out.amplitude_curves = amplitude_curves(out, s);
   out.departure = analyse_departure(out, s);
