@@ -34,7 +34,7 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 // Physical ranges of model (1)'s coefficients. K1 in (0, 1e6] output units per g (mA/g, V/g:
 // navigation instruments are ~1); every other coefficient within 1 in its unit (1 g of bias,
 // 1/g, 1/g^2, 1 rad: orders beyond any accelerometer, whose values are <= 1e-2). Beyond these
-// the results overflow (K1 = 1e308 gave inf with exit 0) or mean nothing.
+// the results overflow (K1 = 1e308 would give inf with exit 0) or mean nothing.
 constexpr double kMaxK1 = 1e6, kMaxCoefficient = 1.0;
 void check_coefficient(const Table& t, int i, double x) {
   const std::string_view name = plant::coefficient_name(i);

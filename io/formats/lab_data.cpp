@@ -264,7 +264,7 @@ rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, co
   for (const auto& t : cmd.psd)
     if (t) lo = std::min(lo, t->rows.front().frequency_Hz), hi = std::max(hi, t->rows.back().frequency_Hz);
   // Two bins beyond each end: the Hann window's main lobe spreads a sharp band edge over
-  // +-2 bins, and that power is the motion's (left out, it was ~1 % of a 20-500 Hz table's
+  // +-2 bins, and that power is the motion's (left out, it would be ~1 % of a 20-500 Hz table's
   // variance at 7.8 Hz bins).
   lo = std::max(lo - 2 * a.resolution_Hz, a.bin_Hz.empty() ? 0.0 : a.bin_Hz.front());
   hi += 2 * a.resolution_Hz;

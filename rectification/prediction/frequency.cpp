@@ -40,8 +40,8 @@ LoopResponder::LoopResponder(const PlantConfig& config, bool dc_gain) {
   n_ = plant.size();
   // (s I - A) x = B solved in the plant's state scales (x = S y, S = diag(state_scale)): a
   // mechanical mode's states are ~1/w_m^2 g s^2, so unscaled A spans 1e-4 .. 1e11 and a full-pivot
-  // LU's rank threshold (eps n max|pivot|) took real pivots for zero and returned a zero response
-  // for a mode above the drive (issue 15: a mode at 2.5 kHz gave |I| = 0 at 800 Hz).
+  // LU's rank threshold (eps n max|pivot|) would take real pivots for zero and return a zero response
+  // for a mode above the drive (a mode at 2.5 kHz would give |I| = 0 at 800 Hz).
   const std::vector<double> scale = plant.state_scale();
   sc_.resize(n_);
   for (int k = 0; k < n_; ++k) sc_[k] = scale[static_cast<std::size_t>(k)];
@@ -434,7 +434,7 @@ const std::vector<std::complex<double>>& period_phasors() {
 
 // The same for kM = 6 h_max + 1 points (h_max = 11..kFilmHarmonics: a squeeze film's
 // harmonics through the loop), e^{j h phi_k}, phi_k = 2 pi k / kM, h = 1..h_max, by the same
-// expression as the loop computed them (the same numbers): was a sincos per point and
+// expression as the loop computes them (the same numbers), rather than a sincos per point and
 // harmonic of every run of every film value.
 constexpr int kLongMaxHarmonic = kFilmHarmonics;
 const std::vector<std::complex<double>>* long_period_phasors(int points) {

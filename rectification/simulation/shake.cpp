@@ -77,7 +77,7 @@ class SampledRecorder {
   // rest_closed_form: without noise and without a sink every sample at rest is the same
   // number, and each block's sum is taken as block_n times it (the running sum of block_n
   // equal terms differs from it by rounding only, ~block_n ulp of the baseline; the sine
-  // paths keep the running sum, bit for bit as before).
+  // paths keep the running sum).
   SampledRecorder(const Readout& ro, double k1, double baseline_g, int blocks, long block_n, double dt,
                   const SampleSink& sink, bool rest_closed_form = false)
       : ro_(ro), k1_(k1), baseline_(baseline_g), block_n_(block_n), dt_(dt), sink_(sink), rng_(ro.seed),

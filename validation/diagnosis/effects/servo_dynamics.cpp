@@ -1,5 +1,5 @@
 // The servo loop's dynamics differ from the manifest's: the crossover, and in its natural form
-// the phase margin and the pendulum frequency with it (docs/diagnose.md, "Loop dynamics").
+// the phase margin and the pendulum frequency with it (docs/effects.md, "Loop dynamics").
 #include "validation/diagnosis/effects/common.hpp"
 
 namespace vrelab::validation {
