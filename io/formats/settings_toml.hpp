@@ -23,9 +23,10 @@ namespace vrelab::io {
 template <class S, class Fail>
 void read_settings_table(const toml::table& t, S& s, const Fail& fail) {
   for (auto&& [k, v] : t) {
+    const std::string name(k.str());  // a copy: clang 14 cannot capture a structured binding
     bool known = false;
-    core::for_each_field<S>([&](const auto& f) { known = known || f.name == k.str(); });
-    if (!known) fail(&v, std::string(k.str()), std::string(k.str()) + ": unknown key");
+    core::for_each_field<S>([&](const auto& f) { known = known || f.name == name; });
+    if (!known) fail(&v, name, name + ": unknown key");
   }
   core::for_each_field<S>([&](const auto& f) {
     using T = typename std::decay_t<decltype(f)>::Type;
