@@ -44,6 +44,7 @@
 #include "io/services/studies.hpp"
 #include "plant/model1.hpp"
 #include "plant/ode_solver.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 #include "vrelab_version.hpp"
 
 namespace py = pybind11;
@@ -607,8 +608,8 @@ PYBIND11_MODULE(_core, m) {
       .def_readwrite("dir", &io::FolderDiagnosis::dir, "The campaign folder (diagnose_data: the name given).")
       .def_readonly("settings_from", &io::FolderDiagnosis::settings_from)
       .def_readonly("wall_s", &io::FolderDiagnosis::wall_s, "The diagnosis alone, s.")
-      .def_property_readonly("verdict", [](const io::FolderDiagnosis& f) { return f.diagnosis.verdict; })
-      .def_property_readonly("chosen", [](const io::FolderDiagnosis& f) { return f.diagnosis.chosen; }, "The best effect (or \"A + B\").")
+      .def_property_readonly("verdict", [](const io::FolderDiagnosis& f) { return validation::verdict_text(f.diagnosis); })
+      .def_property_readonly("chosen", [](const io::FolderDiagnosis& f) { return validation::to_string(f.diagnosis.chosen); }, "The best effect (or \"A + B\").")
       .def_property_readonly("explained", [](const io::FolderDiagnosis& f) { return f.diagnosis.explained; })
       .def_property_readonly("gap_significant", [](const io::FolderDiagnosis& f) { return f.diagnosis.gap_significant; })
       .def_property_readonly("significant_runs", [](const io::FolderDiagnosis& f) { return f.diagnosis.significant_runs; }, "Runs whose gap exceeds significance_sigma.")

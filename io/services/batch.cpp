@@ -14,6 +14,7 @@
 #include "core/dispatch.hpp"
 #include "core/progress.hpp"
 #include "io/formats/output.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 #include "vrelab_version.hpp"
 
 namespace vrelab::io {
@@ -79,11 +80,11 @@ std::string diagnose_row(const std::string& dir, const DiagnoseOverrides& o) {
   const validation::Diagnosis& d = f.diagnosis;
   const validation::EffectFit* e = nullptr;
   for (const auto& x : d.effects)
-    if (x.name == d.chosen) e = &x;
+    if (d.chosen.names.size() == 1 && x.name == d.chosen.names.front()) e = &x;  // (a pair: no one parameter)
   const double shrink = d.rms_before_g > 0 ? 1 - d.rms_after_g / d.rms_before_g : 0.0;
   const double shrink_s = d.rms_before_sigma > 0 ? 1 - d.rms_after_sigma / d.rms_before_sigma : 0.0;
-  return fmt::format("{},{},{},{},{},{},{},{:.6g},{:.6g},{:.6e},{:.6e},{},{},{}", field(dir), field(d.verdict),
-                     field(d.chosen), field(e ? e->parameter : ""), e ? fmt::format("{:.6e}", e->value) : "",
+  return fmt::format("{},{},{},{},{},{},{},{:.6g},{:.6g},{:.6e},{:.6e},{},{},{}", field(dir), field(validation::verdict_text(d)),
+                     field(validation::to_string(d.chosen)), field(e ? e->parameter : ""), e ? fmt::format("{:.6e}", e->value) : "",
                      field(e ? e->unit : ""), e && !e->at_bound ? fmt::format("{:.3e}", e->sigma) : "", shrink, shrink_s,
                      d.rms_before_g, d.rms_after_g, d.significant_runs, d.runs.size(), field(f.settings_from));
 }

@@ -11,6 +11,7 @@
 #include "io/formats/output.hpp"
 #include "io/formats/settings_json.hpp"
 #include "rectification/measurement/vrc.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 
 namespace vrelab::io {
 
@@ -31,7 +32,7 @@ json parameters_json(const validation::EffectFit& e) {
               {"unit", q.unit},
               {"value", q.value},
               {"sigma", finite_or_null(q.sigma)},
-              {"status", q.status},
+              {"status", validation::to_string(q.status)},
               {"at_bound", q.at_bound},
               {"range", json::array({finite_or_null(q.lower), finite_or_null(q.upper)})}};
     if (!q.sign_identifiable) p["sign_identifiable"] = false;  // the value is a magnitude
@@ -135,11 +136,11 @@ json campaign_row(const validation::BlindCampaign& k) {
     row["top_parameter"] = k.diagnosis.effects.front().value;
     json tp = json::array();
     for (const auto& q : k.diagnosis.effects.front().parameters)
-      tp.push_back({{"name", q.name}, {"value", q.value}, {"sigma", std::isfinite(q.sigma) ? json(q.sigma) : json()}, {"status", q.status}});
+      tp.push_back({{"name", q.name}, {"value", q.value}, {"sigma", std::isfinite(q.sigma) ? json(q.sigma) : json()}, {"status", validation::to_string(q.status)}});
     row["top_parameters"] = tp;
     row["rms_before_g"] = k.diagnosis.rms_before_g, row["rms_after_g"] = k.diagnosis.rms_after_g;
     row["where"] = k.diagnosis.where;
-    row["verdict"] = k.diagnosis.verdict;
+    row["verdict"] = validation::verdict_text(k.diagnosis);
     row["nuisances"] = nuisances_json(k.diagnosis);
     row["ambiguous_with"] = k.diagnosis.ambiguous_with;
   } else {
@@ -218,8 +219,8 @@ json to_json(const validation::Diagnosis& d, const validation::Campaign& c) {
   json rms_z = json::object();
   for (const auto& [dir, z] : d.rms_z_by_direction) rms_z[dir] = z;
   return {{"gap_significant", d.gap_significant},
-          {"verdict", d.verdict},
-          {"chosen", d.chosen},
+          {"verdict", validation::verdict_text(d)},
+          {"chosen", validation::to_string(d.chosen)},
           {"pairs", pairs_json(d)},
           {"explained", d.explained},
           {"where", d.where},

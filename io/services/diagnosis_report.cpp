@@ -7,6 +7,7 @@
 #include "io/services/diagnosis_json.hpp"
 #include "io/formats/output.hpp"
 #include "io/formats/report.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 #include "vrelab_version.hpp"
 
 namespace vrelab::io {
@@ -25,14 +26,14 @@ void which_effect(Report& rep, const FolderDiagnosis& f) {
     rep.paragraph(fmt::format("No one effect explains the gap; the best with the two most promising seconds (ranked on "
                               "each fold's training runs), fitted together (additive to first order), a pair chosen "
                               "only when its evidence beats the best single effect's by {:.0f}:",
-                              std::pow(f.settings.significance_sigma, 2)));
+                              d.pair_evidence_margin));
     std::vector<std::vector<std::string>> prow = {{"pair", "parameters", "evidence", "held-out chi2"}};
     for (const auto& p : d.pairs)
       prow.push_back({p.a + " + " + p.b, fmt::format("{:.5g}, {:.5g}", p.pa, p.pb), fmt::format("{:.1f}", p.evidence),
                       fmt::format("{:.1f}", p.heldout_chi2)});
     rep.table(prow);
   }
-  rep.paragraph("Verdict: " + d.verdict + ".");
+  rep.paragraph("Verdict: " + validation::verdict_text(d) + ".");
 }
 
 // Section 3: the held-out shrinkage and the confirmation on the ODE plant.
@@ -41,13 +42,13 @@ void how_far(Report& rep, const validation::Diagnosis& d) {
       "On the held-out runs (each amplitude predicted from the others), the gap the static test's coefficient errors "
       "cannot take up has rms {:.4g} ug ({:.3g} sigma) with the nominal simulation and {:.4g} ug ({:.3g} sigma) with {} "
       "added: {:.0f} % removed.",
-      d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, d.chosen,
+      d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, validation::to_string(d.chosen),
       d.rms_before_g > 0 ? 100 * (1 - d.rms_after_g / d.rms_before_g) : 0.0));
   if (d.resimulated_runs > 0)
     rep.paragraph(fmt::format(
         "Confirmed on the ODE plant: the {} runs with the largest gaps re-simulated with the coefficients corrected by "
         "all runs under {} and the effect added leave rms {:.4g} ug; without the effect, {:.4g} ug.",
-        d.resimulated_runs, d.chosen, d.resimulated_rms_after_g * 1e6, d.resimulated_rms_before_g * 1e6));
+        d.resimulated_runs, validation::to_string(d.chosen), d.resimulated_rms_after_g * 1e6, d.resimulated_rms_before_g * 1e6));
 }
 
 }  // namespace

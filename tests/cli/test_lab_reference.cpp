@@ -24,6 +24,7 @@
 #include "support/files.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 #include "vibration/random.hpp"
 
 using namespace vrelab;
@@ -195,7 +196,7 @@ TEST(LabReferenceCampaign, TransverseMotionIsMeasuredNotFitted) {
   EXPECT_NE(std::find(d.measured_effects.begin(), d.measured_effects.end(), "shaker_transverse_motion"), d.measured_effects.end());
   for (const auto& e : d.effects) EXPECT_NE(e.name, "shaker_transverse_motion");
   // The measured motion predicts the transverse part's rectification: no gap left.
-  EXPECT_FALSE(d.gap_significant) << d.verdict << " max |z| " << d.max_abs_z;
+  EXPECT_FALSE(d.gap_significant) << verdict_text(d) << " max |z| " << d.max_abs_z;
 
   // The same campaign as summaries (no reference): the gap is there, and with two frequencies
   // an in-phase transverse motion is hard to tell from a tilted mounting or the cross terms
@@ -204,7 +205,7 @@ TEST(LabReferenceCampaign, TransverseMotionIsMeasuredNotFitted) {
   validation::Campaign summaries = c;
   for (auto& r : summaries.runs) r.motion.reset();
   const validation::Diagnosis ds = validation::diagnose(summaries, s);
-  EXPECT_TRUE(ds.gap_significant) << ds.verdict;
+  EXPECT_TRUE(ds.gap_significant) << verdict_text(ds);
   EXPECT_TRUE(ds.measured_effects.empty());
   EXPECT_EQ(ds.runs_with_measured_motion, 0);
 }
@@ -237,7 +238,7 @@ TEST(LabReferenceCampaign, MixedSineAndRandomCampaignIsDiagnosedToItsHiddenEffec
   s.resimulate_runs = 0;
   const validation::Diagnosis d = validation::diagnose(c, s);
   EXPECT_TRUE(d.gap_significant);
-  EXPECT_EQ(d.chosen, "pickoff_nonlinearity") << d.verdict;
+  EXPECT_EQ(to_string(d.chosen), "pickoff_nonlinearity") << verdict_text(d);
   ASSERT_FALSE(d.effects.empty());
   EXPECT_EQ(d.effects.front().name, "pickoff_nonlinearity");
   // The docs' figure: 15.015 +- 0.038 /rad against the truth's 15 (4 sigma).

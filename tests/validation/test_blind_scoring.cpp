@@ -20,6 +20,7 @@
 #include "support/small_design.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 
 using namespace vrelab;
 using namespace vrelab::validation;
@@ -143,9 +144,9 @@ TEST(BlindScoringCampaign, TheGapsHeldOutRmsWithoutTheNoiseIsTheNoiseFreeDiagnos
   const Campaign noisy = simulate_campaign(truth, {{"pickoff_nonlinearity", 0.5}}, small_design(), 9102, 2, {}, &noise_g);
   const Campaign quiet = without_noise(noisy, noise_g);
   const Diagnosis dn = diagnose(noisy, s), dq = diagnose(quiet, s);
-  ASSERT_EQ(dn.chosen, "pickoff_nonlinearity") << dn.verdict;
-  ASSERT_TRUE(dn.explained) << dn.verdict;
-  ASSERT_EQ(dq.chosen, "pickoff_nonlinearity") << dq.verdict;
+  ASSERT_EQ(to_string(dn.chosen), "pickoff_nonlinearity") << verdict_text(dn);
+  ASSERT_TRUE(dn.explained) << verdict_text(dn);
+  ASSERT_EQ(to_string(dq.chosen), "pickoff_nonlinearity") << verdict_text(dq);
   const std::vector<double> gap_g = heldout_nominal_gap_g(quiet, s);
   ASSERT_EQ(gap_g.size(), dq.runs.size());
   double largest = 0;
@@ -214,16 +215,17 @@ TEST(BlindScoring, SinglesAreScoredByTheGapAsTheLabSeesItTheOldSizeBeside) {
     k.diagnosis.effects = {e};
     k.top = e.name;
     k.called = "clean";
-    k.diagnosis.verdict = "no significant gap";
+    k.diagnosis.verdict = Verdict::no_significant_gap;
     k.effect_max_sigma = 40, k.effect_gap_sigma = 40;
     k.gap_rms_before_g = 1e-6, k.gap_rms_after_g = 0.5e-6;
     k.diagnosis.rms_before_g = 1e-6, k.diagnosis.rms_after_g = 0.7e-6;
     k.diagnosis.rms_before_sigma = 1, k.diagnosis.rms_after_sigma = 0.7;
     if (i == 9) k.effect_max_sigma = 55, k.effect_gap_sigma = 3, k.diagnosis.rms_after_g = 0.8e-6;
     if (i == 10 || i == 11) {
-      k.called = k.diagnosis.chosen = k.hidden[0].name;
+      k.called = k.hidden[0].name;
+      k.diagnosis.chosen.names = {k.hidden[0].name};
       k.diagnosis.explained = k.diagnosis.gap_significant = true;
-      k.diagnosis.verdict = "explained by " + k.hidden[0].name;
+      k.diagnosis.verdict = Verdict::explained;
     }
     if (i == 10) k.effect_max_sigma = 4, k.effect_gap_sigma = 8;
     if (i == 11) k.gap_rms_after_g = 0.1e-6, k.diagnosis.rms_after_g = 0.2e-6;

@@ -144,7 +144,7 @@ TEST(EffectFitter, OneParameterEqualsGeneralisedLeastSquares) {
   ASSERT_EQ(mf.values.size(), 1u);
   EXPECT_NEAR(mf.values[0], static_cast<double>(g.theta(0)), 1e-6 * sigma);
   EXPECT_NEAR(mf.sigma[0], sigma, 1e-6 * sigma);
-  EXPECT_EQ(mf.status[0], "fitted");
+  EXPECT_EQ(mf.status[0], ParameterStatus::fitted);
   // The same fit through fit(): the one-parameter path.
   const auto [value, s] = fitter.fit(p.data, p.all);
   EXPECT_EQ(value, mf.values[0]);
@@ -172,8 +172,8 @@ TEST(EffectFitter, TwoParametersEqualGeneralisedLeastSquaresWithThePrior) {
   const EffectFitter::Multi mf = fitter.fit_all(p.data, p.all);
   const Gls g = gls(p, {0, 1 / (static_cast<long double>(prior_sigma) * prior_sigma)}, {0, 0});
   ASSERT_EQ(mf.status.size(), 2u);
-  EXPECT_EQ(mf.status[0], "fitted");
-  EXPECT_EQ(mf.status[1], "fitted");
+  EXPECT_EQ(mf.status[0], ParameterStatus::fitted);
+  EXPECT_EQ(mf.status[1], ParameterStatus::fitted);
   ASSERT_EQ(mf.cov.rows(), 2);
   for (int j = 0; j < 2; ++j) {
     const double sj = std::sqrt(static_cast<double>(g.cov(j, j)));
@@ -219,7 +219,7 @@ TEST(EffectFitter, FindsTheOptimumOfANarrowValleyFromFarOff) {
   ASSERT_GT(objective(p0_start, 0) - objective(static_cast<double>(g.theta(0)), static_cast<double>(g.theta(1))), 100);
   const EffectFitter::Multi mf = fitter.fit_all(p.data, p.all);
   ASSERT_EQ(mf.status.size(), 2u);
-  EXPECT_EQ(mf.status[1], "fitted");
+  EXPECT_EQ(mf.status[1], ParameterStatus::fitted);
   EXPECT_NEAR(mf.values[0], static_cast<double>(g.theta(0)), 1e-3 * s0);
   EXPECT_NEAR(mf.values[1], static_cast<double>(g.theta(1)), 1e-3 * s1);
   EXPECT_NEAR(mf.sigma[1], s1, 1e-3 * s1);
@@ -275,7 +275,7 @@ TEST(EffectFitter, HoldsAParameterTheDataDoNotPin) {
     const EffectFitter fitter(e, p.nominal, model_of(p));
     const EffectFitter::Multi mf = fitter.fit_all(p.data, p.all);
     ASSERT_EQ(mf.status.size(), 2u);
-    EXPECT_EQ(mf.status[1], "held") << (collinear ? "collinear" : "loose");
+    EXPECT_EQ(mf.status[1], ParameterStatus::held) << (collinear ? "collinear" : "loose");
     EXPECT_EQ(mf.values[1], 0.0);
     EXPECT_TRUE(std::isnan(mf.sigma[1]));
     EXPECT_EQ(mf.cov.size(), 0);

@@ -14,6 +14,7 @@
 #include "support/instrument.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 
 using namespace vrelab;
 using namespace vrelab::validation;
@@ -49,25 +50,25 @@ void expect_within_3_sigma(const EffectFit& e, const std::vector<double>& truth_
   const Effect* registered = find_effect(e.name);
   ASSERT_NE(registered, nullptr) << e.name;
   ASSERT_EQ(registered->parameters.size(), e.parameters.size());
-  EXPECT_EQ(e.parameters.front().status, "fitted") << e.name << ": its size not fitted";
+  EXPECT_EQ(e.parameters.front().status, ParameterStatus::fitted) << e.name << ": its size not fitted";
   int judged = 0;
   for (std::size_t j = 0; j < truth_values.size(); ++j) {
     const FittedParameter& q = e.parameters[j];
-    std::printf("  %s %s: %s %.6g +- %.3g (truth %.6g)\n", e.name.c_str(), q.name.c_str(), q.status.c_str(), q.value, q.sigma,
+    std::printf("  %s %s: %s %.6g +- %.3g (truth %.6g)\n", e.name.c_str(), q.name.c_str(), to_string(q.status), q.value, q.sigma,
                 truth_values[j]);
-    SCOPED_TRACE(q.name + " " + q.status);
-    if (q.status == "fitted") {
+    SCOPED_TRACE(q.name + " " + to_string(q.status));
+    if (q.status == ParameterStatus::fitted) {
       ASSERT_TRUE(std::isfinite(q.sigma) && q.sigma > 0);
       double diff = q.value - truth_values[j];
       if (q.unit == "rad" && q.name.find("phase") != std::string::npos)
         diff = std::remainder(diff, 2 * std::numbers::pi);  // a phase: the nearest turn
       EXPECT_LE(std::abs(diff), 3 * q.sigma) << q.value << " +- " << q.sigma << " for " << truth_values[j];
       ++judged;
-    } else if (q.status == "chosen") {
+    } else if (q.status == ParameterStatus::chosen) {
       EXPECT_EQ(q.value, truth_values[j]);
       ++judged;
     } else {
-      EXPECT_EQ(q.status, "held");
+      EXPECT_EQ(q.status, ParameterStatus::held);
       EXPECT_EQ(q.value, registered->parameters[j].nominal) << "held, but not at its nominal";
     }
   }
@@ -87,11 +88,11 @@ TEST(NaturalFormCampaign, AModeAlongPaWithLowDampingIsFoundWithItsParameters) {
                                        51, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << d.verdict;
-  ASSERT_EQ(d.effects.front().name, "mechanical_mode") << d.verdict;
+  EXPECT_TRUE(d.explained) << verdict_text(d);
+  ASSERT_EQ(d.effects.front().name, "mechanical_mode") << verdict_text(d);
   const EffectFit& e = d.effects.front();
-  EXPECT_EQ(parameter(e, "axis").status, "chosen");
-  EXPECT_EQ(parameter(e, "damping_ratio").status, "fitted");
+  EXPECT_EQ(parameter(e, "axis").status, ParameterStatus::chosen);
+  EXPECT_EQ(parameter(e, "damping_ratio").status, ParameterStatus::fitted);
   expect_within_3_sigma(e, v);
 }
 
@@ -104,9 +105,9 @@ TEST(NaturalFormCampaign, ASecondHarmonicAtNinetyDegreesIsFoundWithItsPhase) {
                                        52, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << d.verdict;
-  ASSERT_EQ(d.effects.front().name, "shaker_harmonic_distortion") << d.verdict;
-  EXPECT_EQ(parameter(d.effects.front(), "second_harmonic_phase_rad").status, "fitted");
+  EXPECT_TRUE(d.explained) << verdict_text(d);
+  ASSERT_EQ(d.effects.front().name, "shaker_harmonic_distortion") << verdict_text(d);
+  EXPECT_EQ(parameter(d.effects.front(), "second_harmonic_phase_rad").status, ParameterStatus::fitted);
   expect_within_3_sigma(d.effects.front(), v);
 }
 
@@ -120,9 +121,9 @@ TEST(NaturalFormCampaign, AMisalignmentAboutPaAndOaIsFoundWithBothAngles) {
                                        53, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << d.verdict;
-  ASSERT_EQ(d.effects.front().name, "mounting_misalignment") << d.verdict;
-  EXPECT_EQ(parameter(d.effects.front(), "angle_about_PA_rad").status, "fitted");
+  EXPECT_TRUE(d.explained) << verdict_text(d);
+  ASSERT_EQ(d.effects.front().name, "mounting_misalignment") << verdict_text(d);
+  EXPECT_EQ(parameter(d.effects.front(), "angle_about_PA_rad").status, ParameterStatus::fitted);
   expect_within_3_sigma(d.effects.front(), v);
 }
 
@@ -135,16 +136,16 @@ TEST(NaturalFormCampaign, ACleanCampaignIsNotExplainedByTheRicherEffects) {
                                               {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(1, 1, 0).normalized()}),
                                        54, 2);
   const Diagnosis d = diagnose(c);
-  EXPECT_FALSE(d.gap_significant) << d.where << "; " << d.verdict;
-  EXPECT_FALSE(d.explained) << d.verdict;
+  EXPECT_FALSE(d.gap_significant) << d.where << "; " << verdict_text(d);
+  EXPECT_FALSE(d.explained) << verdict_text(d);
   // Every library effect is judged (none left out of the list, so none escapes the bound).
-  ASSERT_EQ(d.effects.size(), effect_library().size()) << d.verdict;
+  ASSERT_EQ(d.effects.size(), effect_library().size()) << verdict_text(d);
   for (const EffectFit& e : d.effects) {
     EXPECT_LT(e.evidence, 25) << e.name;
     // No discrete form chosen for an effect the runs do not see.
-    for (const FittedParameter& q : e.parameters) EXPECT_NE(q.status, "chosen") << e.name << " " << q.name;
+    for (const FittedParameter& q : e.parameters) EXPECT_NE(q.status, ParameterStatus::chosen) << e.name << " " << q.name;
     for (std::size_t j = 1; j < e.parameters.size(); ++j)
-      std::printf("  %s %s: %s %.6g (evidence %.2f)\n", e.name.c_str(), e.parameters[j].name.c_str(), e.parameters[j].status.c_str(),
+      std::printf("  %s %s: %s %.6g (evidence %.2f)\n", e.name.c_str(), e.parameters[j].name.c_str(), to_string(e.parameters[j].status),
                   e.parameters[j].value, e.evidence);
   }
   // The top effect's fitted parameters carry its held ones' spread over their ranges (the held
@@ -152,8 +153,8 @@ TEST(NaturalFormCampaign, ACleanCampaignIsNotExplainedByTheRicherEffects) {
   // one such parameter (fitted, a finite range, inside it) must be there to judge.
   int claims = 0;
   for (const FittedParameter& q : d.effects.front().parameters) {
-    std::printf("  top %s %s: %s %.6g +- %.3g\n", d.effects.front().name.c_str(), q.name.c_str(), q.status.c_str(), q.value, q.sigma);
-    if (q.status == "fitted" && std::isfinite(q.upper - q.lower) && !q.at_bound) {
+    std::printf("  top %s %s: %s %.6g +- %.3g\n", d.effects.front().name.c_str(), q.name.c_str(), to_string(q.status), q.value, q.sigma);
+    if (q.status == ParameterStatus::fitted && std::isfinite(q.upper - q.lower) && !q.at_bound) {
       EXPECT_LT(q.sigma, (q.upper - q.lower) / 2) << q.name;
       ++claims;
     }
@@ -174,10 +175,10 @@ TEST(NaturalFormCampaign, TransverseMotionOutOfPhaseOnTheOtherAxisIsFoundWithIts
                                        design({10, 100, 400, 800, 1500}, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}), 6010, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << d.verdict;
-  ASSERT_EQ(d.effects.front().name, "shaker_transverse_motion") << d.verdict;
-  EXPECT_EQ(parameter(d.effects.front(), "axis_cycle").status, "chosen");
-  EXPECT_EQ(parameter(d.effects.front(), "frequency_power").status, "fitted");
+  EXPECT_TRUE(d.explained) << verdict_text(d);
+  ASSERT_EQ(d.effects.front().name, "shaker_transverse_motion") << verdict_text(d);
+  EXPECT_EQ(parameter(d.effects.front(), "axis_cycle").status, ParameterStatus::chosen);
+  EXPECT_EQ(parameter(d.effects.front(), "frequency_power").status, ParameterStatus::fitted);
   expect_within_3_sigma(d.effects.front(), v);
 }
 
@@ -191,8 +192,8 @@ TEST(NaturalFormCampaign, RockingAboutPaIsFoundWithItsAxis) {
                                        design({10, 100, 400, 1000}, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}), 6011, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << d.verdict;
-  ASSERT_EQ(d.effects.front().name, "fixture_rocking") << d.verdict;
-  EXPECT_EQ(parameter(d.effects.front(), "axis").status, "chosen");
+  EXPECT_TRUE(d.explained) << verdict_text(d);
+  ASSERT_EQ(d.effects.front().name, "fixture_rocking") << verdict_text(d);
+  EXPECT_EQ(parameter(d.effects.front(), "axis").status, ParameterStatus::chosen);
   expect_within_3_sigma(d.effects.front(), v);
 }

@@ -18,6 +18,7 @@
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 
 using namespace vrelab;
 using namespace vrelab::validation;
@@ -49,13 +50,13 @@ Campaign campaign_off_manifest(const Departure& x, std::uint64_t seed) {
 }
 
 void print(const Diagnosis& d) {
-  std::printf("  verdict: %s\n", d.verdict.c_str());
+  std::printf("  verdict: %s\n", verdict_text(d).c_str());
   for (std::size_t i = 0; i < d.effects.size() && i < 3; ++i) {
     const EffectFit& e = d.effects[i];
     std::printf("  %-28s evidence %10.1f held-out chi2 %8.1f\n", e.name.c_str(), e.evidence, e.heldout_chi2);
     if (e.name == "servo_dynamics")
       for (const FittedParameter& q : e.parameters)
-        std::printf("    %-26s %-7s %.6g +- %.3g\n", q.name.c_str(), q.status.c_str(), q.value, q.sigma);
+        std::printf("    %-26s %-7s %.6g +- %.3g\n", q.name.c_str(), to_string(q.status), q.value, q.sigma);
   }
 }
 
@@ -66,20 +67,20 @@ void print(const Diagnosis& d) {
 void expect_loop_found(const Diagnosis& d, const Departure& x) {
   print(d);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << d.verdict;
-  EXPECT_TRUE(d.ambiguous_with.empty()) << d.verdict;
-  EXPECT_EQ(d.chosen, "servo_dynamics") << d.verdict;
-  ASSERT_EQ(d.effects.front().name, "servo_dynamics") << d.verdict;
+  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.ambiguous_with.empty()) << verdict_text(d);
+  EXPECT_EQ(to_string(d.chosen), "servo_dynamics") << verdict_text(d);
+  ASSERT_EQ(d.effects.front().name, "servo_dynamics") << verdict_text(d);
   const std::vector<double> truth = x.values();
   const std::vector<FittedParameter>& ps = d.effects.front().parameters;
   ASSERT_EQ(ps.size(), truth.size());
   for (std::size_t j = 0; j < ps.size(); ++j) {
-    SCOPED_TRACE(ps[j].name + " " + ps[j].status);
-    if (ps[j].status == "fitted") {
+    SCOPED_TRACE(ps[j].name + " " + to_string(ps[j].status));
+    if (ps[j].status == ParameterStatus::fitted) {
       ASSERT_TRUE(std::isfinite(ps[j].sigma) && ps[j].sigma > 0);
       EXPECT_LE(std::abs(ps[j].value - truth[j]), 3 * ps[j].sigma) << ps[j].value << " +- " << ps[j].sigma << " for " << truth[j];
     } else {
-      EXPECT_EQ(ps[j].status, "held");
+      EXPECT_EQ(ps[j].status, ParameterStatus::held);
       EXPECT_EQ(ps[j].value, find_effect("servo_dynamics")->parameters[j].nominal);
     }
   }
@@ -142,9 +143,10 @@ TEST(LoopDynamics, BlindScoresDynamicsOffByEveryFittedParameter) {
       k.called = "clean";
       if (i == kIndex) {
         Diagnosis& d = k.diagnosis;
-        d.gap_significant = true, d.explained = called != "unexplained", d.chosen = d.explained ? called : "";
+        d.gap_significant = true, d.explained = called != "unexplained";
+        if (d.explained) d.chosen.names = {called};
         d.ambiguous_with = std::move(ambiguous);
-        d.verdict = d.explained ? "explained by " + called : "not explained by any known effect";
+        d.verdict = !d.explained ? Verdict::not_explained : d.ambiguous_with.empty() ? Verdict::explained : Verdict::ambiguous;
         EffectFit e;
         e.name = called == "unexplained" ? "servo_dynamics" : called;
         e.value = ps.empty() ? 0 : ps.front().value;
@@ -156,38 +158,38 @@ TEST(LoopDynamics, BlindScoresDynamicsOffByEveryFittedParameter) {
     }
     return run_blind(s, {}, done, {}).scores.families.at("dynamics_off");
   };
-  const auto q = [](const char* name, double value, double sigma, const char* status) {
+  const auto q = [](const char* name, double value, double sigma, ParameterStatus status) {
     FittedParameter p;
     p.name = name, p.value = value, p.sigma = sigma, p.status = status;
     return p;
   };
   // Within 3 sigma (2 sigma each): right.
-  FamilyScore f = score("servo_dynamics", {q("bandwidth_ratio", crossover + 0.002, 0.001, "fitted"),
-                                           q("phase_margin_change_deg", margin - 0.1, 0.05, "fitted"),
-                                           q("pendulum_frequency_ratio", pendulum + 0.02, 0.01, "fitted")});
+  FamilyScore f = score("servo_dynamics", {q("bandwidth_ratio", crossover + 0.002, 0.001, ParameterStatus::fitted),
+                                           q("phase_margin_change_deg", margin - 0.1, 0.05, ParameterStatus::fitted),
+                                           q("pendulum_frequency_ratio", pendulum + 0.02, 0.01, ParameterStatus::fitted)});
   EXPECT_EQ(f.n, 1);
   EXPECT_EQ(f.right, 1);
   // The pendulum held at its nominal (not judged, whatever the truth): right.
-  f = score("servo_dynamics", {q("bandwidth_ratio", crossover, 0.001, "fitted"), q("phase_margin_change_deg", margin, 0.05, "fitted"),
-                               q("pendulum_frequency_ratio", 1, NAN, "held")});
+  f = score("servo_dynamics", {q("bandwidth_ratio", crossover, 0.001, ParameterStatus::fitted), q("phase_margin_change_deg", margin, 0.05, ParameterStatus::fitted),
+                               q("pendulum_frequency_ratio", 1, NAN, ParameterStatus::held)});
   EXPECT_EQ(f.right, 1);
   // The margin 4 sigma off: the right effect, a parameter beyond 3 sigma.
-  f = score("servo_dynamics", {q("bandwidth_ratio", crossover, 0.001, "fitted"),
-                               q("phase_margin_change_deg", margin + 0.2, 0.05, "fitted"),
-                               q("pendulum_frequency_ratio", 1, NAN, "held")});
+  f = score("servo_dynamics", {q("bandwidth_ratio", crossover, 0.001, ParameterStatus::fitted),
+                               q("phase_margin_change_deg", margin + 0.2, 0.05, ParameterStatus::fitted),
+                               q("pendulum_frequency_ratio", 1, NAN, ParameterStatus::held)});
   EXPECT_EQ(f.right, 0);
   EXPECT_EQ(f.parameters_off, 1);
   // The truth's crossover on the manifest's side (the ratio the wrong way round): off.
-  f = score("servo_dynamics", {q("bandwidth_ratio", 1 / crossover, 0.001, "fitted"),
-                               q("phase_margin_change_deg", margin, 0.05, "fitted"),
-                               q("pendulum_frequency_ratio", 1, NAN, "held")});
+  f = score("servo_dynamics", {q("bandwidth_ratio", 1 / crossover, 0.001, ParameterStatus::fitted),
+                               q("phase_margin_change_deg", margin, 0.05, ParameterStatus::fitted),
+                               q("pendulum_frequency_ratio", 1, NAN, ParameterStatus::held)});
   EXPECT_EQ(f.parameters_off, 1);
   // Another physics: confidently wrong; nothing: unexplained; an ambiguity with it: among.
-  f = score("pickoff_nonlinearity", {q("p2", 12, 0.1, "fitted")});
+  f = score("pickoff_nonlinearity", {q("p2", 12, 0.1, ParameterStatus::fitted)});
   EXPECT_EQ(f.wrong, 1);
   f = score("unexplained", {});
   EXPECT_EQ(f.unexplained, 1);
-  f = score("servo_dynamics", {q("bandwidth_ratio", crossover, 0.001, "fitted")}, {"servo_dynamics", "mechanical_mode"});
+  f = score("servo_dynamics", {q("bandwidth_ratio", crossover, 0.001, ParameterStatus::fitted)}, {"servo_dynamics", "mechanical_mode"});
   EXPECT_EQ(f.ambiguous, 1);
   EXPECT_EQ(f.right_among, 1);
 }
@@ -216,7 +218,7 @@ TEST(LoopDynamicsCampaign, ASingleServoChangeIsCalledServoDynamics) {
 TEST(LoopDynamicsCampaign, AManifestThatIsRightGivesNoGap) {
   const Diagnosis d = diagnose(campaign_off_manifest({}, 6153));
   print(d);
-  EXPECT_FALSE(d.gap_significant) << d.verdict;
+  EXPECT_FALSE(d.gap_significant) << verdict_text(d);
   // servo_dynamics is in the library: the diagnosis must have fitted and judged it.
   const auto servo = std::find_if(d.effects.begin(), d.effects.end(), [](const EffectFit& e) { return e.name == "servo_dynamics"; });
   ASSERT_NE(servo, d.effects.end()) << "servo_dynamics is not among the " << d.effects.size() << " effects judged";

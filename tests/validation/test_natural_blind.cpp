@@ -78,12 +78,12 @@ TEST(NaturalBlind, TheDrawHasNaturalFormsAndSeveralOutOfLibraryEffects) {
   EXPECT_GE(ool.size(), 3u);
 }
 
-Diagnosis fitted_mode(double f, double f_sigma, double zeta, const std::string& zeta_status, double axis) {
+Diagnosis fitted_mode(double f, double f_sigma, double zeta, ParameterStatus zeta_status, double axis) {
   Diagnosis d;
   EffectFit e;
   e.name = "mechanical_mode";
-  e.parameters = {{"frequency_Hz", "Hz", f, f_sigma, "fitted"}, {"damping_ratio", "1", zeta, 0.001, zeta_status},
-                  {"axis", "0 IA, 1 PA, 2 OA", axis, NAN, "chosen"}};
+  e.parameters = {{"frequency_Hz", "Hz", f, f_sigma, ParameterStatus::fitted}, {"damping_ratio", "1", zeta, 0.001, zeta_status},
+                  {"axis", "0 IA, 1 PA, 2 OA", axis, NAN, ParameterStatus::chosen}};
   d.effects = {e};
   return d;
 }
@@ -93,26 +93,26 @@ Diagnosis fitted_mode(double f, double f_sigma, double zeta, const std::string& 
 TEST(NaturalBlind, ParametersAreScoredWithinThreeSigma) {
   const HiddenEffect mode("mechanical_mode", 800, {0.03, 1});
   std::string why;
-  EXPECT_TRUE(parameters_match(mode, fitted_mode(800.2, 0.1, 0.031, "fitted", 1), &why)) << why;
-  EXPECT_FALSE(parameters_match(mode, fitted_mode(800.4, 0.1, 0.031, "fitted", 1), &why));
+  EXPECT_TRUE(parameters_match(mode, fitted_mode(800.2, 0.1, 0.031, ParameterStatus::fitted, 1), &why)) << why;
+  EXPECT_FALSE(parameters_match(mode, fitted_mode(800.4, 0.1, 0.031, ParameterStatus::fitted, 1), &why));
   EXPECT_NE(why.find("frequency_Hz"), std::string::npos) << why;
-  EXPECT_FALSE(parameters_match(mode, fitted_mode(800.2, 0.1, 0.034, "fitted", 1), &why));
-  EXPECT_TRUE(parameters_match(mode, fitted_mode(800.2, 0.1, 0.05, "held", 1), &why));
+  EXPECT_FALSE(parameters_match(mode, fitted_mode(800.2, 0.1, 0.034, ParameterStatus::fitted, 1), &why));
+  EXPECT_TRUE(parameters_match(mode, fitted_mode(800.2, 0.1, 0.05, ParameterStatus::held, 1), &why));
   EXPECT_NE(why.find("damping_ratio held"), std::string::npos) << why;
-  EXPECT_FALSE(parameters_match(mode, fitted_mode(800.2, 0.1, 0.031, "fitted", 0), &why));
-  EXPECT_FALSE(parameters_match(HiddenEffect("servo_dynamics", 0.8), fitted_mode(800, 0.1, 0.03, "fitted", 1), &why));
+  EXPECT_FALSE(parameters_match(mode, fitted_mode(800.2, 0.1, 0.031, ParameterStatus::fitted, 0), &why));
+  EXPECT_FALSE(parameters_match(HiddenEffect("servo_dynamics", 0.8), fitted_mode(800, 0.1, 0.03, ParameterStatus::fitted, 1), &why));
   // A phase of 3.1 rad fitted as -3.1 +- 0.05 is 0.083 rad away, within 3 sigma.
   Diagnosis h;
   EffectFit e;
   e.name = "shaker_harmonic_distortion";
-  e.parameters = {{"second_harmonic_ratio", "1", 0.2, 0.01, "fitted"}, {"second_harmonic_phase_rad", "rad", -3.1, 0.05, "fitted"}};
+  e.parameters = {{"second_harmonic_ratio", "1", 0.2, 0.01, ParameterStatus::fitted}, {"second_harmonic_phase_rad", "rad", -3.1, 0.05, ParameterStatus::fitted}};
   h.effects = {e};
   EXPECT_TRUE(parameters_match(HiddenEffect("shaker_harmonic_distortion", 0.21, {3.1}), h, &why)) << why;
   h.effects[0].parameters[1].value = 2.9;
   EXPECT_FALSE(parameters_match(HiddenEffect("shaker_harmonic_distortion", 0.21, {3.1}), h, &why));
   // A phase +- 1.1 rad (3 sigma over pi: within 3 sigma of any truth) claims nothing: not
   // judged, said as not pinned; +- 1.0 rad (3 sigma under pi) is judged, 3.1 rad off: wrong.
-  h.effects[0].parameters[1] = {"second_harmonic_phase_rad", "rad", 0.0, 1.1, "fitted"};
+  h.effects[0].parameters[1] = {"second_harmonic_phase_rad", "rad", 0.0, 1.1, ParameterStatus::fitted};
   EXPECT_TRUE(parameters_match(HiddenEffect("shaker_harmonic_distortion", 0.21, {3.1}), h, &why)) << why;
   EXPECT_NE(why.find("second_harmonic_phase_rad not pinned"), std::string::npos) << why;
   h.effects[0].parameters[1].sigma = 1.0;
@@ -123,7 +123,7 @@ TEST(NaturalBlind, ParametersAreScoredWithinThreeSigma) {
 TEST(NaturalBlind, TheResultLineCarriesTheTopEffectsParameters) {
   BlindCampaign k;
   k.called = "mechanical_mode", k.top = "mechanical_mode";
-  k.diagnosis = fitted_mode(812.25, 0.125, 0.05, "held", 2);
+  k.diagnosis = fitted_mode(812.25, 0.125, 0.05, ParameterStatus::held, 2);
   k.diagnosis.effects[0].value = 812.25;
   k.diagnosis.effects[0].parameters[0].at_bound = true;
   BlindCampaign back;
@@ -134,7 +134,7 @@ TEST(NaturalBlind, TheResultLineCarriesTheTopEffectsParameters) {
   EXPECT_EQ(p[0].value, 812.25);
   EXPECT_EQ(p[0].sigma, 0.125);
   EXPECT_TRUE(p[0].at_bound);
-  EXPECT_EQ(p[1].status, "held");
+  EXPECT_EQ(p[1].status, ParameterStatus::held);
   EXPECT_EQ(p[2].name, "axis");
   EXPECT_EQ(p[2].value, 2);
   EXPECT_TRUE(std::isnan(p[2].sigma));

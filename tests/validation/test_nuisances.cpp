@@ -18,6 +18,7 @@
 #include "support/small_design.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 
 using namespace vrelab;
 using namespace vrelab::validation;
@@ -75,9 +76,9 @@ TEST(NuisancesCampaign, ADriftIsEstimatedFromTheRestReadingsRemovedAndNotCalledA
   for (const auto& r : c.runs) stt += (r.time_h - tm) * (r.time_h - tm);
   EXPECT_NEAR(x->sigma, 0.3 / std::sqrt(stt), 0.3 * 0.3 / std::sqrt(stt));
   EXPECT_NEAR(x->value, 2.0, 3 * x->sigma);
-  EXPECT_FALSE(d.explained) << d.verdict;
-  EXPECT_FALSE(d.gap_significant) << d.verdict;
-  EXPECT_NE(d.verdict.find("bias drift"), std::string::npos) << d.verdict;
+  EXPECT_FALSE(d.explained) << verdict_text(d);
+  EXPECT_FALSE(d.gap_significant) << verdict_text(d);
+  EXPECT_NE(verdict_text(d).find("bias drift"), std::string::npos) << verdict_text(d);
   // The same drift without the rest readings is a gap the diagnosis sees (the test can fail).
   const Diagnosis blind_to_it = diagnose(with_drift(2e-6, 0.3e-6, false));
   EXPECT_TRUE(blind_to_it.gap_significant);
@@ -93,11 +94,11 @@ TEST(NuisancesCampaign, AStatedSigmaTooSmallIsFlaggedAndTheGapJudgedWithTheCorre
   const Diagnosis d = diagnose(c);
   const Nuisance* x = d.nuisance("sigma_scale");
   ASSERT_NE(x, nullptr);
-  EXPECT_TRUE(x->applied) << d.verdict << "; " << x->note;
+  EXPECT_TRUE(x->applied) << verdict_text(d) << "; " << x->note;
   // k from 36 gaps: sigma ~ k / sqrt(72) = 0.3; allow 3 of it.
   EXPECT_NEAR(x->value, 2.5, 3 * x->sigma) << x->note;
-  EXPECT_FALSE(d.explained) << d.verdict;
-  EXPECT_NE(d.verdict.find("sigma understated"), std::string::npos) << d.verdict;
+  EXPECT_FALSE(d.explained) << verdict_text(d);
+  EXPECT_NE(verdict_text(d).find("sigma understated"), std::string::npos) << verdict_text(d);
   // Unscaled, the clean campaign is not flagged.
   const Diagnosis clean = diagnose(clean_campaign());
   EXPECT_FALSE(clean.nuisance("sigma_scale")->applied);
@@ -147,12 +148,12 @@ TEST(NuisancesCampaign, ASqueezeFilmWithTheStatedSigmaRightIsNotCalledSigmaUnder
   const Diagnosis d = diagnose(c);
   const Nuisance* x = d.nuisance("sigma_scale");
   ASSERT_NE(x, nullptr);
-  std::printf("verdict: %s\nsigma_scale: %.3f +- %.3f, applied %d; %s\nbest: %s evidence %.1f\n", d.verdict.c_str(), x->value,
+  std::printf("verdict: %s\nsigma_scale: %.3f +- %.3f, applied %d; %s\nbest: %s evidence %.1f\n", verdict_text(d).c_str(), x->value,
               x->sigma, x->applied ? 1 : 0, x->note.c_str(), d.effects.empty() ? "-" : d.effects[0].name.c_str(),
               d.effects.empty() ? 0.0 : d.effects[0].evidence);
-  EXPECT_FALSE(x->applied) << d.verdict << "; " << x->note;
-  EXPECT_EQ(d.verdict.find("sigma understated"), std::string::npos) << d.verdict;
-  EXPECT_TRUE(d.gap_significant) << d.verdict;  // the film is seen (the test can fail)
+  EXPECT_FALSE(x->applied) << verdict_text(d) << "; " << x->note;
+  EXPECT_EQ(verdict_text(d).find("sigma understated"), std::string::npos) << verdict_text(d);
+  EXPECT_TRUE(d.gap_significant) << verdict_text(d);  // the film is seen (the test can fail)
 }
 
 // The drift test's false-alarm rate, by Monte Carlo: rest readings that are independent normal

@@ -17,6 +17,7 @@
 #include "support/small_design.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 
 using namespace vrelab;
 using namespace vrelab::validation;
@@ -68,10 +69,10 @@ TEST(NuisancesBlindCampaign, ADriftAtBlindsLowerEndIsReportedWhateverTheGapsVerd
     const Diagnosis d = diagnose(lab_campaign(9000, 9001, 1.0, drift_ug_per_h * 1e-6));
     const Nuisance* x = d.nuisance("bias_drift");
     ASSERT_NE(x, nullptr);
-    EXPECT_TRUE(x->significant) << x->value << " +- " << x->sigma << "; " << d.verdict;
+    EXPECT_TRUE(x->significant) << x->value << " +- " << x->sigma << "; " << verdict_text(d);
     EXPECT_NEAR(x->value, drift_ug_per_h, 3 * x->sigma);
-    EXPECT_FALSE(d.explained) << d.verdict;
-    EXPECT_NE(d.verdict.find("bias drift"), std::string::npos) << d.verdict;
+    EXPECT_FALSE(d.explained) << verdict_text(d);
+    EXPECT_NE(verdict_text(d).find("bias drift"), std::string::npos) << verdict_text(d);
     // Not a nuisance it is not.
     EXPECT_FALSE(d.nuisance("sigma_scale")->significant) << d.nuisance("sigma_scale")->note;
   }
@@ -87,10 +88,10 @@ TEST(NuisancesBlindCampaign, AnUnderstatedSigmaIsFlaggedWhateverTheGapsVerdict) 
     const Diagnosis d = diagnose(lab_campaign(9002, 9003, k, 0));
     const Nuisance* x = d.nuisance("sigma_scale");
     ASSERT_NE(x, nullptr);
-    EXPECT_TRUE(x->significant && x->applied) << k << ": " << x->value << "; " << x->note << "; " << d.verdict;
+    EXPECT_TRUE(x->significant && x->applied) << k << ": " << x->value << "; " << x->note << "; " << verdict_text(d);
     EXPECT_NEAR(x->value, k, 3 * x->sigma) << x->note;
-    EXPECT_FALSE(d.explained) << d.verdict;
-    EXPECT_NE(d.verdict.find("sigma understated"), std::string::npos) << d.verdict;
+    EXPECT_FALSE(d.explained) << verdict_text(d);
+    EXPECT_NE(verdict_text(d).find("sigma understated"), std::string::npos) << verdict_text(d);
     EXPECT_FALSE(d.nuisance("bias_drift")->significant);
   }
 }
@@ -118,19 +119,20 @@ TEST(NuisancesBlindCampaign, CleanCampaignsFlagNoNuisance) {
         EXPECT_FALSE(x.significant) << "truth " << seed << " draw " << draw << ": " << x.name << " " << x.value << " +- " << x.sigma
                                     << "; " << x.note;
       }
-      EXPECT_FALSE(d.gap_significant) << d.verdict;
+      EXPECT_FALSE(d.gap_significant) << verdict_text(d);
     }
   EXPECT_EQ(judged, 2 * 10);
   EXPECT_EQ(flagged, 0);
 }
 
 // The result line of a blind campaign (what a thread or an MPI rank hands to the scoring)
-// carries the verdict, the ambiguity and every nuisance with its significance.
+// carries the verdict, the ambiguity and every nuisance with its significance; the verdict in
+// words read back is what was written (the nuisances applied said after it).
 TEST(NuisanceTransport, BlindResultLineCarriesTheVerdictAmbiguityAndNuisances) {
   BlindCampaign k;
   k.called = "clean", k.top = "pickoff_nonlinearity";
   Diagnosis& d = k.diagnosis;
-  d.verdict = "no significant gap (sigma understated x2.21;\tjudged with the corrected sigma)";
+  d.verdict = Verdict::no_significant_gap;
   d.ambiguous_with = {"servo_dynamics", "nonlinearity_at_input"};
   EffectFit e;
   e.name = "pickoff_nonlinearity", e.value = 0.125;
@@ -140,10 +142,12 @@ TEST(NuisanceTransport, BlindResultLineCarriesTheVerdictAmbiguityAndNuisances) {
   drift.estimated = drift.applied = drift.significant = true, drift.note = "the rest readings' line\nover 168 runs";
   Nuisance scale;
   scale.name = "sigma_scale", scale.unit = "1", scale.value = 2.21, scale.sigma = NAN, scale.estimated = true;
+  scale.note = "from the gaps;\tnot applied";
   d.nuisances = {drift, scale};
   BlindCampaign back;
   read_campaign_result(campaign_result_text(k), back);
   EXPECT_EQ(back.diagnosis.verdict, d.verdict);
+  EXPECT_EQ(verdict_text(back.diagnosis), "no significant gap (bias drift -0.595 +- 0.0096 ug/h removed)");
   EXPECT_EQ(back.diagnosis.ambiguous_with, d.ambiguous_with);
   ASSERT_EQ(back.diagnosis.nuisances.size(), 2u);
   const Nuisance* x = back.diagnosis.nuisance("bias_drift");
@@ -157,6 +161,7 @@ TEST(NuisanceTransport, BlindResultLineCarriesTheVerdictAmbiguityAndNuisances) {
   ASSERT_NE(y, nullptr);
   EXPECT_TRUE(std::isnan(y->sigma));
   EXPECT_FALSE(y->applied || y->significant);
+  EXPECT_EQ(y->note, scale.note);
   EXPECT_EQ(back.top, "pickoff_nonlinearity");
   // A line cut short is refused, not read as fewer nuisances.
   test::expect_refused_not_outdated(test::cut_before_gap(campaign_result_text(k)), "a line cut short");

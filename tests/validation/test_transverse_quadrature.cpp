@@ -24,6 +24,7 @@
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/effect.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 
 using namespace vrelab;
 using namespace vrelab::validation;
@@ -174,17 +175,17 @@ TEST(TransverseQuadrature, BlindComparesTheMagnitudes) {
   Diagnosis d;
   EffectFit e;
   e.name = "shaker_transverse_motion";
-  e.parameters = {{"ratio_at_1kHz", "1", 0.051, 0.002, "fitted"},
-                  {"quadrature_ratio_at_1kHz", "1", 0.041, 0.005, "fitted"},
-                  {"frequency_power", "1", 1.25, 0.1, "fitted"},
-                  {"axis_cycle", "0 next, 1 other", 1, NAN, "chosen"}};
+  e.parameters = {{"ratio_at_1kHz", "1", 0.051, 0.002, ParameterStatus::fitted},
+                  {"quadrature_ratio_at_1kHz", "1", 0.041, 0.005, ParameterStatus::fitted},
+                  {"frequency_power", "1", 1.25, 0.1, ParameterStatus::fitted},
+                  {"axis_cycle", "0 next, 1 other", 1, NAN, ParameterStatus::chosen}};
   d.effects = {e};
   std::string why;
   EXPECT_TRUE(parameters_match(truth, d, &why)) << why;
   d.effects[0].parameters[1].value = 0.08;
   EXPECT_FALSE(parameters_match(truth, d, &why));
   EXPECT_NE(why.find("magnitudes compared"), std::string::npos) << why;
-  d.effects[0].parameters[1] = {"quadrature_ratio_at_1kHz", "1", 0, NAN, "held"};
+  d.effects[0].parameters[1] = {"quadrature_ratio_at_1kHz", "1", 0, NAN, ParameterStatus::held};
   EXPECT_TRUE(parameters_match(truth, d, &why)) << why;
 }
 
@@ -200,12 +201,12 @@ TEST(NaturalMissesCampaign, ATransverseQuadraturesSizeIsJudgedNotItsSign) {
   ASSERT_EQ(k.category, "natural");
   ASSERT_EQ(k.hidden.at(0).name, "shaker_transverse_motion");
   const Diagnosis& d = k.diagnosis;
-  std::printf("  %s\n", d.verdict.c_str());
+  std::printf("  %s\n", verdict_text(d).c_str());
   ASSERT_EQ(d.effects.front().name, "shaker_transverse_motion");
   const FittedParameter& q = d.effects.front().parameters.at(quadrature_index());
   const double truth = k.hidden[0].form.at(0);
-  std::printf("  quadrature %.4f +- %.4f (%s; truth %.4f)\n", q.value, q.sigma, q.status.c_str(), truth);
-  EXPECT_EQ(q.status, "fitted");
+  std::printf("  quadrature %.4f +- %.4f (%s; truth %.4f)\n", q.value, q.sigma, to_string(q.status), truth);
+  EXPECT_EQ(q.status, ParameterStatus::fitted);
   EXPECT_GE(q.value, 0.0);
   EXPECT_LE(std::abs(q.value - std::abs(truth)), 3 * q.sigma);
   EXPECT_EQ(r.scores.families.at("natural").right, 1);

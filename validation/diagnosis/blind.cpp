@@ -13,6 +13,7 @@
 
 #include "core/dispatch.hpp"
 #include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 
 namespace vrelab::validation {
 namespace {
@@ -168,7 +169,7 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
   k.called = !k.error.empty()           ? "error"
              : !d.ambiguous_with.empty() ? "ambiguous"
              : !d.gap_significant        ? "clean"
-             : d.explained               ? d.chosen
+             : d.explained               ? to_string(d.chosen)
                                          : "unexplained";
   k.top = k.error.empty() && d.effects.front().not_ranked.empty() ? d.effects.front().name : "";
 }
@@ -209,16 +210,16 @@ bool match_parameters(const HiddenEffect& h, const Diagnosis& d, std::string* of
     if (!e->parameters[i].sign_identifiable) diff = std::abs(q.value) - std::abs(truth[i]);
     if (e->parameters[i].discrete) {  // held at its nominal or chosen, it is a claim (the mode's axis)
       if (diff != 0) {
-        *off = fmt::format("{} {} {:.4g}, truth {:.4g}", q.name, q.status, q.value, truth[i]);
+        *off = fmt::format("{} {} {:.4g}, truth {:.4g}", q.name, to_string(q.status), q.value, truth[i]);
         return false;
       }
-    } else if (q.status == "held" || (e->parameters[i].periodic && !(3 * q.sigma < std::numbers::pi))) {
+    } else if (q.status == ParameterStatus::held || (e->parameters[i].periodic && !(3 * q.sigma < std::numbers::pi))) {
       // A phase with 3 sigma over half the circle claims nothing: not judged, said (as held).
-      held += q.status == "held"
+      held += q.status == ParameterStatus::held
                   ? fmt::format("{}{} held at {:.4g} (truth {:.4g})", held.empty() ? "" : ", ", q.name, q.value, truth[i])
                   : fmt::format("{}{} not pinned: {:.4g} +- {:.2g} (truth {:.4g})", held.empty() ? "" : ", ", q.name,
                                 q.value, q.sigma, truth[i]);
-    } else if (q.status == "chosen") {
+    } else if (q.status == ParameterStatus::chosen) {
       if (diff != 0) {
         *off = fmt::format("{} chosen {:.4g}, truth {:.4g}", q.name, q.value, truth[i]);
         return false;
@@ -275,7 +276,7 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
                        k.manifest_pendulum_ratio, k.manifest_margin_offset_deg);
   if (k.category == "drift") key += fmt::format(" ({:.3g} ug/h)", k.drift_g_per_h * 1e6);
   const std::string why = fmt::format("[{}] campaign {} (seed {}): {}; called \"{}\" (top {})", k.category, k.index, k.seed, key,
-                                      d.verdict, k.top);
+                                      verdict_text(d), k.top);
   if (!d.ambiguous_with.empty()) {
     ++f.ambiguous;
     const bool among = std::any_of(d.ambiguous_with.begin(), d.ambiguous_with.end(), is_truth);
@@ -284,13 +285,7 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
     return;
   }
   // What was called: the effects of an "explained" verdict.
-  std::vector<std::string> called;
-  if (d.explained) {
-    const std::string& c = d.chosen;
-    const auto plus = c.find(" + ");
-    if (plus == std::string::npos) called = {c};
-    else called = {c.substr(0, plus), c.substr(plus + 3)};
-  }
+  const std::vector<std::string> called = d.explained ? d.chosen.names : std::vector<std::string>{};
   const Nuisance* scale = d.nuisance("sigma_scale");
   const Nuisance* drift = d.nuisance("bias_drift");
   bool right = false, family = false;
@@ -505,11 +500,10 @@ std::string campaign_result_text(const BlindCampaign& k) {
                               k.simulate_s, k.wall_s, k.effect_max_sigma, d.gap_significant ? 1 : 0, d.explained ? 1 : 0,
                               d.rms_before_g, d.rms_after_g, d.rms_before_sigma, d.rms_after_sigma,
                               has_top ? d.effects.front().value : 0.0);
-  for (const std::string* x : {&k.error, &k.called, &k.top, &d.chosen, &d.where})
-    t.append("\t").append(escaped(*x));
+  for (const std::string& x : {k.error, k.called, k.top, to_string(d.chosen), d.where}) t.append("\t").append(escaped(x));
   t.append("\t").append(escaped(has_top ? d.effects.front().name : std::string()));
   t.append(has_top ? "\t1" : "\t0");
-  t.append("\t").append(escaped(d.verdict));
+  t.append("\t").append(escaped(verdict_text(d)));
   t.append(fmt::format("\t{}", d.ambiguous_with.size()));
   for (const std::string& a : d.ambiguous_with) t.append("\t").append(escaped(a));
   t.append(fmt::format("\t{}", d.nuisances.size()));
@@ -520,7 +514,7 @@ std::string campaign_result_text(const BlindCampaign& k) {
   const std::vector<FittedParameter>& ps = has_top ? d.effects.front().parameters : none;
   t.append(fmt::format("\t{}", ps.size()));
   for (const FittedParameter& q : ps)
-    t.append(fmt::format("\t{}\t{}\t{:.17g}\t{:.17g}\t{}\t{:d}", escaped(q.name), escaped(q.unit), q.value, q.sigma, escaped(q.status),
+    t.append(fmt::format("\t{}\t{}\t{:.17g}\t{:.17g}\t{}\t{:d}", escaped(q.name), escaped(q.unit), q.value, q.sigma, to_string(q.status),
                          q.at_bound ? 1 : 0));
   t.append(fmt::format("\tgap\t{:.17g}\t{:.17g}\t{:.17g}", k.effect_gap_sigma, k.gap_rms_before_g, k.gap_rms_after_g));
   return t;
@@ -560,7 +554,12 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
   d.gap_significant = f[3] == "1", d.explained = f[4] == "1";
   d.rms_before_g = num(5), d.rms_after_g = num(6), d.rms_before_sigma = num(7), d.rms_after_sigma = num(8);
   k.error = unescaped(f[10]), k.called = unescaped(f[11]), k.top = unescaped(f[12]);
-  d.chosen = unescaped(f[13]), d.where = unescaped(f[14]);
+  try {
+    d.chosen = chosen_from_text(unescaped(f[13]));
+  } catch (const std::invalid_argument& e) {
+    throw bad(e.what());
+  }
+  d.where = unescaped(f[14]);
   d.effects.clear();
   if (f[16] == "1") {
     EffectFit e;
@@ -569,11 +568,17 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
     d.effects.push_back(e);
   }
   std::size_t at = kFixedResultFields;
-  d.verdict = unescaped(f[at++]);
+  const std::string verdict_words = unescaped(f[at++]);  // (what the flags and the nuisances say: checked below)
+  const bool diagnosed = !verdict_words.empty();
   const std::size_t n_ambiguous = count(at++);
   if (f.size() < at + n_ambiguous + 1) throw bad("the ambiguous effects cut short");
   d.ambiguous_with.clear();
   for (std::size_t i = 0; i < n_ambiguous; ++i) d.ambiguous_with.push_back(unescaped(f[at++]));
+  d.verdict = !diagnosed                   ? Verdict::none
+              : !d.gap_significant         ? Verdict::no_significant_gap
+              : !d.ambiguous_with.empty()  ? Verdict::ambiguous
+              : d.explained                ? Verdict::explained
+                                           : Verdict::not_explained;
   const std::size_t n_nuisances = count(at++);
   if (f.size() < at + kNuisanceFields * n_nuisances + 1) throw bad(fmt::format("{} nuisances of {} fields expected", n_nuisances, kNuisanceFields));
   d.nuisances.clear();
@@ -586,6 +591,7 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
     d.nuisances.push_back(x);
     at += kNuisanceFields;
   }
+  if (verdict_text(d) != verdict_words) throw bad(fmt::format("the verdict \"{}\" is not what the fields say", verdict_words));
   // The top effect's parameters (the natural forms' scoring reads them).
   const std::size_t n_parameters = count(at++);
   const std::size_t gap_at = at + kParameterFields * n_parameters;
@@ -601,7 +607,12 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
   for (std::size_t i = 0; i < n_parameters; ++i) {
     FittedParameter q;
     q.name = unescaped(f[at]), q.unit = unescaped(f[at + 1]);
-    q.value = num(at + 2), q.sigma = num(at + 3), q.status = unescaped(f[at + 4]), q.at_bound = f[at + 5] == "1";
+    q.value = num(at + 2), q.sigma = num(at + 3), q.at_bound = f[at + 5] == "1";
+    try {
+      q.status = parameter_status_from_text(f[at + 4]);
+    } catch (const std::invalid_argument& e) {
+      throw bad(e.what());
+    }
     d.effects.front().parameters.push_back(q);
     at += kParameterFields;
   }

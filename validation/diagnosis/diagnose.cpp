@@ -3,7 +3,6 @@
 // saying what it takes and gives.
 #include "validation/diagnosis/diagnose.hpp"
 
-#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -74,12 +73,7 @@ Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s) {
   // The stated sigma: scaled and judged again when the gaps say it is scatter.
   const Nuisance scale =
       internal::sigma_scale(c, s, d, [&](const Campaign& scaled) { return diagnose_once(scaled, s, cache); });
-  if (drift.significant) {
-    char buf[120];
-    std::snprintf(buf, sizeof buf, " (bias drift %.3g +- %.2g ug/h removed)", drift.value, drift.sigma);
-    d.verdict += buf;
-  }
-  d.nuisances = {drift, scale};
+  d.nuisances = {drift, scale};  // (a drift removed or a sigma scaled is said after the verdict: verdict_text)
   return d;
 }
 

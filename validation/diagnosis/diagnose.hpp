@@ -103,13 +103,17 @@ double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, cons
 // The same at every parameter's value (the natural form).
 double predict_run_g(const plant::PlantConfig& nominal, const RunRecord& r, const Effect& e, ParameterValues values);
 
+// How a fitted effect's parameter got its value: fitted (with a sigma), chosen (a discrete
+// parameter: one of its values), or held at its nominal.
+enum class ParameterStatus { fitted, chosen, held };
+
 // One parameter of a fitted effect: its value and sigma (fitted on all runs), or held at its
 // nominal (the data do not pin it: its sigma from the data alone would not be smaller than its
 // prior width, or its slope is in the span of the others'), with its prior range.
 struct FittedParameter {
   std::string name, unit;
   double value = 0, sigma = NAN;
-  std::string status;  // "fitted", "chosen" (a discrete parameter: one of its values), "held"
+  ParameterStatus status = ParameterStatus::fitted;
   double lower = -INFINITY, upper = INFINITY;  // the prior range
   bool at_bound = false;  // fitted, but ended on the edge of its range (its sigma ignores the edge)
   bool sign_identifiable = true;  // false: the value is a magnitude (EffectParameter::sign_identifiable)
@@ -159,6 +163,19 @@ struct NextRun {
   std::string between;  // "A vs B"
 };
 
+// The effects a diagnosis chose: the best one, or two fitted together when a pair explains the
+// gap; none when no effect is ranked.
+struct ChosenEffects {
+  std::vector<std::string> names;  // at most two
+  bool empty() const { return names.empty(); }
+  bool operator==(const ChosenEffects&) const = default;
+};
+
+// What the diagnosis concludes. explained: by the chosen effect(s); ambiguous: more than one
+// effect explains the gap equally well (Diagnosis::ambiguous_with); none: not diagnosed (a
+// Diagnosis as constructed).
+enum class Verdict { none, no_significant_gap, explained, not_explained, ambiguous };
+
 struct RunDiagnosis {
   double predicted_g = 0, sigma_predicted_g = 0;  // nominal simulation
   double gap_g = 0, sigma_g = 0;                  // measured - predicted; sigma from V's diagonal
@@ -188,11 +205,11 @@ struct Diagnosis {
   double odd_in_a_IA_fraction = NAN;
   std::vector<EffectFit> effects;  // best first (evidence)
   std::vector<PairFit> pairs;      // tried when no one effect explains a significant gap; best first
-  std::string chosen;              // the best effect, or "A + B" when a pair explains the gap
+  double pair_evidence_margin = 0;  // a pair is chosen only when its evidence beats the best single effect's by this
+  ChosenEffects chosen;            // the best effect, or the pair that explains the gap
   std::string folds;               // the cross-validation used
   bool explained = false;
-  std::string verdict;             // "no significant gap", "explained by <name>" (or "<A> + <B>"), "not explained by any known effect",
-                                   // "ambiguous between <A> and <B>"; a nuisance applied is said after it
+  Verdict verdict = Verdict::none;  // in words (with the nuisances applied): verdict_text
   std::vector<Nuisance> nuisances;        // bias_drift, sigma_scale
   std::vector<std::string> ambiguous_with;  // the effects that explain the gap equally well (empty: not ambiguous)
   std::vector<NextRun> next_runs;         // best first; for an ambiguous or unexplained gap

@@ -1,6 +1,7 @@
 // validation/diagnosis/diagnosis_report.cpp -- a diagnosis in words (Diagnosis::BriefReport,
 // FullReport).
 #include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 
 #include <cmath>
 
@@ -11,7 +12,7 @@ namespace {
 
 std::string heldout_line(const Diagnosis& d, double wall_s) {
   return fmt::format("Held-out gap rms: {:.4g} ug ({:.3g} sigma) before, {:.4g} ug ({:.3g} sigma) after {}{}\n",
-                     d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, d.chosen,
+                     d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, to_string(d.chosen),
                      wall_s >= 0 ? fmt::format(" ({:.1f} s wall)", wall_s) : "");
 }
 
@@ -44,7 +45,7 @@ std::string next_run_lines(const Diagnosis& d) {
 
 std::string Diagnosis::BriefReport() const {
   const Diagnosis& d = *this;
-  std::string t = "Verdict: " + d.verdict + "\n" + heldout_line(d, -1);
+  std::string t = "Verdict: " + verdict_text(d) + "\n" + heldout_line(d, -1);
   for (const auto& x : d.nuisances)
     if (x.significant)
       t += fmt::format("Nuisance {}: {:.4g} +- {:.2g} {}\n", x.name, x.value, x.sigma, x.unit == "1" ? "" : x.unit);
@@ -55,7 +56,7 @@ std::string Diagnosis::FullReport(double wall_s) const {
   const Diagnosis& d = *this;
   std::string t = "Gap: " + d.where + "\n";
   t += "Cross-validation: " + d.folds + "\n";
-  t += "Verdict: " + d.verdict + "\n";
+  t += "Verdict: " + verdict_text(d) + "\n";
   t += fmt::format("  {:<26}{:>16}{:>12}{:>12}{:>14}\n", "effect", "parameter", "sigma", "evidence", "held-out chi2");
   for (const auto& e : d.effects) {
     t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}{:>12.1f}{:>14.1f}  {} ({})\n", e.name, e.value, e.sigma, e.evidence,
@@ -64,11 +65,11 @@ std::string Diagnosis::FullReport(double wall_s) const {
     for (std::size_t j = 1; j < e.parameters.size(); ++j) {
       const auto& q = e.parameters[j];
       const char* magnitude = q.sign_identifiable ? "" : ", its magnitude: the sign is not identifiable";
-      if (q.status == "fitted")
+      if (q.status == ParameterStatus::fitted)
         t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}  fitted{}: {} ({}{})\n", "", q.value, q.sigma, q.at_bound ? " at its bound" : "",
                          q.name, q.unit, magnitude);
       else
-        t += fmt::format("  {:<26}{:>16.5g}{:>12}  {}: {} ({}; range {:.3g} .. {:.3g}{})\n", "", q.value, "", q.status, q.name,
+        t += fmt::format("  {:<26}{:>16.5g}{:>12}  {}: {} ({}; range {:.3g} .. {:.3g}{})\n", "", q.value, "", to_string(q.status), q.name,
                          q.unit, q.lower, q.upper, magnitude);
     }
   }
@@ -81,7 +82,7 @@ std::string Diagnosis::FullReport(double wall_s) const {
   if (d.resimulated_runs > 0)
     t += fmt::format("Re-simulated on the ODE plant ({} runs with the largest gaps): rms {:.4g} ug without {}, {:.4g} ug "
                      "with it\n",
-                     d.resimulated_runs, d.resimulated_rms_before_g * 1e6, d.chosen, d.resimulated_rms_after_g * 1e6);
+                     d.resimulated_runs, d.resimulated_rms_before_g * 1e6, to_string(d.chosen), d.resimulated_rms_after_g * 1e6);
   for (const auto& f : d.resimulation_failures) t += "  re-simulation failed: " + f + "\n";
   t += nuisance_lines(d) + next_run_lines(d);
   return t;

@@ -74,10 +74,10 @@ EffectFitter::Multi EffectFitter::fit_all(const Data& d, const std::vector<int>&
   const std::size_t m = e_.parameters.size();
   Multi out;
   out.values = nominal_values_;
-  out.status.assign(m, "held");
+  out.status.assign(m, ParameterStatus::held);
   out.sigma.assign(m, NAN);
   const auto [p0, s0] = fit(d, idx);
-  out.values.front() = p0, out.status.front() = "fitted", out.sigma.front() = s0;
+  out.values.front() = p0, out.status.front() = ParameterStatus::fitted, out.sigma.front() = s0;
   if (m == 1) return out;
   // The starts: the nominal first, then every combination of the further parameters' starts.
   std::vector<std::vector<double>> bases = {nominal_values_};
@@ -127,7 +127,7 @@ EffectFitter::Multi EffectFitter::fit_all(const Data& d, const std::vector<int>&
     best = best_nominal;
   std::vector<double> start = start_v[best];
   for (std::size_t j = 1; j < m; ++j)
-    if (e_.parameters[j].discrete && start[j] != e_.parameters[j].nominal) out.status[j] = "chosen";
+    if (e_.parameters[j].discrete && start[j] != e_.parameters[j].nominal) out.status[j] = ParameterStatus::chosen;
   // The continuous candidates: the first parameter and the further continuous ones.
   std::vector<int> free = {0};
   for (std::size_t j = 1; j < m; ++j)
@@ -215,7 +215,7 @@ bool EffectFitter::descend(const Data& d, const std::vector<int>& idx, const std
       continue;
     }
     for (std::size_t a = 0; a < fr.size(); ++a) {
-      res.status[static_cast<std::size_t>(fr[a])] = "fitted";
+      res.status[static_cast<std::size_t>(fr[a])] = ParameterStatus::fitted;
       const double var = res.cov(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(a));
       res.sigma[static_cast<std::size_t>(fr[a])] = var > 0 ? std::sqrt(var) : std::numeric_limits<double>::quiet_NaN();
     }
@@ -396,7 +396,7 @@ std::vector<FittedParameter> fitted_parameters(const Effect& e, const EffectFitt
     fp.sign_identifiable = q.sign_identifiable;
     if (j == 0 && !q.linear && !q.grid.empty()) fp.lower = q.grid.front(), fp.upper = q.grid.back();
     if (j == 0) fp.at_bound = first_at_bound || fp.value <= fp.lower || fp.value >= fp.upper;
-    else if (fp.status == "fitted" && !q.periodic) fp.at_bound = fp.value <= q.lower || fp.value >= q.upper;
+    else if (fp.status == ParameterStatus::fitted && !q.periodic) fp.at_bound = fp.value <= q.lower || fp.value >= q.upper;
     out.push_back(fp);
   }
   return out;

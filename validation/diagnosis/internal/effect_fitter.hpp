@@ -77,7 +77,7 @@ class EffectFitter {
     std::vector<double> values;
     std::vector<int> free;         // the parameters fitted continuously (the first among them when any further is)
     Eigen::MatrixXd cov;           // their covariance (free.size() square); empty: the one-parameter fit
-    std::vector<std::string> status;
+    std::vector<ParameterStatus> status;
     std::vector<double> sigma;     // per parameter (NaN: held or chosen)
     Eigen::MatrixXd slopes;        // n x free.size(), over every run
   };
@@ -236,7 +236,7 @@ class EffectFitter {
 EffectFitter make_effect_fitter(const Effect& e, const Table& nominal, const plant::PlantConfig& plant,
                                 const std::vector<RunRecord>& runs, ResponseCache& cache, const Absorbed& absorbed);
 
-// Each parameter of e as fitted (value, sigma, status "fitted", "chosen" or "held", range, at_bound:
+// Each parameter of e as fitted (value, sigma, status, range, at_bound:
 // the first one's sigma not finite or its value on its range's edge, a further fitted one's
 // value on its edge (a periodic one has none)).
 std::vector<FittedParameter> fitted_parameters(const Effect& e, const EffectFitter::Multi& mf);

@@ -110,7 +110,7 @@ void EffectFitter::add_held_spread(const Data& d, const std::vector<int>& idx, M
   Eigen::MatrixXd spread = Eigen::MatrixXd::Zero(k, k);
   for (std::size_t j = 1; j < e_.parameters.size(); ++j) {
     const EffectParameter& q = e_.parameters[j];
-    if (q.discrete || mf.status[j] != "held" || !(std::isfinite(q.lower) && std::isfinite(q.upper))) continue;
+    if (q.discrete || mf.status[j] != ParameterStatus::held || !(std::isfinite(q.lower) && std::isfinite(q.upper))) continue;
     std::vector<double> xs;
     for (int i = 0; i < kHeldPoints; ++i)
       xs.push_back(q.periodic ? q.lower + (q.upper - q.lower) * i / kHeldPoints

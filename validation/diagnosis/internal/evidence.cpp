@@ -99,7 +99,7 @@ Fitted Scorer::fitted_multi(const EffectFitter& fitter, const EffectFitter::Mult
   const int n = m_.n;
   if (mf.cov.size() == 0) {
     if (mf.values.size() > 1 && mf.status.size() > 1 &&
-        std::any_of(mf.status.begin() + 1, mf.status.end(), [](const std::string& x) { return x != "held"; })) {
+        std::any_of(mf.status.begin() + 1, mf.status.end(), [](ParameterStatus x) { return x != ParameterStatus::held; })) {
       // A discrete parameter chosen, the first fitted at it: its slope at that value.
       Fitted f{fitter.at(mf.values), Eigen::MatrixXd(n, 0), Eigen::MatrixXd(0, 0)};
       const double sp = mf.sigma.front();

@@ -174,10 +174,7 @@ Nuisance sigma_scale(const Campaign& c, const DiagnoseSettings& s, Diagnosis& d,
       scale.note += buf;
     } else {
       d = std::move(ds);
-      scale.applied = true, scale.significant = true;
-      char buf[80];
-      std::snprintf(buf, sizeof buf, " (sigma understated x%.2f; judged with the corrected sigma)", scale.value);
-      d.verdict += buf;
+      scale.applied = true, scale.significant = true;  // (said after the verdict: verdict_text)
     }
   } else if (excess) {
     scale.note += d.explained ? "; not applied: the chosen effect explains the gap (only repeated runs would tell scatter apart)"

@@ -23,9 +23,7 @@ void shrinkage_after(const Scored& best_candidate, const Data& data, Diagnosis& 
     d.runs[static_cast<std::size_t>(k)].heldout_after_g = best->heldout(k);
   }
   d.rms_after_g = std::sqrt(ss_a / n), d.rms_after_sigma = std::sqrt(zs_a / n);
-  d.chosen = best->fit.name;
-  if (!best->fit.not_ranked.empty()) {  // no effect ranked: nothing chosen, nothing removed
-    d.chosen.clear();
+  if (!best->fit.not_ranked.empty()) {  // no effect ranked: nothing removed
     d.rms_after_g = d.rms_before_g, d.rms_after_sigma = d.rms_before_sigma;
     for (RunDiagnosis& rd : d.runs) rd.heldout_after_g = rd.heldout_before_g;
   }

@@ -6,7 +6,7 @@
 //        candidate (fitted without the run's fold), and the runs' variances (g^2).
 // Gives: in the Diagnosis, each run's held-out gap before (heldout_before_g) or after
 //        (heldout_after_g) and their rms over the runs, in g and in each run's sigma; after:
-//        the chosen candidate's name, or none (and no shrinkage) when no effect was ranked.
+//        no shrinkage when no effect was ranked.
 #include <Eigen/Dense>
 
 #include "validation/diagnosis/diagnose.hpp"

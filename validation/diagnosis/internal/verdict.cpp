@@ -141,18 +141,21 @@ Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, D
     d.where += w.str();
   }
   shrinkage_before(ev.heldout_nominal, data, d);
+  d.pair_evidence_margin = s.significance_sigma * s.significance_sigma;
   Chosen chosen = {{find_effect(best->fit.name), best->fit.values()}};
   Scored pair_best;
   if (d.gap_significant && best->fit.not_ranked.empty() && !explains_gap(*best, rms(best->heldout)) && s.try_pairs)
     best = try_pairs(m, ev, scorer, best, d, pair_best, chosen);
   shrinkage_after(*best, data, d);
+  if (best->fit.not_ranked.empty())  // (none ranked: nothing chosen)
+    for (const auto& [e, values] : chosen) d.chosen.names.push_back(e->name);
   if (!d.gap_significant) {
-    d.verdict = "no significant gap";
+    d.verdict = Verdict::no_significant_gap;
   } else if (explains_gap(*best, d.rms_after_g)) {
     d.explained = true;
-    d.verdict = "explained by " + best->fit.name;
+    d.verdict = Verdict::explained;
   } else {
-    d.verdict = "not explained by any known effect";
+    d.verdict = Verdict::not_explained;
   }
   // Ambiguity: another single effect that also explains the gap with held-out evidence within
   // ambiguity_evidence of the chosen one's (2 ln of their Bayes factor on the held-out runs).
@@ -163,8 +166,7 @@ Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, D
         tied.push_back(sc.fit.name);
     if (tied.size() > 1) {
       d.ambiguous_with = tied;
-      d.verdict = "ambiguous between " + tied[0];
-      for (std::size_t i = 1; i < tied.size(); ++i) d.verdict += (i + 1 == tied.size() ? " and " : ", ") + tied[i];
+      d.verdict = Verdict::ambiguous;
     }
   }
   // The reported effects' held parameters in their fitted parameters' sigma (add_held_spread):

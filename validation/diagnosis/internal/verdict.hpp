@@ -6,9 +6,9 @@
 //        and the Diagnosis with the gap stage's significance and the nominal's held-out gap.
 // Gives: in the Diagnosis, the targeted test (an effect's held-out evidence beyond the
 //        significance level makes the gap significant), the shrinkage before and after, the
-//        pairs tried when no one effect explains a significant gap, the chosen candidate, the
-//        verdict ("no significant gap", "explained by <name>", "not explained by any known
-//        effect", "ambiguous between ..."), the effects tied with the chosen one, and the
+//        pairs tried when no one effect explains a significant gap, the chosen effect(s) (none
+//        when no effect is ranked), the verdict (no significant gap, explained, not explained,
+//        ambiguous), the effects tied with the chosen one, and the
 //        reported effects' sigma widened by their held parameters. Returns the chosen
 //        effect(s), each with its values (one per parameter).
 #include <utility>
