@@ -1,6 +1,6 @@
 #pragma once
 // app/settings_cli.hpp -- a described settings struct's fields (core/settings_description.hpp)
-// as CLI11 flags: `--significance-sigma S` for significance_sigma, the help text, the range
+// as CLI11 flags: `--threshold-sigma S` for a field threshold_sigma, the help text, the range
 // and the default from the description. A bool field gives `--name` (true) and `--no-name`
 // (false), its alias (e.g. --no-pairs) naming the flag that sets the non-default. A field
 // whose type is described (a nested table) gets no flag.

@@ -4,7 +4,7 @@
 //
 // A struct S lists its fields in one static member template
 //     template <class V> static void Describe(V& v) {
-//       v(core::field("significance_sigma", &S::significance_sigma, "sigma", core::above(0), "help"));
+//       v(core::field("threshold_sigma", &S::threshold_sigma, "sigma", core::above(0), "help"));
 //       ...
 //     }
 // each with its name (the TOML key, the JSON key, the Python keyword; the CLI flag is the name

@@ -252,7 +252,7 @@ Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {});
 // g = r_with - r_without (the noise cancels; what the static test took up of an effect that
 // acts at rest is out of it, as it is out of the gap the diagnosis sees), and its
 // significance sqrt(g^T V^-1 g), V the covariance diagnose judges `with`'s runs by
-// (each run's sigma^2 and (model_accuracy x prediction)^2, plus G Sigma G^T: the static
+// (each run's sigma^2 and (the simulation's relative accuracy x prediction)^2, plus G Sigma G^T: the static
 // test's coefficient uncertainty through the nominal prediction). No effect hypothesis is
 // used. Throws std::invalid_argument when the campaigns' runs differ or the static readings
 // do not determine the coefficients.

@@ -128,7 +128,7 @@ struct Effect {
   // and the drawn range; the squeeze film's harmonic balance 2 %,
   // test_squeeze_film_harmonic_balance.cpp). A fitted parameter's reported sigma adds what
   // that error, as one common relative error, moves the fit (diagnose.cpp,
-  // EffectFitter::add_model_error); apart from DiagnoseSettings::model_accuracy (the simulation's).
+  // EffectFitter::add_model_error); apart from the simulation's own accuracy (DiagnoseSettings).
   double hypothesis_accuracy = 0.01;
   // Acts at rest too (linear effects only): the static test took up part of it into the
   // identified coefficients; diagnose gives that part back (docs/diagnose.md).

@@ -10,6 +10,7 @@
 #include "validation/diagnosis/internal/evidence.hpp"
 #include "validation/diagnosis/internal/identification.hpp"
 #include "validation/diagnosis/internal/likelihood.hpp"
+#include "validation/diagnosis/internal/stage_options.hpp"
 #include "validation/diagnosis/internal/tabulate.hpp"
 
 namespace vrelab::validation {
@@ -40,7 +41,8 @@ Nominal nominal_of(const Campaign& c0, const DiagnoseSettings& s, double sigma_s
   internal::Identified id = internal::identify(c);
   internal::ResponseCache cache;
   Nominal nm{std::move(id.data), internal::tabulate(id.plant, c.runs, nullptr, 0, cache, internal::Absorbed{})};
-  for (Eigen::Index k = 0; k < nm.t.pred.size(); ++k) nm.data.sigma2(k) += std::pow(s.model_accuracy * nm.t.pred(k), 2);
+  const double accuracy = internal::stage_options(s).simulation_rel_accuracy;
+  for (Eigen::Index k = 0; k < nm.t.pred.size(); ++k) nm.data.sigma2(k) += std::pow(accuracy * nm.t.pred(k), 2);
   return nm;
 }
 
@@ -62,7 +64,7 @@ NominalView nominal_view(const Campaign& c, const DiagnoseSettings& s) {
 // none in sigma of the best test there is, with the runs' correlations through the static
 // test's coefficients counted (a gap the coefficients can take up is no gap to any test).
 // The diagnosis' targeted test asks an effect's held-out evidence, the fall of -2 ln L it
-// brings, for more than significance_sigma^2 = 25; for a one-parameter effect of the true
+// brings, for more than the significance level squared, 25; for a one-parameter effect of the true
 // shape that fall is (g^T V^-1 y)^2 / g^T V^-1 g, expected g^T V^-1 g + 1: a gap at 5 is the
 // one the diagnosis' own test finds about half the time, no yardstick asks for more. The
 // largest |g_k| / sigma_k of any one run (the largest run's size) counts neither the take-up

@@ -16,10 +16,9 @@ using plant::PlantConfig;
 // 5. Confirmation on the ODE plant: the runs with the largest gaps re-simulated with the
 // coefficients corrected by all runs (under the chosen effect) and the effect added, and
 // without it.
-void confirm_on_ode(const CampaignModel& m, const Chosen& chosen, const Eigen::VectorXd& r, Diagnosis& d) {
-  if (!(m.settings.resimulate_runs > 0 && d.explained)) return;
+void confirm_on_ode(const CampaignModel& m, const Chosen& chosen, const Eigen::VectorXd& r, int max_runs, Diagnosis& d) {
+  if (!(max_runs > 0 && d.explained)) return;
   const Campaign& c = m.campaign;
-  const DiagnoseSettings& s = m.settings;
   const PlantConfig& plant = m.plant;
   const Data& data = m.data;
   const Table& nominal = m.nominal;
@@ -51,7 +50,7 @@ void confirm_on_ode(const CampaignModel& m, const Chosen& chosen, const Eigen::V
     return c.runs[static_cast<std::size_t>(k)].random.has_value() || c.runs[static_cast<std::size_t>(k)].motion.has_value();
   });
   std::sort(order.begin(), order.end(), [&](int a, int b) { return std::abs(r(a)) > std::abs(r(b)); });
-  order.resize(std::min<std::size_t>(order.size(), static_cast<std::size_t>(s.resimulate_runs)));
+  order.resize(std::min<std::size_t>(order.size(), static_cast<std::size_t>(max_runs)));
   double sb = 0, sa = 0;
   int done = 0;
   for (int k : order) {

@@ -4,7 +4,7 @@
 //
 // Takes: the campaign model (identified plant, runs, data, nominal table, what the static test
 //        takes up), the chosen effect(s) with their values, the nominal gap r (g, per run) and
-//        the settings (how many runs to re-simulate).
+//        how many runs to re-simulate at most.
 // Gives: for an explained gap, the runs with the largest |r| (sine runs without measured
 //        motion) simulated on the ODE with the coefficients corrected by all runs under the
 //        chosen effect(s), with and without the effect(s): d.resimulated_runs, the rms of
@@ -17,6 +17,6 @@
 
 namespace vrelab::validation::internal {
 
-void confirm_on_ode(const CampaignModel& m, const Chosen& chosen, const Eigen::VectorXd& r, Diagnosis& d);
+void confirm_on_ode(const CampaignModel& m, const Chosen& chosen, const Eigen::VectorXd& r, int max_runs, Diagnosis& d);
 
 }  // namespace vrelab::validation::internal

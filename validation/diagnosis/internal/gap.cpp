@@ -37,9 +37,8 @@ struct Span {
 };
 
 // Each run's prediction, gap and z; the peak, the significant runs and their span.
-Span per_run(const CampaignModel& m, const Eigen::VectorXd& r, const Eigen::VectorXd& adj, Diagnosis& d) {
+Span per_run(const CampaignModel& m, double threshold_sigma, const Eigen::VectorXd& r, const Eigen::VectorXd& adj, Diagnosis& d) {
   const Campaign& c = m.campaign;
-  const DiagnoseSettings& s = m.settings;
   const Data& data = m.data;
   const Table& nominal = m.nominal;
   const int n = m.n;
@@ -63,7 +62,7 @@ Span per_run(const CampaignModel& m, const Eigen::VectorXd& r, const Eigen::Vect
       d.max_abs_z = std::abs(rd.z);
       d.peak = fmt_peak(run, dir, orient, rd.z);
     }
-    if (std::abs(rd.z) >= s.significance_sigma) {
+    if (std::abs(rd.z) >= threshold_sigma) {
       ++d.significant_runs;
       dirs.insert(dir);
       f_lo = std::min(f_lo, run.frequency_Hz), f_hi = std::max(f_hi, run.frequency_Hz);
@@ -79,7 +78,7 @@ Span per_run(const CampaignModel& m, const Eigen::VectorXd& r, const Eigen::Vect
 
 // Odd or even in the static a_IA: runs alike but for the sign of a_IA, where either is
 // significant; the share of the pairs' gap power in (z1 - z2) / 2 (NaN without such pairs).
-double odd_in_a_IA_fraction(const Campaign& c, const Diagnosis& d, double significance_sigma) {
+double odd_in_a_IA_fraction(const Campaign& c, const Diagnosis& d, double threshold_sigma) {
   const int n = static_cast<int>(c.runs.size());
   double odd = 0, even = 0;
   for (int k = 0; k < n; ++k)
@@ -90,7 +89,7 @@ double odd_in_a_IA_fraction(const Campaign& c, const Diagnosis& d, double signif
           (mirrored - b.orientation_g).norm() > 1e-3 || std::abs(a.orientation_g[0]) < 0.1)
         continue;
       const double za = d.runs[static_cast<std::size_t>(k)].z, zb = d.runs[static_cast<std::size_t>(j)].z;
-      if (std::max(std::abs(za), std::abs(zb)) < significance_sigma) continue;
+      if (std::max(std::abs(za), std::abs(zb)) < threshold_sigma) continue;
       odd += std::pow((za - zb) / 2, 2), even += std::pow((za + zb) / 2, 2);
     }
   return odd + even > 0 ? odd / (odd + even) : NAN;
@@ -110,12 +109,12 @@ double pooled_slope(const std::map<std::string, std::vector<std::pair<double, do
 }
 
 // The summary of where the gap lies (Diagnosis::where).
-std::string where_text(const Diagnosis& d, const Span& sp, double chi2_sigma, int n, double significance_sigma) {
+std::string where_text(const Diagnosis& d, const Span& sp, double chi2_sigma, int n, double threshold_sigma) {
   std::ostringstream w;
   w.precision(3);
   w << "chi^2 " << d.chi2_nominal << " for " << n << " runs (" << chi2_sigma << " sigma); ";
   if (d.significant_runs > 0) {
-    w << d.significant_runs << " run(s) with a gap beyond " << significance_sigma
+    w << d.significant_runs << " run(s) with a gap beyond " << threshold_sigma
       << " sigma that the coefficients cannot take up: " << sp.f_lo << "-" << sp.f_hi << " Hz, " << sp.a_lo << "-" << sp.a_hi
       << " g, direction(s)";
     for (const auto& x : sp.dirs) w << " " << x;
@@ -125,15 +124,14 @@ std::string where_text(const Diagnosis& d, const Span& sp, double chi2_sigma, in
     if (std::isfinite(d.odd_in_a_IA_fraction))
       w << "; share of the gap odd in the static a_IA: " << d.odd_in_a_IA_fraction;
   } else {
-    w << "no single run beyond " << significance_sigma << " sigma";
+    w << "no single run beyond " << threshold_sigma << " sigma";
   }
   return w.str();
 }
 
 }  // namespace
 
-Eigen::VectorXd locate_gap(const CampaignModel& m, Diagnosis& d) {
-  const DiagnoseSettings& s = m.settings;
+Eigen::VectorXd locate_gap(const CampaignModel& m, const GapOptions& o, Diagnosis& d) {
   const Data& data = m.data;
   const Table& nominal = m.nominal;
   const std::vector<int>& all = m.all;
@@ -147,13 +145,13 @@ Eigen::VectorXd locate_gap(const CampaignModel& m, Diagnosis& d) {
   // simulation accuracy). The raw gap is dominated by the coefficient errors at several g
   // and would point everywhere.
   const Eigen::VectorXd adj = adjusted_residual(data, nominal.pred, nominal.G, all, all);
-  const Span sp = per_run(m, r, adj, d);
+  const Span sp = per_run(m, o.threshold_sigma, r, adj, d);
   // Odd or even in the static a_IA.
-  d.odd_in_a_IA_fraction = odd_in_a_IA_fraction(m.campaign, d, s.significance_sigma);
-  d.gap_significant = d.significant_runs > 0 || chi2_sigma >= s.significance_sigma;
+  d.odd_in_a_IA_fraction = odd_in_a_IA_fraction(m.campaign, d, o.threshold_sigma);
+  d.gap_significant = d.significant_runs > 0 || chi2_sigma >= o.threshold_sigma;
   d.amplitude_power = pooled_slope(sp.over_amplitude);
   d.frequency_power = pooled_slope(sp.over_frequency);
-  d.where = where_text(d, sp, chi2_sigma, n, s.significance_sigma);
+  d.where = where_text(d, sp, chi2_sigma, n, o.threshold_sigma);
   return r;
 }
 

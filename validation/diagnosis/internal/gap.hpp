@@ -3,7 +3,7 @@
 // the nominal simulation and the runs lies, and whether it is significant.
 //
 // Takes: the campaign model (identification.hpp: the runs' data, the nominal table) and the
-//        settings' significance level (sigma).
+//        significance level (GapOptions, sigma).
 // Gives: in the Diagnosis, per run the nominal prediction and its sigma from the coefficients
 //        (g), the gap measured - predicted and its sigma (V's diagonal, g), the gap the
 //        coefficient errors cannot take up (g) and its z in the run's own sigma; the nominal
@@ -18,6 +18,10 @@
 
 namespace vrelab::validation::internal {
 
-Eigen::VectorXd locate_gap(const CampaignModel& m, Diagnosis& d);
+struct GapOptions {
+  double threshold_sigma = 5;  // a run's gap (its z), or chi^2 as a normal deviate, beyond this is significant
+};
+
+Eigen::VectorXd locate_gap(const CampaignModel& m, const GapOptions& o, Diagnosis& d);
 
 }  // namespace vrelab::validation::internal

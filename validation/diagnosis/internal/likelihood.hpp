@@ -4,7 +4,7 @@
 // "Covariance" and "The factored likelihood").
 //
 // Takes: the runs' measured vibration errors (g) and variances (g^2: the run's own plus the
-//        simulation's, (model_accuracy x nominal prediction)^2), the static test's coefficient
+//        simulation's, (its relative accuracy x nominal prediction)^2), the static test's coefficient
 //        covariance Sigma (coefficient units^2), a table of predictions (g) and their gradient
 //        G in the coefficients (g per coefficient unit), and a subset of the runs (indices).
 // Gives: the residual's covariance V = diag(sigma2) + G Sigma G^T on the subset, -2 ln L and

@@ -11,12 +11,12 @@ namespace vrelab::validation::internal {
 
 // Advice on the next runs: for an ambiguous or unexplained gap, the runs (direction,
 // frequency, amplitude, static orientation) where the candidates' predictions differ most,
-// in a run's sigma (the campaign's median, with the model accuracy). The candidates: the
+// in a run's sigma (the campaign's median, with the simulation's accuracy). The candidates: the
 // ambiguous ones, else the three best by evidence, each at its fitted value; predicted from
 // the identified coefficients (what the static test took up of an effect acting at rest is
 // not given back here: a small part of such an effect's prediction).
-void advise_next_runs(const plant::PlantConfig& plant, const Campaign& c, const DiagnoseSettings& s, Diagnosis& d) {
-  if (!(s.advise_next_runs && d.gap_significant && (!d.ambiguous_with.empty() || !d.explained))) return;
+void suggest_next_runs(const plant::PlantConfig& plant, const Campaign& c, double simulation_rel_accuracy, Diagnosis& d) {
+  if (!(d.gap_significant && (!d.ambiguous_with.empty() || !d.explained))) return;
   std::vector<std::pair<const Effect*, std::vector<double>>> cand;
   if (!d.ambiguous_with.empty()) {
     for (const auto& name : d.ambiguous_with)
@@ -44,7 +44,7 @@ void advise_next_runs(const plant::PlantConfig& plant, const Campaign& c, const 
           run.frequency_Hz = f, run.amplitude_g = a, run.direction = dir, run.orientation_g = o;
           try {
             const double p0 = predict_run_g(plant, run, nullptr, 0);
-            const double sg = std::hypot(sigma_run, s.model_accuracy * p0);
+            const double sg = std::hypot(sigma_run, simulation_rel_accuracy * p0);
             std::vector<double> pr;
             for (const auto& [e, v] : cand) pr.push_back(predict_run_g(plant, run, *e, v));
             NextRun nr{f, a, dir, o, INFINITY, ""};

@@ -3,18 +3,18 @@
 // or unexplained gap.
 //
 // Takes: the identified plant, the campaign's runs (their sigma in g and largest amplitude in
-//        g), the settings (model accuracy; whether to advise) and the Diagnosis with its
-//        ranked effects, verdict and ties.
+//        g), the simulation's relative accuracy and the Diagnosis with its ranked effects,
+//        verdict and ties.
 // Gives: d.next_runs: up to three runs (direction, frequency in Hz among 10-2000, amplitude in
 //        g among a quarter, half and all of the largest, static orientation) where the
 //        candidates' predictions differ most, in a run's sigma (the campaign's median with the
-//        model accuracy at the nominal prediction), each a different direction or orientation
+//        simulation's accuracy at the nominal prediction), each a different direction or orientation
 //        where possible. The candidates: the tied effects, else the three best ranked, each at
 //        its fitted values. Nothing for an explained unambiguous or insignificant gap.
 #include "validation/diagnosis/diagnose.hpp"
 
 namespace vrelab::validation::internal {
 
-void advise_next_runs(const plant::PlantConfig& plant, const Campaign& c, const DiagnoseSettings& s, Diagnosis& d);
+void suggest_next_runs(const plant::PlantConfig& plant, const Campaign& c, double simulation_rel_accuracy, Diagnosis& d);
 
 }  // namespace vrelab::validation::internal

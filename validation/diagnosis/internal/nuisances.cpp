@@ -105,7 +105,7 @@ std::pair<double, int> repeat_scatter(const Campaign& c) {
   return {chi2, dof};
 }
 
-Nuisance sigma_scale(const Campaign& c, const DiagnoseSettings& s, Diagnosis& d,
+Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d,
                      const std::function<Diagnosis(const Campaign&)>& rediagnose) {
   // The stated sigma: from repeated runs when there are enough (their scatter is the
   // measurement's alone), else from the gaps no effect explains (the nominal's adjusted gaps
@@ -117,7 +117,7 @@ Nuisance sigma_scale(const Campaign& c, const DiagnoseSettings& s, Diagnosis& d,
   double z2 = 0;
   for (int k = 0; k < n; ++k) {
     const RunDiagnosis& rd = d.runs[static_cast<std::size_t>(k)];
-    const double sig = std::hypot(c.runs[static_cast<std::size_t>(k)].sigma_g, s.model_accuracy * rd.predicted_g);  // as rd.z's
+    const double sig = std::hypot(c.runs[static_cast<std::size_t>(k)].sigma_g, o.simulation_rel_accuracy * rd.predicted_g);  // as rd.z's
     z[static_cast<std::size_t>(k)] = d.explained ? rd.heldout_after_g / sig : rd.z;
     z2 += z[static_cast<std::size_t>(k)] * z[static_cast<std::size_t>(k)];
   }
@@ -153,7 +153,7 @@ Nuisance sigma_scale(const Campaign& c, const DiagnoseSettings& s, Diagnosis& d,
   // It is scatter when measured by repeats, or when no effect explains the gaps and their
   // neighbours are not alike (structure is physics). Whatever the gap's verdict: an
   // overdispersion below the gap's own 5-sigma test is still reported.
-  const bool scatter = from_repeats || (!d.explained && rho_sigma < s.structure_sigma);
+  const bool scatter = from_repeats || (!d.explained && rho_sigma < o.structure_threshold_sigma);
   // A physical gap is not scatter: scaled from the gaps alone (no repeats), the scaling is not
   // applied when, judged with the corrected sigma, one library effect's held-out evidence still
   // exceeds the targeted test's level (significance^2 = 25). With the right sigma, 30 clean
@@ -164,7 +164,7 @@ Nuisance sigma_scale(const Campaign& c, const DiagnoseSettings& s, Diagnosis& d,
     Campaign scaled = c;
     for (RunRecord& r : scaled.runs) r.sigma_g *= scale.value;
     Diagnosis ds = rediagnose(scaled);
-    const double level = s.significance_sigma * s.significance_sigma;
+    const double level = o.threshold_sigma * o.threshold_sigma;
     if (!from_repeats && !ds.effects.empty() && ds.effects.front().not_ranked.empty() && ds.effects.front().evidence > level) {
       char buf[240];
       std::snprintf(buf, sizeof buf,

@@ -4,8 +4,8 @@
 // drift is diagnose.hpp's remove_drift.
 //
 // Takes: a campaign (its runs' frequency in Hz, amplitude in g, direction, static orientation,
-//        measured error and stated sigma in g), each run's gap in its sigma (z), the settings
-//        and a diagnosis of the campaign.
+//        measured error and stated sigma in g), each run's gap in its sigma (z), the levels
+//        the stated sigma is judged by (SigmaScaleOptions) and a diagnosis of the campaign.
 // Gives: the repeats' pooled chi^2 about their weighted means and its degrees of freedom; the
 //        correlation of neighbouring runs' z (one frequency or amplitude step apart, the rest
 //        alike) and the number of pairs; and the sigma_scale nuisance: the factor the stated
@@ -34,10 +34,16 @@ std::pair<double, int> neighbour_correlation(const Campaign& c, const std::vecto
 // scatter over the stated sigma (chi^2 about each group's weighted mean), and its degrees of freedom.
 std::pair<double, int> repeat_scatter(const Campaign& c);
 
+struct SigmaScaleOptions {
+  double simulation_rel_accuracy = 0.002;  // the simulation's error over its prediction, in each run's sigma as in z's
+  double structure_threshold_sigma = 3;    // gaps whose neighbours correlate below this (normal deviate) are scatter
+  double threshold_sigma = 5;              // a library effect's evidence beyond its square, judged again: a physical gap
+};
+
 // The stated sigma's scale, estimated from d (the diagnosis with the stated sigma); when it is
 // scatter beyond chance, `rediagnose` (the campaign with each run's sigma scaled) replaces d
-// unless a physical gap remains (d.verdict says so). Returns the sigma_scale nuisance.
-Nuisance sigma_scale(const Campaign& c, const DiagnoseSettings& s, Diagnosis& d,
+// unless a physical gap remains (the nuisance's note says so). Returns the sigma_scale nuisance.
+Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d,
                      const std::function<Diagnosis(const Campaign&)>& rediagnose);
 
 }  // namespace vrelab::validation::internal

@@ -18,11 +18,10 @@ namespace {
 // fold (so the held-out runs do not choose them); the best and the next are fitted together
 // with A by alternating one-parameter fits, each on the data less the other's part, and
 // scored on the held-out runs like a single effect. A pair is chosen only when its evidence
-// beats A's by significance_sigma^2 and it explains the gap.
+// beats A's by threshold_sigma^2 and it explains the gap.
 // Returns the pair chosen (pair_best) or best; d.pairs filled, chosen replaced by the pair's.
-const Scored* try_pairs(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, const Scored* best, Diagnosis& d,
-                        Scored& pair_best, Chosen& chosen) {
-  const DiagnoseSettings& s = m.settings;
+const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, const VerdictOptions& o,
+                        const Scored* best, Diagnosis& d, Scored& pair_best, Chosen& chosen) {
   const Data& data = m.data;
   const Table& nominal = m.nominal;
   const std::vector<int>& all = m.all;
@@ -30,7 +29,7 @@ const Scored* try_pairs(const CampaignModel& m, const Evidence& ev, const Scorer
   const std::map<std::string, std::unique_ptr<EffectFitter>>& fitters = ev.fitters;
   const auto fitted_at = [&](const EffectFitter& fitter, double p, double sp) { return scorer.fitted_at(fitter, p, sp); };
   const auto rms = [&](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / n); };
-  const auto explains_gap = [&](const Scored& sc, double rms_after) { return explains(sc, rms_after, d.rms_before_g, n, s); };
+  const auto explains_gap = [&](const Scored& sc, double rms_after) { return explains(sc, rms_after, d.rms_before_g, n, o); };
   // (The two parameters' variances: each conditional on the other, their correlation left out.)
   const auto fit_pair = [&](const EffectFitter& A, const EffectFitter& B, double pB, const std::vector<int>& idx) {
     double pA = A.fit(data, idx).first;  // (pB: B's nominal, the start)
@@ -100,7 +99,7 @@ const Scored* try_pairs(const CampaignModel& m, const Evidence& ev, const Scorer
   // rms (a pair whose parameters the training runs leave loose can pass chi^2 without
   // predicting anything).
   if (!pair_best.fit.name.empty() &&
-      pair_best.fit.evidence > best->fit.evidence + s.significance_sigma * s.significance_sigma &&
+      pair_best.fit.evidence > best->fit.evidence + o.threshold_sigma * o.threshold_sigma &&
       explains_gap(pair_best, rms(pair_best.heldout)) && rms(pair_best.heldout) <= 0.5 * d.rms_before_g) {
     best = &pair_best;
     chosen = {{find_effect(chosen_pair.a), find_effect(chosen_pair.a)->values_at(chosen_pair.pa)},
@@ -111,20 +110,19 @@ const Scored* try_pairs(const CampaignModel& m, const Evidence& ev, const Scorer
 
 }  // namespace
 
-bool explains(const Scored& sc, double rms_after_g, double rms_before_g, int n, const DiagnoseSettings& s) {
-  return sc.fit.not_ranked.empty() && sc.fit.evidence > s.significance_sigma * s.significance_sigma &&
-         (chi2_as_sigma(sc.fit.heldout_chi2, n) < s.significance_sigma ||
-          rms_after_g <= (1 - s.explained_shrinkage) * rms_before_g);
+bool explains(const Scored& sc, double rms_after_g, double rms_before_g, int n, const VerdictOptions& o) {
+  return sc.fit.not_ranked.empty() && sc.fit.evidence > o.threshold_sigma * o.threshold_sigma &&
+         (chi2_as_sigma(sc.fit.heldout_chi2, n) < o.threshold_sigma ||
+          rms_after_g <= (1 - o.min_rms_removed) * rms_before_g);
 }
 
-Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, Diagnosis& d) {
-  const DiagnoseSettings& s = m.settings;
+Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, const VerdictOptions& o, Diagnosis& d) {
   const Data& data = m.data;
   const std::vector<int>& all = m.all;
   const int n = m.n;
   const std::vector<Scored>& scored = ev.scored;
   const auto& fitters = ev.fitters;
-  const auto explains_gap = [&](const Scored& sc, double rms_after) { return explains(sc, rms_after, d.rms_before_g, n, s); };
+  const auto explains_gap = [&](const Scored& sc, double rms_after) { return explains(sc, rms_after, d.rms_before_g, n, o); };
   const auto rms = [&](const Eigen::VectorXd& v) { return std::sqrt(v.squaredNorm() / n); };
   const Scored* best = &scored.front();
   // The targeted test: one effect's held-out evidence (the chi^2 it removes on runs it was
@@ -132,20 +130,20 @@ Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, D
   // z miss it because most of its shape trades with the coefficients' errors (a squeeze film,
   // ~ amplitude^4 like k4). 30 clean campaigns (blind's random truths, seeds 5000-5029) gave
   // at most 7.
-  if (!d.gap_significant && best->fit.not_ranked.empty() && best->fit.evidence > s.significance_sigma * s.significance_sigma) {
+  if (!d.gap_significant && best->fit.not_ranked.empty() && best->fit.evidence > o.threshold_sigma * o.threshold_sigma) {
     d.gap_significant = true;
     std::ostringstream w;
     w.precision(3);
     w << "; " << best->fit.name << " lowers -2 ln L of the held-out runs by " << best->fit.evidence << " (beyond "
-      << s.significance_sigma * s.significance_sigma << ")";
+      << o.threshold_sigma * o.threshold_sigma << ")";
     d.where += w.str();
   }
   shrinkage_before(ev.heldout_nominal, data, d);
-  d.pair_evidence_margin = s.significance_sigma * s.significance_sigma;
+  d.pair_evidence_margin = o.threshold_sigma * o.threshold_sigma;
   Chosen chosen = {{find_effect(best->fit.name), best->fit.values()}};
   Scored pair_best;
-  if (d.gap_significant && best->fit.not_ranked.empty() && !explains_gap(*best, rms(best->heldout)) && s.try_pairs)
-    best = try_pairs(m, ev, scorer, best, d, pair_best, chosen);
+  if (d.gap_significant && best->fit.not_ranked.empty() && !explains_gap(*best, rms(best->heldout)) && o.try_two_effects)
+    best = best_pair(m, ev, scorer, o, best, d, pair_best, chosen);
   shrinkage_after(*best, data, d);
   if (best->fit.not_ranked.empty())  // (none ranked: nothing chosen)
     for (const auto& [e, values] : chosen) d.chosen.names.push_back(e->name);
@@ -158,11 +156,11 @@ Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, D
     d.verdict = Verdict::not_explained;
   }
   // Ambiguity: another single effect that also explains the gap with held-out evidence within
-  // ambiguity_evidence of the chosen one's (2 ln of their Bayes factor on the held-out runs).
+  // tie_evidence of the chosen one's (2 ln of their Bayes factor on the held-out runs).
   if (d.explained && chosen.size() == 1) {
     std::vector<std::string> tied = {best->fit.name};
     for (const Scored& sc : scored)
-      if (&sc != best && best->fit.evidence - sc.fit.evidence < s.ambiguity_evidence && explains_gap(sc, rms(sc.heldout)))
+      if (&sc != best && best->fit.evidence - sc.fit.evidence < o.tie_evidence && explains_gap(sc, rms(sc.heldout)))
         tied.push_back(sc.fit.name);
     if (tied.size() > 1) {
       d.ambiguous_with = tied;

@@ -3,7 +3,8 @@
 // pair of effects) explains the gap, and how sure that is.
 //
 // Takes: the campaign model, the evidence stage's ranked candidates and fitters, its scorer,
-//        and the Diagnosis with the gap stage's significance and the nominal's held-out gap.
+//        the Diagnosis with the gap stage's significance and the nominal's held-out gap, and
+//        the levels a verdict is judged by (VerdictOptions).
 // Gives: in the Diagnosis, the targeted test (an effect's held-out evidence beyond the
 //        significance level makes the gap significant), the shrinkage before and after, the
 //        pairs tried when no one effect explains a significant gap, the chosen effect(s) (none
@@ -22,13 +23,20 @@ namespace vrelab::validation::internal {
 
 using Chosen = std::vector<std::pair<const Effect*, std::vector<double>>>;
 
-// A candidate explains the gap: ranked, held-out evidence beyond significance_sigma^2, and
-// either its held-out chi^2 as a normal deviate below significance_sigma or its held-out gap
-// rms (rms_after_g) at most (1 - explained_shrinkage) of the nominal's (rms_before_g). The
+struct VerdictOptions {
+  double threshold_sigma = 5;    // held-out evidence beyond its square: a gap, and needed to explain one
+  double min_rms_removed = 0.9;  // share of the held-out gap rms an effect that explains the gap removes (or chi^2)
+  bool try_two_effects = true;   // two effects at once when no one effect explains a significant gap
+  double tie_evidence = 6;       // explaining effects whose evidence is closer than this: ambiguous
+};
+
+// A candidate explains the gap: ranked, held-out evidence beyond threshold_sigma^2, and
+// either its held-out chi^2 as a normal deviate below threshold_sigma or its held-out gap
+// rms (rms_after_g) at most (1 - min_rms_removed) of the nominal's (rms_before_g). The
 // held-out gap rms need not shrink: the adjusted residuals leave out the runs' correlations and
 // can grow while chi^2 falls (docs/diagnose.md).
-bool explains(const Scored& sc, double rms_after_g, double rms_before_g, int n, const DiagnoseSettings& s);
+bool explains(const Scored& sc, double rms_after_g, double rms_before_g, int n, const VerdictOptions& o);
 
-Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, Diagnosis& d);
+Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, const VerdictOptions& o, Diagnosis& d);
 
 }  // namespace vrelab::validation::internal
