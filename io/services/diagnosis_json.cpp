@@ -398,7 +398,7 @@ json to_json(const validation::BlindResult& r) {
           {"median_shrinkage_in_sigma", s.median_shrinkage_in_sigma},
           {"families", families_json(s.families)},
           {"criteria", criteria_json(r.Criteria())},
-          {"old_family_size_max_run_sigma",
+          {"family_size_max_run_sigma",
            {{"family_size", "effect_max_sigma: the largest |with - without| of any run over its sigma; scored when >= 5"},
             {"top1_accuracy", BlindScores::rate(s.by_max_run_sigma.single_right, s.by_max_run_sigma.single)},
             {"single_effect_campaigns", s.by_max_run_sigma.single},
@@ -483,7 +483,7 @@ std::string blind_html(const validation::BlindResult& r) {
   {
     // The two family sizes and the two shrinkages side by side (docs/blind.md, "Blind's measures").
     const validation::BlindScores& s = r.scores;
-    const validation::OldSizeScores& o = s.by_max_run_sigma;
+    const validation::LargestRunSizeScores& o = s.by_max_run_sigma;
     const auto fam = [](const std::map<std::string, validation::FamilyScore>& m, const std::string& name) {
       const auto it = m.find(name);
       return it == m.end() ? std::string("0/0") : fmt::format("{}/{}", it->second.right, it->second.n);
@@ -492,14 +492,14 @@ std::string blind_html(const validation::BlindResult& r) {
       const auto it = m.find(name);
       return it == m.end() ? 0 : it->second.n;
     };
-    h += "<h2>Family size and shrinkage: the scored measures and the old ones</h2>\n<p>A single or natural campaign is "
+    h += "<h2>Family size and shrinkage: the scored measures and the largest run's</h2>\n<p>A single or natural campaign is "
          "scored when the gap its effect makes is &ge; 5&sigma; as the diagnosis' nominal model sees it: sqrt(g<sup>T</sup> "
          "V<sup>-1</sup> g), g the nominal gap with the effect less without it (the virtual lab, the same noise draws), V the "
          "diagnosis' covariance of the runs with the static test's coefficient uncertainty (<code>effect_gap_sigma</code>). "
-         "The old size was the largest run's |with - without| over its &sigma; (<code>effect_max_sigma</code>). The "
+         "The largest run's size, beside: the largest |with - without| of any run over its &sigma; (<code>effect_max_sigma</code>). The "
          "shrinkage of the gap is of the held-out residuals with each run's noise draw (and the lab log's drift and "
-         "scatter, less the drift line removed) taken out; the old one kept the noise.</p>\n";
-    h += "<table><tr><th class=\"l\">measure</th><th>scored (gap as the lab sees it)</th><th>old (largest run)</th></tr>\n";
+         "scatter, less the drift line removed) taken out; the residuals' shrinkage beside keeps the noise.</p>\n";
+    h += "<table><tr><th class=\"l\">measure</th><th>scored (gap as the lab sees it)</th><th>largest run's size</th></tr>\n";
     h += fmt::format("<tr><td class=\"l\">single, right effect</td><td>{}</td><td>{}</td></tr>\n", fam(s.families, "single"),
                      fam(o.families, "single"));
     h += fmt::format("<tr><td class=\"l\">natural, right effect (parameters within 3&sigma;)</td><td>{}</td><td>{}</td></tr>\n",

@@ -59,10 +59,10 @@ TEST(BlindScoring, ACoefficientChangeTheStaticTestPinsIsNoGap) {
   changed.coefficients[plant::k2] += 1e-6;  // 8 ug at 4 g along IA: ~27 sigma of a run
   const Campaign without = simulate_campaign(truth, {}, small_design(), 9100, 2);
   const Campaign with = simulate_campaign(changed, {}, small_design(), 9100, 2);
-  const double old_size = max_run_sigma(with, without);
+  const double largest_run_size = max_run_sigma(with, without);
   const double size = nominal_gap_significance(with, without, quick());
-  std::printf("  k2 + 1e-6: largest run %.1f sigma; the gap as the nominal model sees it %.3f sigma\n", old_size, size);
-  EXPECT_GT(old_size, 20);
+  std::printf("  k2 + 1e-6: largest run %.1f sigma; the gap as the nominal model sees it %.3f sigma\n", largest_run_size, size);
+  EXPECT_GT(largest_run_size, 20);
   // The first-order (frequency-domain) prediction follows the ODE to ~0.2 % of the change
   // (DiagnoseSettings::model_accuracy): 0.2 % of 27 sigma is 0.05 sigma a run; 1 allows for
   // the settled statics' own departure from linear in k2.
@@ -204,7 +204,7 @@ TEST(BlindScoring, TheResultLineCarriesTheGapsSizeAndNoiseFreeRms) {
 // gap shrinkage's median is over the gap size's single family (campaigns 10, 11: 0.5 and 0.9
 // -> 0.9, the upper median of two as blind takes it); the residuals' median (with the noise)
 // over the largest-run size's family (campaigns 9, 11).
-TEST(BlindScoring, SinglesAreScoredByTheGapAsTheLabSeesItTheOldSizeBeside) {
+TEST(BlindScoring, SinglesAreScoredByTheGapAsTheLabSeesItTheLargestRunSizeBeside) {
   BlindSettings s;
   s.n = 12, s.seed = 9103, s.threads = 1;
   std::map<int, std::string> done;
@@ -250,7 +250,7 @@ TEST(BlindScoring, SinglesAreScoredByTheGapAsTheLabSeesItTheOldSizeBeside) {
   EXPECT_DOUBLE_EQ(sc.median_shrinkage, 0.8);                   // campaigns 10 (0.3), 11 (0.8)
   const std::string brief = r.BriefReport();
   EXPECT_NE(brief.find("shrinkage of the gap rms (the lab's noise removed; 2 single campaigns): 90 %"), std::string::npos) << brief;
-  EXPECT_NE(brief.find("sized the old way, >= 5 sigma in some run: 1/2 = 50 %"), std::string::npos) << brief;
+  EXPECT_NE(brief.find("sized by the largest run, >= 5 sigma in some run: 1/2 = 50 %"), std::string::npos) << brief;
 }
 
 namespace {

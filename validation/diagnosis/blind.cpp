@@ -349,7 +349,7 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
 // the scored single family; the first two over the single family by the largest run's size
 // too.
 struct Shrinkages {
-  std::vector<double> residual_g, residual_sigma, gap, old_residual_g, old_residual_sigma;
+  std::vector<double> residual_g, residual_sigma, gap, largest_run_residual_g, largest_run_residual_sigma;
 };
 
 void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
@@ -359,13 +359,13 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
   score_family(k, k.effect_gap_sigma, s.families, &r.wrong);
   score_family(k, k.effect_max_sigma, s.by_max_run_sigma.families, nullptr);
   if (k.category == "single" && k.error.empty()) {  // the single family by the largest run's size
-    OldSizeScores& o = s.by_max_run_sigma;
+    LargestRunSizeScores& o = s.by_max_run_sigma;
     if (k.effect_max_sigma < 5) {
       ++o.small, o.small_right += called == k.hidden[0].name;
     } else {
       ++o.single, o.single_right += called == k.hidden[0].name;
-      if (d.rms_before_g > 0) sh.old_residual_g.push_back(1 - d.rms_after_g / d.rms_before_g);
-      if (d.rms_before_sigma > 0) sh.old_residual_sigma.push_back(1 - d.rms_after_sigma / d.rms_before_sigma);
+      if (d.rms_before_g > 0) sh.largest_run_residual_g.push_back(1 - d.rms_after_g / d.rms_before_g);
+      if (d.rms_before_sigma > 0) sh.largest_run_residual_sigma.push_back(1 - d.rms_after_sigma / d.rms_before_sigma);
     }
   } else if (k.category == "single") {
     ++s.by_max_run_sigma.single;  // an error counts against it
@@ -672,8 +672,8 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
   r.scores.gap_shrinkage_campaigns = static_cast<int>(sh.gap.size());
   r.scores.median_shrinkage = median(sh.residual_g);
   r.scores.median_shrinkage_in_sigma = median(sh.residual_sigma);
-  r.scores.by_max_run_sigma.median_shrinkage = median(sh.old_residual_g);
-  r.scores.by_max_run_sigma.median_shrinkage_in_sigma = median(sh.old_residual_sigma);
+  r.scores.by_max_run_sigma.median_shrinkage = median(sh.largest_run_residual_g);
+  r.scores.by_max_run_sigma.median_shrinkage_in_sigma = median(sh.largest_run_residual_sigma);
   return r;
 }
 
@@ -727,17 +727,17 @@ std::string BlindResult::BriefReport() const {
   const BlindScores& s = scores;
   std::string t = fmt::format("blind --n {} --seed {}: {:.1f} s wall on {} threads{}\n", settings.n, settings.seed, wall_s, threads,
                               ranks > 1 ? fmt::format(" x {} MPI ranks", ranks) : "");
-  const OldSizeScores& o = s.by_max_run_sigma;
+  const LargestRunSizeScores& o = s.by_max_run_sigma;
   t += "  a single or natural effect is scored when its gap is >= 5 sigma as the nominal model sees it (after the static "
        "test's coefficient uncertainty: effect_gap_sigma)\n";
   t += fmt::format("  top-1 attribution (single in-library effects, verdict 'explained by' the hidden one): {}/{} = {:.0f} %"
-                   " (sized the old way, >= 5 sigma in some run: {}/{} = {:.0f} %)\n",
+                   " (sized by the largest run, >= 5 sigma in some run: {}/{} = {:.0f} %)\n",
                    s.single_right, s.single, 100 * BlindScores::rate(s.single_right, s.single), o.single_right, o.single,
                    100 * BlindScores::rate(o.single_right, o.single));
   t += fmt::format("  hidden effect ranked first whatever the verdict: {}/{}\n", s.single_top_right, s.single);
   if (s.small > 0 || o.small > 0)
-    t += fmt::format("  single effects with a gap below 5 sigma (not scored): {}, explained right anyway {} (the old way, "
-                     "below 5 sigma in every run: {}, right {})\n",
+    t += fmt::format("  single effects with a gap below 5 sigma (not scored): {}, explained right anyway {} (sized by the "
+                     "largest run, below 5 sigma in every run: {}, right {})\n",
                      s.small, s.small_right, o.small, o.small_right);
   t += fmt::format("  false alarms on clean campaigns: {}/{}\n", s.false_alarms, s.clean);
   t += fmt::format("  out-of-library called unexplained: {}/{}\n", s.out_of_library_unexplained, s.out_of_library);
@@ -746,7 +746,7 @@ std::string BlindResult::BriefReport() const {
   t += fmt::format("  median held-out shrinkage of the gap rms (the lab's noise removed; {} single campaigns): {:.0f} %\n",
                    s.gap_shrinkage_campaigns, 100 * s.median_gap_shrinkage);
   t += fmt::format("  median held-out shrinkage of the residual rms (with each run's noise): {:.0f} %, in each run's sigma "
-                   "{:.0f} % (the old measure, on the old size's single family: {:.0f} %, {:.0f} %)\n",
+                   "{:.0f} % (on the single family sized by the largest run: {:.0f} %, {:.0f} %)\n",
                    100 * s.median_shrinkage, 100 * s.median_shrinkage_in_sigma, 100 * o.median_shrinkage,
                    100 * o.median_shrinkage_in_sigma);
   t += "Issue 15's rates (the 95 % interval is Clopper-Pearson's: what a run of this size can tell):\n";
@@ -756,7 +756,7 @@ std::string BlindResult::BriefReport() const {
                      c.n == 0 ? "no campaigns" : c.met() ? "met" : "not met");
   t += "Per family (right; right physics, not the right effect; unexplained; no gap; WRONG: explained by another physics):\n";
   t += FamilyTable();
-  t += "The single and natural families sized the old way (the largest run's gap in its sigma):\n";
+  t += "The single and natural families sized by the largest run (its gap in its sigma):\n";
   return t + family_rows(o.families, {"single", "single_below_5_sigma", "natural", "natural_below_5_sigma"});
 }
 

@@ -112,7 +112,7 @@ struct FamilyScore {
 
 // The families sized by the largest run (a single or natural campaign below 5 sigma in every run,
 // effect_max_sigma, is "_below_5_sigma"), kept beside the scored ones (effect_gap_sigma).
-struct OldSizeScores {
+struct LargestRunSizeScores {
   int single = 0, single_right = 0, small = 0, small_right = 0;
   double median_shrinkage = 0, median_shrinkage_in_sigma = 0;  // with the runs' noise, its single family
   std::map<std::string, FamilyScore> families;
@@ -131,7 +131,7 @@ struct BlindScores {
   double median_gap_shrinkage = 0;
   int gap_shrinkage_campaigns = 0;  // single campaigns it is the median of
   double median_shrinkage = 0, median_shrinkage_in_sigma = 0;
-  OldSizeScores by_max_run_sigma;  // the families by the largest run's size, beside
+  LargestRunSizeScores by_max_run_sigma;  // the families by the largest run's size, beside
   std::map<std::string, FamilyScore> families;  // per family (category)
   static double rate(int k, int of) { return of ? static_cast<double>(k) / of : 0.0; }
 };
