@@ -68,11 +68,12 @@ double run_input_rms_g(const validation::RunRecord& r) {
   return std::sqrt(s2);
 }
 
+// Each run as read; with its diagnosis (prediction, gap, z, held-out gaps) when d has one per run.
 json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
   json runs = json::array();
+  const bool diagnosed = d.runs.size() == c.runs.size();
   for (std::size_t k = 0; k < c.runs.size(); ++k) {
     const auto& r = c.runs[k];
-    const auto& x = d.runs[k];
     const VibrationKind kind =
         !r.random ? VibrationKind::sine : r.sine_part ? VibrationKind::sine_on_random : VibrationKind::random;
     runs.push_back({{"id", r.id},
@@ -83,16 +84,19 @@ json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
                     {"orientation_g", vec_json(r.orientation_g)},
                     {"measured_g", r.measured_g},
                     {"sigma_measured_g", r.sigma_g},
-                    {"predicted_g", x.predicted_g},
-                    {"sigma_predicted_g", x.sigma_predicted_g},
                     {"input_rms_g", run_input_rms_g(r)},
-                    {"measured_vrc_ug_per_g2", rectification::vrc_ug_per_g2(r.measured_g, run_input_rms_g(r))},
-                    {"predicted_vrc_ug_per_g2", rectification::vrc_ug_per_g2(x.predicted_g, run_input_rms_g(r))},
-                    {"gap_g", x.gap_g},
-                    {"adjusted_gap_g", x.adjusted_gap_g},
-                    {"z", x.z},
-                    {"heldout_before_g", x.heldout_before_g},
-                    {"heldout_after_g", x.heldout_after_g}});
+                    {"measured_vrc_ug_per_g2", rectification::vrc_ug_per_g2(r.measured_g, run_input_rms_g(r))}});
+    if (diagnosed) {
+      const auto& x = d.runs[k];
+      runs.back().update({{"predicted_g", x.predicted_g},
+                          {"sigma_predicted_g", x.sigma_predicted_g},
+                          {"predicted_vrc_ug_per_g2", rectification::vrc_ug_per_g2(x.predicted_g, run_input_rms_g(r))},
+                          {"gap_g", x.gap_g},
+                          {"adjusted_gap_g", x.adjusted_gap_g},
+                          {"z", x.z},
+                          {"heldout_before_g", x.heldout_before_g},
+                          {"heldout_after_g", x.heldout_after_g}});
+    }
     if (r.motion) {
       runs.back()["motion"] = to_json(r.motion->departure);
       runs.back()["motion"]["used_by_prediction"] = r.motion->used();
@@ -359,8 +363,14 @@ json to_json(const FolderDiagnosis& f) {
   j["settings"] = to_json(f.settings);
   j["settings"]["from"] = f.settings_from;
   j["wall_s"] = f.wall_s;
-  j.update(to_json(f.diagnosis, c));
-  if (f.diagnosis.runs_with_measured_motion > 0) j["motion"] = motion_summary_json(f.diagnosis, c);
+  if (f.diagnosed) {
+    j.update(to_json(f.diagnosis, c));
+    if (f.diagnosis.runs_with_measured_motion > 0) j["motion"] = motion_summary_json(f.diagnosis, c);
+  } else {  // read and checked only: the campaign as read, nothing judged
+    j["diagnosed"] = false;
+    j["skipped_runs"] = c.skipped;
+    j["runs"] = runs_json(f.diagnosis, c);
+  }
   j["units"] = {{"gap", "g"}, {"parameter", "see each effect's unit"}};
   return j;
 }

@@ -3,7 +3,8 @@
 // the CLI and the library's other users. Every result carries the settings that made it.
 //
 //   to_json(FolderDiagnosis)   `diagnose --json`: program, data, campaign, nominal dynamics,
-//                              settings, the diagnosis (per effect, pair and run), units
+//                              settings, the diagnosis (per effect, pair and run), units; a
+//                              folder read only (not diagnosed): the runs as read, "diagnosed": false
 //   to_json(BlindResult)       `blind`'s scores.json: settings, scores, confusion, campaigns
 //   confusion_csv(BlindResult) `blind`'s confusion.csv: rows the truth, columns what was called
 #include <string>
