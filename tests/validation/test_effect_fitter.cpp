@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -223,6 +224,60 @@ TEST(EffectFitter, FindsTheOptimumOfANarrowValleyFromFarOff) {
   EXPECT_NEAR(mf.values[0], static_cast<double>(g.theta(0)), 1e-3 * s0);
   EXPECT_NEAR(mf.values[1], static_cast<double>(g.theta(1)), 1e-3 * s1);
   EXPECT_NEAR(mf.sigma[1], s1, 1e-3 * s1);
+}
+
+// A curved valley (Rosenbrock's banana): -2 ln L = K [ratio (b - a^2)^2 + (a - 1)^2] + the prior
+// on a, b the first (linear) parameter, a the further one. Runs 0..9 see ratio x (b - a^2),
+// runs 10..19 see a (the predictions' coefficients chosen so), with exact data at a = b = 1, G
+// zero (V = diag(sigma^2), ln det V constant). The closed form: for each a the best b is a^2
+// (the first term vanishes), so a* = (K + w a0) / (K + w) (w the prior's weight, a0 its
+// nominal) and b* = a*^2; the marginal sigmas from the Hessian there. From the start (a at its
+// nominal 0, b fitted there: 0, the bottom of the floor) the floor bends up to (1, 1); b's
+// difference step is about 6 of its conditional sigma, so the differences straddle the walls.
+// Levenberg-Marquardt's damped steps creep along the bend and stop short within their 15
+// iterations (seen with the valley step switched off: 1.2 marginal sigma short in a and b);
+// the valley step (Newton's step on the local Hessian, backtracked) follows the floor to its
+// end (seen: 7e-4 sigma). The descent stops when its step is below 1e-3 of each conditional
+// sigma, which in this valley leaves more in the marginal one: 1e-2 of the marginal sigma.
+TEST(EffectFitter, FollowsACurvedValleyToItsOptimum) {
+  const Eigen::Index n = 20, half = 10;
+  const double sigma = 0.05, K = 4000, ratio = 100;
+  // sum over each half of (coefficient / sigma)^2: ratio K and K.
+  const double c_floor = std::sqrt(ratio * K / half) * sigma, c_a = std::sqrt(K / half) * sigma;
+  Problem p;
+  p.f0 = Eigen::VectorXd::Constant(n, 1e-3);
+  p.S = Eigen::MatrixXd::Zero(n, 2);
+  p.data.sigma2 = Eigen::VectorXd::Constant(n, sigma * sigma);
+  p.data.Sigma = Eigen::MatrixXd::Identity(2, 2);
+  const auto pred_at = [&](double b, double a) {
+    Eigen::VectorXd pr = p.f0;
+    pr.head(half).array() += c_floor * (b - a * a);
+    pr.tail(n - half).array() += c_a * a;
+    return pr;
+  };
+  const double a0 = 0, prior_sigma = 10, w = 1 / (prior_sigma * prior_sigma);
+  p.nominal = {pred_at(0, a0), Eigen::MatrixXd::Zero(n, 2)};  // the parameters at their nominal
+  p.data.measured = pred_at(1, 1);
+  for (Eigen::Index k = 0; k < n; ++k) p.all.push_back(static_cast<int>(k));
+  EffectParameter a_par = further(-5, 5, prior_sigma, 0.01);
+  a_par.nominal = a0;
+  const Effect e = effect_of({linear_first(-10, 10), a_par});
+  const EffectFitter fitter(e, p.nominal, [&](const std::vector<double>& v) { return Table{pred_at(v[0], v[1]), p.nominal.G}; });
+  const long double a_opt = (static_cast<long double>(K) + w * a0) / (K + w), b_opt = a_opt * a_opt;
+  // The marginal sigmas from the Hessian at the optimum, half of it being
+  // [[R, -2 a R], [-2 a R, 4 a^2 R + K + w]] with R = ratio K (b first).
+  const long double R = static_cast<long double>(ratio) * K;
+  MatrixL Hh(2, 2);
+  Hh << R, -2 * a_opt * R, -2 * a_opt * R, 4 * a_opt * a_opt * R + K + w;
+  const MatrixL C = Hh.inverse();
+  const double sb = std::sqrt(static_cast<double>(C(0, 0))), sa = std::sqrt(static_cast<double>(C(1, 1)));
+  const EffectFitter::Multi mf = fitter.fit_all(p.data, p.all);
+  ASSERT_EQ(mf.status.size(), 2u);
+  EXPECT_EQ(mf.status[1], ParameterStatus::fitted);
+  std::printf("  end a %.9g b %.9g; closed form a %.9g b %.9g (sigma %.3g, %.3g)\n", mf.values[1], mf.values[0],
+              static_cast<double>(a_opt), static_cast<double>(b_opt), sa, sb);
+  EXPECT_NEAR(mf.values[1], static_cast<double>(a_opt), 1e-2 * sa);
+  EXPECT_NEAR(mf.values[0], static_cast<double>(b_opt), 1e-2 * sb);
 }
 
 // The unconstrained optimum outside the range: the first parameter ends on its upper edge
