@@ -17,7 +17,6 @@ namespace vrelab {
 namespace {
 
 using plant::PlantConfig;
-constexpr double kG = 9.80665;
 
 vibration::SineVibration sine(const Vec3& amplitude_g, double f_Hz) {
   vibration::SineVibration v;

@@ -130,7 +130,6 @@ TEST(SettingsDescription, EveryFieldArrivesThroughTheManifestsDiagnoseTable) {
 TEST(SettingsDescription, EveryFieldArrivesThroughTheCommandLine) {
   int fields = 0;
   const Settings want = all_other(&fields);
-  const Settings d;
   std::vector<std::string> args;  // CLI11 parses a reversed vector
   core::for_each_field<Settings>([&](const auto& f) {
     using T = typename std::decay_t<decltype(f)>::Type;
