@@ -721,8 +721,8 @@ FrequencyStudy frequency(const Case& c) {
   require(c, c.coefficients.has_value(), "coefficients", "frequency");
   require(c, c.orientation_g.has_value(), "orientation", "frequency");
   FrequencyStudy s;
-  s.settings = c.frequency_study.value_or(rectification::FrequencyStudySettings{
-      rectification::spaced(1, 5000, 80, true), rectification::spaced(1, 5000, 10, true)});
+  if (c.frequency_study) s.settings = *c.frequency_study;
+  else rectification::FrequencyGrid{}.apply(s.settings);  // no table: the grid's defaults
   if (std::string why; !s.settings.IsValid(&why)) throw FormatError(table_of(c, "frequency_study"), why);
   const auto start = std::chrono::steady_clock::now();
   s.curves = rectification::frequency_study(c.plant, *c.orientation_g, s.settings);
