@@ -23,6 +23,8 @@
 #include "rectification/prediction/frequency_study.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/files.hpp"
+#include "validation/diagnosis/blind.hpp"
+#include "validation/diagnosis/settings.hpp"
 
 using namespace vrelab;
 namespace fs = std::filesystem;
@@ -151,6 +153,9 @@ TEST(CaseSettings, EachDescriptionListsEveryMemberOfItsStruct) {
             core::field_count<rectification::FrequencyStudySettings>());
   EXPECT_EQ(member_count<rectification::FrequencyGrid>(), core::field_count<rectification::FrequencyGrid>());
   EXPECT_EQ(member_count<plant::SolverSettings>(), core::field_count<plant::SolverSettings>());
+  // The structs described before these (validation/diagnosis), by the same count.
+  EXPECT_EQ(member_count<validation::DiagnoseSettings>(), core::field_count<validation::DiagnoseSettings>());
+  EXPECT_EQ(member_count<validation::BlindSettings>(), core::field_count<validation::BlindSettings>());
   // And the JSON record holds them by the names written here by hand (the documented keys).
   using V = std::vector<std::string>;
   EXPECT_EQ(keys_of(io::settings_json(rectification::Readout{})),
