@@ -13,7 +13,11 @@
 // (a generic lambda); a field whose type is itself described (has Describe) is a nested table.
 // A field's type: bool, an integer, a floating-point number, a string, a list of numbers
 // (std::vector<double>, the range applying to each), a fixed-size vector (Eigen's Vec3,
-// written [IA, PA, OA]) or a described struct.
+// written [IA, PA, OA]), an array of optional numbers (std::array<std::optional<double>, N>,
+// e.g. the coefficients held fixed; the range applying to each one set) or a described struct.
+// A type of its own (a position, a named vector) is a field too where the adapter that
+// writes it has a converter for it (io/formats/settings_json.hpp's JsonValue); its range is
+// any_value and its checks are the struct's IsValid's.
 //
 // Where the file does not hold the member as it is, the description still says so, once:
 //  - .scaled(k): the member holds the value as written times k (a [readout] states noise in
@@ -32,11 +36,13 @@
 // and Overrides<S> (fields set on top of other settings, e.g. from a command line). The
 // adapters to TOML, JSON, CLI11 and Python live with those libraries and iterate Describe.
 // Standard library only.
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -74,6 +80,11 @@ concept FixedVector = requires(const T& v) {
 } && (T::SizeAtCompileTime > 0);
 template <class T>
 inline constexpr bool is_number_list = std::is_same_v<T, std::vector<double>>;
+// An array of optional numbers (a value per slot or none).
+template <class T>
+inline constexpr bool is_optional_numbers = false;
+template <std::size_t N>
+inline constexpr bool is_optional_numbers<std::array<std::optional<double>, N>> = true;
 
 // One field of S of type T.
 template <class S, class T>
@@ -172,10 +183,16 @@ std::string format_value(const T& x, int precision = 0) {
     std::string t = "[";
     for (int i = 0; i < static_cast<int>(x.size()); ++i) t += (i ? ", " : "") + format_value(static_cast<double>(x[i]), precision);
     return t + "]";
+  } else if constexpr (is_optional_numbers<T>) {
+    std::string t = "[";
+    for (std::size_t i = 0; i < x.size(); ++i) t += (i ? ", " : "") + (x[i] ? format_value(*x[i], precision) : std::string("none"));
+    return t + "]";
   } else if constexpr (std::is_same_v<T, std::string>) {
     return "\"" + x + "\"";
-  } else {
+  } else if constexpr (std::is_arithmetic_v<T>) {
     return std::to_string(x);
+  } else {
+    return "(a value of its own type)";  // a type with a converter: never out of range here
   }
 }
 
@@ -220,6 +237,10 @@ bool admissible_value(const F& f, const T& w) {
     for (int i = 0; i < static_cast<int>(w.size()); ++i)
       if (!admissible_value(f, static_cast<double>(w[i]))) return false;
     return true;
+  } else if constexpr (is_optional_numbers<T>) {
+    for (const auto& e : w)
+      if (e && !admissible_value(f, *e)) return false;
+    return true;
   } else {
     return true;
   }
@@ -239,6 +260,12 @@ std::string range_error_written(const F& f, const T& w) {
       if (!admissible_value(f, static_cast<double>(w[i])))
         return std::string(f.name) + "[" + std::to_string(i) + "] = " + format_value(static_cast<double>(w[i])) +
                ": must be " + range_text(f.range, f.unit);
+    return std::string(f.name) + ": must be " + range_text(f.range, f.unit);
+  } else if constexpr (is_optional_numbers<T>) {
+    for (std::size_t i = 0; i < w.size(); ++i)
+      if (w[i] && !admissible_value(f, *w[i]))
+        return std::string(f.name) + "[" + std::to_string(i) + "] = " + format_value(*w[i]) + ": must be " +
+               range_text(f.range, f.unit);
     return std::string(f.name) + ": must be " + range_text(f.range, f.unit);
   } else {
     return std::string(f.name) + " = " + format_value(w) + ": must be " + range_text(f.range, f.unit);

@@ -8,6 +8,12 @@
 // record of the settings used can be read and run again; it throws std::invalid_argument
 // naming the key for an unknown key or a value of the wrong type, and does not check ranges
 // (the struct's IsValid does).
+//
+// A field of a type of its own (the coefficients held fixed, a position, a named vector) is
+// written and read by JsonValue<T>, specialised beside the type's other io
+// (io/formats/validation_json.hpp); a struct with such a field is written where that header
+// is included (else a compile error names the type).
+#include <concepts>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -18,6 +24,16 @@
 
 namespace vrelab::io {
 
+// JsonValue<T>::to(x) gives the JSON of x; JsonValue<T>::from(j, x) sets x from it, throwing
+// std::invalid_argument saying what is wrong (the caller prefixes the key).
+template <class T>
+struct JsonValue;
+template <class T>
+concept HasJsonValue = requires(const T& x, T& y, const nlohmann::json& j) {
+  { JsonValue<T>::to(x) } -> std::convertible_to<nlohmann::json>;
+  JsonValue<T>::from(j, y);
+};
+
 template <class S>
 nlohmann::json settings_json(const S& s) {
   nlohmann::json j = nlohmann::json::object();
@@ -26,11 +42,15 @@ nlohmann::json settings_json(const S& s) {
     const T& x = s.*f.member;
     if constexpr (core::Described<T>) {
       j[std::string(f.name)] = settings_json(x);
+    } else if constexpr (HasJsonValue<T>) {
+      j[std::string(f.name)] = JsonValue<T>::to(x);
     } else if constexpr (core::FixedVector<T>) {
       nlohmann::json a = nlohmann::json::array();
       for (int i = 0; i < T::SizeAtCompileTime; ++i) a.push_back(x[i]);
       j[std::string(f.name)] = a;
     } else {
+      static_assert(std::is_arithmetic_v<T> || std::is_same_v<T, std::string> || core::is_number_list<T>,
+                    "settings_json: a field type without JsonValue<T> (include its io/formats header)");
       j[std::string(f.name)] = core::written(f, x);
     }
   });
@@ -54,6 +74,12 @@ void settings_from_json(const nlohmann::json& j, S& s, const std::string& prefix
     try {
       if constexpr (core::Described<T>) {
         settings_from_json(v, x, prefix + key + ".");
+      } else if constexpr (HasJsonValue<T>) {
+        try {
+          JsonValue<T>::from(v, x);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(prefix + key + ": " + e.what());
+        }
       } else if constexpr (core::FixedVector<T>) {
         if (!v.is_array() || static_cast<int>(v.size()) != T::SizeAtCompileTime) throw std::invalid_argument("size");
         for (int i = 0; i < T::SizeAtCompileTime; ++i) x[i] = v[static_cast<std::size_t>(i)].template get<double>();

@@ -6,6 +6,7 @@
 
 #include "io/formats/output.hpp"
 #include "io/formats/settings_json.hpp"
+#include "io/formats/validation_json.hpp"
 #include "rectification/measurement/vrc.hpp"
 
 namespace vrelab::io {
@@ -169,10 +170,10 @@ json identify_json(const Case& c, const IdentifyStudy& s) {
   const DividingHead& head = *c.dividing_head;
   const int mc = s.settings.monte_carlo_trials;
   json j = result_record("identify", c);
-  j["settings"] = {{"monte_carlo_trials", mc},
-                   {"monte_carlo_seed", mc > 0 ? json(c.seed + 1) : json(nullptr)},
-                   {"least_squares_weights", "1 / first-order variance of each reading"},
-                   {"rank_tolerance", 1e-10}};
+  j["settings"] = settings_json(s.settings);  // as described, and what the program fixes:
+  j["settings"]["monte_carlo_seed"] = mc > 0 ? json(s.settings.seed + 1) : json(nullptr);
+  j["settings"]["least_squares_weights"] = "1 / first-order variance of each reading";
+  j["settings"]["rank_tolerance"] = 1e-10;
   json units = json::object();
   for (int i = 0; i < kNumCoefficients; ++i) units[std::string(plant::coefficient_name(i))] = unit_of(i, c);
   j["units"] = units;

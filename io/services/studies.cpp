@@ -81,9 +81,10 @@ IdentifyStudy identify(const Case& c, int monte_carlo_trials, const std::string&
     s.settings.monte_carlo_checkpoint.fingerprint = fmt::format(
         "case+program {:016x}", fnv1a(c.content.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + kProgramVersion + kGitDescribe));
   }
+  validation::OutputSource source;  // empty: model (1)
   if (head.from_ode) {
     const plant::PlantConfig plant = c.plant;
-    s.settings.source = [plant](const Vec3& a) { return plant.coefficients[plant::K1] * plant::settled_output_g(plant, a); };
+    source = [plant](const Vec3& a) { return plant.coefficients[plant::K1] * plant::settled_output_g(plant, a); };
   }
   if (std::string why; !s.settings.IsValid(&why)) throw InputError(c.path + ": --monte-carlo: " + why);
   // Identifiability first: a rank-deficient set is reported in words, not solved into noise.
@@ -98,7 +99,7 @@ IdentifyStudy identify(const Case& c, int monte_carlo_trials, const std::string&
            "from another test and assumes k_PP = k_OO = 0), or add positions.";
     throw InputError(msg);
   }
-  s.report = validation::run_static_test(*c.coefficients, head.positions, head.errors, s.settings);
+  s.report = validation::run_static_test(*c.coefficients, head.positions, head.errors, s.settings, source);
   return s;
 }
 

@@ -1,6 +1,7 @@
 // The case file's settings structs described once (core/settings_description.hpp): ShakeSettings
 // with its Readout, FrequencyStudySettings with the FrequencyGrid it is read through, and
-// SolverSettings. A range is enforced from the case file with the file, the line, the table
+// SolverSettings, and StaticTestSettings with its MonteCarloCheckpoint (no table: recorded and
+// validated only; the coefficients held fixed through JsonValue). A range is enforced from the case file with the file, the line, the table
 // and the key in the message; a scaled key ([readout] noise_sigma_ug) arrives in g and is
 // recorded as written; each struct's JSON record reads back to the same struct; and each
 // description lists every member of its struct (counted from the aggregate itself), so a
@@ -10,6 +11,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -19,12 +22,14 @@
 #include "io/formats/case_file.hpp"
 #include "io/formats/error.hpp"
 #include "io/formats/settings_json.hpp"
+#include "io/formats/validation_json.hpp"
 #include "plant/ode_solver.hpp"
 #include "rectification/prediction/frequency_study.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/files.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/settings.hpp"
+#include "validation/identification/static_test.hpp"
 
 using namespace vrelab;
 namespace fs = std::filesystem;
@@ -67,6 +72,11 @@ T other_value(const F& f, const T& d) {
   } else if constexpr (core::FixedVector<T>) {
     T v = d;
     for (int i = 0; i < T::SizeAtCompileTime; ++i) v[i] = d[i] + 0.5 * (i + 1);
+    return v;
+  } else if constexpr (core::is_optional_numbers<T>) {
+    T v = d;  // the first slot set or changed, the last unset or cleared
+    v.front() = v.front() ? *v.front() + 0.5 : 0.75;
+    v.back() = v.back() ? std::nullopt : std::optional<double>(-1.5);
     return v;
   } else {
     return d;
@@ -156,6 +166,10 @@ TEST(CaseSettings, EachDescriptionListsEveryMemberOfItsStruct) {
   // The structs described before these (validation/diagnosis), by the same count.
   EXPECT_EQ(member_count<validation::DiagnoseSettings>(), core::field_count<validation::DiagnoseSettings>());
   EXPECT_EQ(member_count<validation::BlindSettings>(), core::field_count<validation::BlindSettings>());
+  // The static test's (no table of its own: every field set from elsewhere).
+  EXPECT_EQ(member_count<validation::StaticTestSettings>(), core::field_count<validation::StaticTestSettings>());
+  EXPECT_EQ(member_count<validation::MonteCarloCheckpoint>(), core::field_count<validation::MonteCarloCheckpoint>());
+  EXPECT_TRUE(core::table_keys<validation::StaticTestSettings>().empty());
   // And the JSON record holds them by the names written here by hand (the documented keys).
   using V = std::vector<std::string>;
   EXPECT_EQ(keys_of(io::settings_json(rectification::Readout{})),
@@ -168,12 +182,17 @@ TEST(CaseSettings, EachDescriptionListsEveryMemberOfItsStruct) {
   EXPECT_EQ(keys_of(io::settings_json(rectification::FrequencyGrid{})), (V{"from_Hz", "ode_points", "points", "to_Hz"}));
   EXPECT_EQ(keys_of(io::settings_json(plant::SolverSettings{})),
             (V{"absolute_tolerance", "analytic_jacobian", "max_step_s", "max_steps", "relative_tolerance"}));
+  EXPECT_EQ(keys_of(io::settings_json(validation::StaticTestSettings{})),
+            (V{"fixed", "monte_carlo_checkpoint", "monte_carlo_trials", "seed"}));
+  EXPECT_EQ(keys_of(io::settings_json(validation::MonteCarloCheckpoint{})), (V{"fingerprint", "path"}));
 }
 
+// adjust: for a struct whose IsValid asks more than the ranges (StaticTestSettings: not 1 trial).
 template <class S>
-void expect_round_trip(const std::string& name) {
+void expect_round_trip(const std::string& name, void (*adjust)(S&) = nullptr) {
   SCOPED_TRACE(name);
-  const S s = all_other<S>();
+  S s = all_other<S>();
+  if (adjust) adjust(s);
   std::string why;
   EXPECT_TRUE(s.IsValid(&why)) << why;
   const nlohmann::json j = io::settings_json(s);
@@ -190,6 +209,21 @@ TEST(CaseSettings, EachJsonRecordReadsBackToTheSameSettings) {
   expect_round_trip<rectification::FrequencyStudySettings>("FrequencyStudySettings");
   expect_round_trip<rectification::FrequencyGrid>("FrequencyGrid");
   expect_round_trip<plant::SolverSettings>("SolverSettings");
+  expect_round_trip<validation::MonteCarloCheckpoint>("MonteCarloCheckpoint");
+  expect_round_trip<validation::StaticTestSettings>("StaticTestSettings",
+                                                    [](validation::StaticTestSettings& s) { s.monte_carlo_trials = 16; });
+  // The coefficients held fixed by name; a name that is not a coefficient is refused, by name.
+  validation::StaticTestSettings st;
+  io::settings_from_json(nlohmann::json{{"fixed", {{"k1_asym", 2e-5}, {"k_PP", 0}}}}, st);
+  EXPECT_EQ(st.fixed[plant::k1_asym], 2e-5);
+  EXPECT_EQ(st.fixed[plant::k_PP], 0.0);
+  EXPECT_FALSE(st.fixed[plant::k0]);
+  try {
+    io::settings_from_json(nlohmann::json{{"fixed", {{"k_XX", 1}}}}, st);
+    ADD_FAILURE() << "an unknown coefficient read";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("fixed: 'k_XX' is not a coefficient"), std::string::npos) << e.what();
+  }
   // A key the description does not hold is refused, by name.
   rectification::ShakeSettings s;
   EXPECT_THROW(io::settings_from_json(nlohmann::json{{"blockz", 3}}, s), std::invalid_argument);
@@ -268,4 +302,13 @@ TEST(CaseSettings, IsValidFollowsTheDescribedRanges) {
   v.absolute_tolerance = {1e-9, 0.0};
   EXPECT_FALSE(v.IsValid(&why));
   EXPECT_EQ(why, "absolute_tolerance[1] = 0: must be a positive number of state units");
+  validation::StaticTestSettings st;
+  EXPECT_TRUE(st.IsValid(&why)) << why;
+  st.monte_carlo_trials = 1;
+  EXPECT_FALSE(st.IsValid(&why));
+  EXPECT_EQ(why, "monte_carlo_trials: needs at least 2 trials (or 0 for none)");
+  st = {};
+  st.monte_carlo_checkpoint.fingerprint = "two\nlines";
+  EXPECT_FALSE(st.IsValid(&why));
+  EXPECT_EQ(why, "monte_carlo_checkpoint.fingerprint: must be one line");
 }
