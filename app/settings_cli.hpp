@@ -3,7 +3,8 @@
 // as CLI11 flags: `--threshold-sigma S` for a field threshold_sigma, the help text, the range
 // and the default from the description. A bool field gives `--name` (true) and `--no-name`
 // (false), its alias (e.g. --no-pairs) naming the flag that sets the non-default. A field
-// whose type is described (a nested table) gets no flag.
+// whose type is described (a nested table), a list, a vector or a field set from elsewhere
+// (set_by) gets no flag; a scaled field's flag takes the value as written.
 //
 // add_override_flags sets a core::Overrides (the value given wins over a manifest's);
 // add_settings_flags sets the struct itself. Ranges are not checked here: the struct's
@@ -33,7 +34,7 @@ std::string cli_help(const F& f, const S& defaults) {
     const core::Range& r = f.range;
     if (r.has_min || r.has_max) h += "; " + core::range_text(r, f.unit);
   }
-  return h + " (default " + core::format_value(defaults.*f.member) + ")";
+  return h + " (default " + core::format_value(core::written(f, defaults.*f.member)) + ")";
 }
 
 // set(field, value) for each flag given.
@@ -42,7 +43,9 @@ void add_described_flags(CLI::App* cmd, const Set& set) {
   const S defaults{};
   core::for_each_field<S>([&](const auto& f) {
     using T = typename std::decay_t<decltype(f)>::Type;
-    if constexpr (core::Described<T>) {
+    if constexpr (core::Described<T> || core::is_number_list<T> || core::FixedVector<T>) {
+      return;
+    } else if (!f.in_table()) {
       return;
     } else if constexpr (std::is_same_v<T, bool>) {
       const bool d = defaults.*f.member;
@@ -52,7 +55,7 @@ void add_described_flags(CLI::App* cmd, const Set& set) {
       cmd->add_flag_callback(on, [set, f] { set(f, true); }, std::string(f.help) + (d ? " (default)" : ""));
       cmd->add_flag_callback(off, [set, f] { set(f, false); }, "Opposite of " + cli_flag(f) + (d ? "" : " (default)"));
     } else {
-      cmd->add_option_function<T>(cli_flag(f), [set, f](const T& x) { set(f, x); }, cli_help(f, defaults));
+      cmd->add_option_function<T>(cli_flag(f), [set, f](const T& x) { set(f, core::held(f, x)); }, cli_help(f, defaults));
     }
   });
 }

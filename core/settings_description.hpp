@@ -11,22 +11,44 @@
 // with '-' for '_'), its member, its unit ("" for a pure number), its range and a help text.
 // The default is the member's initialiser (S{}). A visitor is any callable taking each Field
 // (a generic lambda); a field whose type is itself described (has Describe) is a nested table.
+// A field's type: bool, an integer, a floating-point number, a string, a list of numbers
+// (std::vector<double>, the range applying to each), a fixed-size vector (Eigen's Vec3,
+// written [IA, PA, OA]), an array of optional numbers (std::array<std::optional<double>, N>,
+// e.g. the coefficients held fixed; the range applying to each one set) or a described struct.
+// A type of its own (a position, a named vector) is a field too where the adapter that
+// writes it has a converter for it (io/formats/settings_json.hpp's JsonValue); its range is
+// any_value and its checks are the struct's IsValid's.
+//
+// Where the file does not hold the member as it is, the description still says so, once:
+//  - .scaled(k): the member holds the value as written times k (a [readout] states noise in
+//    ug, the struct holds g: scaled(1e-6); numbers and lists); the name, unit and range are
+//    the written ones, and the readers and writers (TOML, JSON, CLI) use the written value;
+//  - .set_by("..."): the member is not a key of the struct's table (nor a flag or keyword):
+//    another table or a reader's conversion sets it (a grid from from_Hz/to_Hz/points, the
+//    readout's seed from [run] seed), as the text says; it is still recorded and validated.
+// A scale keeps every adapter the same code; a derived field that is a function of several
+// keys (a frequency grid) is better described by a small "as written" struct of those keys
+// with one conversion function beside the settings (e.g. FrequencyGrid beside
+// FrequencyStudySettings): the keys stay plain fields and the conversion has one home.
 //
 // This header gives what needs no file format: validate (IsValid from the ranges, the
 // message naming the field, its value and the rule), format_value, field lookup by member,
 // and Overrides<S> (fields set on top of other settings, e.g. from a command line). The
 // adapters to TOML, JSON, CLI11 and Python live with those libraries and iterate Describe.
 // Standard library only.
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <type_traits>
 #include <utility>
+#include <vector>
 
 namespace vrelab::core {
 
@@ -48,6 +70,21 @@ inline Range at_least(double a) { return {true, false, false, false, a, 0}; }  /
 inline Range closed(double a, double b) { return {true, true, false, false, a, b}; }       // [a, b]
 inline Range closed_open(double a, double b) { return {true, true, false, true, a, b}; }   // [a, b)
 inline Range open_closed(double a, double b) { return {true, true, true, false, a, b}; }   // (a, b]
+inline Range open(double a, double b) { return {true, true, true, true, a, b}; }           // (a, b)
+
+// A fixed-size vector of doubles (Eigen's Vec3), known without including Eigen.
+template <class T>
+concept FixedVector = requires(const T& v) {
+  T::SizeAtCompileTime;
+  v[0];
+} && (T::SizeAtCompileTime > 0);
+template <class T>
+inline constexpr bool is_number_list = std::is_same_v<T, std::vector<double>>;
+// An array of optional numbers (a value per slot or none).
+template <class T>
+inline constexpr bool is_optional_numbers = false;
+template <std::size_t N>
+inline constexpr bool is_optional_numbers<std::array<std::optional<double>, N>> = true;
 
 // One field of S of type T.
 template <class S, class T>
@@ -60,12 +97,53 @@ struct Field {
   Range range;
   std::string_view help;
   std::string_view alias;  // another CLI flag name; for a bool the one that sets the non-default
+  double scale = 1;        // the member holds the written value times this (see the header's note)
+  std::string_view set_by_text;  // non-empty: not a key of the table, set as this says
+
+  Field scaled(double k) const {
+    Field f = *this;
+    f.scale = k;
+    return f;
+  }
+  Field set_by(std::string_view how) const {
+    Field f = *this;
+    f.set_by_text = how;
+    return f;
+  }
+  // A key of the struct's table (a flag, a keyword), not set from elsewhere.
+  bool in_table() const { return set_by_text.empty(); }
 };
+
+// The member's value as written (in the field's unit) and back.
+// A scaled value is written to 15 significant digits: x / k's last-bit noise dropped, so a
+// value read from a file (w, held as w * k) is written as w again and reads back to x.
+template <class F, class T>
+T written(const F& f, const T& x) {
+  if constexpr (std::is_floating_point_v<T>) {
+    if (f.scale == 1) return x;
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.15g", static_cast<double>(x / f.scale));
+    return static_cast<T>(std::strtod(buf, nullptr));
+  } else if constexpr (is_number_list<T>) {
+    T w = x;
+    for (double& e : w) e = written(f, e);
+    return w;
+  } else return x;
+}
+template <class F, class T>
+T held(const F& f, const T& w) {
+  if constexpr (std::is_floating_point_v<T>) return f.scale == 1 ? w : w * f.scale;
+  else if constexpr (is_number_list<T>) {
+    T x = w;
+    for (double& e : x) e = held(f, e);
+    return x;
+  } else return w;
+}
 
 template <class S, class T>
 Field<S, T> field(std::string_view name, T S::*member, std::string_view unit, Range range, std::string_view help,
                   std::string_view alias = {}) {
-  return {name, member, unit, range, help, alias};
+  return {name, member, unit, range, help, alias, 1, {}};
 }
 
 struct AnyVisitor {
@@ -101,8 +179,20 @@ std::string format_value(const T& x, int precision = 0) {
     if (e == std::string::npos || exponent < -4 || exponent >= 16) return s;
     const auto fixed = std::to_chars(buf, buf + sizeof buf, x, std::chars_format::fixed);
     return std::string(buf, fixed.ptr);
-  } else {
+  } else if constexpr (is_number_list<T> || FixedVector<T>) {
+    std::string t = "[";
+    for (int i = 0; i < static_cast<int>(x.size()); ++i) t += (i ? ", " : "") + format_value(static_cast<double>(x[i]), precision);
+    return t + "]";
+  } else if constexpr (is_optional_numbers<T>) {
+    std::string t = "[";
+    for (std::size_t i = 0; i < x.size(); ++i) t += (i ? ", " : "") + (x[i] ? format_value(*x[i], precision) : std::string("none"));
+    return t + "]";
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    return "\"" + x + "\"";
+  } else if constexpr (std::is_arithmetic_v<T>) {
     return std::to_string(x);
+  } else {
+    return "(a value of its own type)";  // a type with a converter: never out of range here
   }
 }
 
@@ -132,27 +222,68 @@ inline std::string range_text(const Range& r, std::string_view unit) {
   return t;
 }
 
-// Whether x is admissible for f: in its range and, for a floating-point field with a range,
-// finite.
-template <class F>
-bool admissible(const F& f, const typename F::Type& x) {
-  using T = typename F::Type;
+// Whether the written value w is admissible for f: in its range and, for a floating-point
+// field with a range, finite; a list of numbers or a vector element by element.
+template <class F, class T>
+bool admissible_value(const F& f, const T& w) {
   if constexpr (std::is_same_v<T, bool>) {
     return true;
   } else if constexpr (std::is_arithmetic_v<T>) {
     const bool bounded = f.range.has_min || f.range.has_max;
     if constexpr (std::is_floating_point_v<T>)
-      if (bounded && !std::isfinite(x)) return false;
-    return f.range.contains(static_cast<double>(x));
+      if (bounded && !std::isfinite(w)) return false;
+    return f.range.contains(static_cast<double>(w));
+  } else if constexpr (is_number_list<T> || FixedVector<T>) {
+    for (int i = 0; i < static_cast<int>(w.size()); ++i)
+      if (!admissible_value(f, static_cast<double>(w[i]))) return false;
+    return true;
+  } else if constexpr (is_optional_numbers<T>) {
+    for (const auto& e : w)
+      if (e && !admissible_value(f, *e)) return false;
+    return true;
   } else {
     return true;
   }
 }
+// Whether the member's value x is admissible for f (its written value in the range).
+template <class F>
+bool admissible(const F& f, const typename F::Type& x) {
+  return admissible_value(f, written(f, x));
+}
 
-// "name = value: must be RULE", the message of a value out of its field's range.
+// "name = value: must be RULE", the message of a value out of its field's range (the value
+// as written; a list's first element out of range as name[i]).
+template <class F, class T>
+std::string range_error_written(const F& f, const T& w) {
+  if constexpr (is_number_list<T> || FixedVector<T>) {
+    for (int i = 0; i < static_cast<int>(w.size()); ++i)
+      if (!admissible_value(f, static_cast<double>(w[i])))
+        return std::string(f.name) + "[" + std::to_string(i) + "] = " + format_value(static_cast<double>(w[i])) +
+               ": must be " + range_text(f.range, f.unit);
+    return std::string(f.name) + ": must be " + range_text(f.range, f.unit);
+  } else if constexpr (is_optional_numbers<T>) {
+    for (std::size_t i = 0; i < w.size(); ++i)
+      if (w[i] && !admissible_value(f, *w[i]))
+        return std::string(f.name) + "[" + std::to_string(i) + "] = " + format_value(*w[i]) + ": must be " +
+               range_text(f.range, f.unit);
+    return std::string(f.name) + ": must be " + range_text(f.range, f.unit);
+  } else {
+    return std::string(f.name) + " = " + format_value(w) + ": must be " + range_text(f.range, f.unit);
+  }
+}
 template <class F>
 std::string range_error(const F& f, const typename F::Type& x) {
-  return std::string(f.name) + " = " + format_value(x) + ": must be " + range_text(f.range, f.unit);
+  return range_error_written(f, written(f, x));
+}
+
+// The names of S's fields that are keys of its table (not set_by), in Describe's order.
+template <class S>
+std::vector<std::string_view> table_keys() {
+  std::vector<std::string_view> k;
+  for_each_field<S>([&](const auto& f) {
+    if (f.in_table()) k.push_back(f.name);
+  });
+  return k;
 }
 
 // True when each field of s is in its range (nested tables checked through their own

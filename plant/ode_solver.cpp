@@ -24,19 +24,6 @@ std::string describe_flag(int flag) {
 
 }  // namespace
 
-bool SolverSettings::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& m) {
-    if (error) *error = m;
-    return false;
-  };
-  if (!(relative_tolerance > 0 && relative_tolerance < 1)) return fail("relative_tolerance must lie in (0, 1)");
-  for (double a : absolute_tolerance)
-    if (!(a > 0) || !std::isfinite(a)) return fail("every absolute tolerance must be positive and finite");
-  if (!(max_step_s >= 0)) return fail("max_step_s must not be negative");
-  if (max_steps < 1) return fail("max_steps must be positive");
-  return true;
-}
-
 SolverError::SolverError(const std::string& c, int f, double t, const std::string& detail)
     : std::runtime_error([&] {
         std::ostringstream s;

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "core/settings_description.hpp"
+
 namespace vrelab::plant {
 
 class OdeSystem {
@@ -30,6 +32,9 @@ class OdeSystem {
   virtual void jacobian(double /*t_s*/, const double* /*x*/, double* /*j*/) const {}
 };
 
+// CVODE's settings. Describe lists each field once (core/settings_description.hpp): IsValid
+// checks the described ranges and the JSON record of the settings used iterates it. The
+// runs set them in code (from ShakeSettings), so no case table or flag holds them.
 struct SolverSettings {
   double relative_tolerance = 1e-10;
   std::vector<double> absolute_tolerance;  // one per state
@@ -38,7 +43,20 @@ struct SolverSettings {
   // Give CVODE the system's own Jacobian when it has one (OdeSystem::has_jacobian); false:
   // CVODE's difference quotients always (a check of the analytic one).
   bool analytic_jacobian = true;
-  bool IsValid(std::string* error) const;
+
+  template <class V>
+  static void Describe(V& v) {
+    using S = SolverSettings;
+    using core::field;
+    v(field("relative_tolerance", &S::relative_tolerance, "", core::open(0, 1), "CVODE's relative tolerance"));
+    v(field("absolute_tolerance", &S::absolute_tolerance, "state units", core::above(0),
+            "CVODE's absolute tolerance, one per state"));
+    v(field("max_step_s", &S::max_step_s, "s", core::at_least(0), "Longest step; 0: no limit"));
+    v(field("max_steps", &S::max_steps, "steps", core::at_least(1), "Steps allowed in one advance"));
+    v(field("analytic_jacobian", &S::analytic_jacobian, "", core::any_value(),
+            "The system's own Jacobian where it has one; false: difference quotients"));
+  }
+  bool IsValid(std::string* error) const { return core::validate(*this, error); }
 };
 
 struct SolverError : std::runtime_error {

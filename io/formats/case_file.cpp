@@ -242,21 +242,14 @@ void read_sweep(Table t, Case& c) {
 
 void read_frequency_study(Table t, Case& c) {
   rectification::FrequencyStudySettings f;
-  const double from = t.opt_number("from_Hz").value_or(1.0), to = t.opt_number("to_Hz").value_or(5000.0);
-  if (!(from > 0) || !(to > from)) t.fail(t.raw().get("to_Hz"), "to_Hz", "need 0 < from_Hz < to_Hz");
-  const auto points = t.integer("points", false, 80, 2, 10000);
-  const auto ode_points = t.integer("ode_points", false, 10, 0, 1000);
-  f.frequencies_Hz = rectification::spaced(from, to, static_cast<int>(points), true);
-  if (ode_points > 0) f.ode_frequencies_Hz = rectification::spaced(from, to, static_cast<int>(ode_points), true);
-  f.amplitude_g = t.opt_number("amplitude_g").value_or(f.amplitude_g);
-  if (!(f.amplitude_g > 0)) t.fail(t.raw().get("amplitude_g"), "amplitude_g", "must be positive");
-  check_amplitude(t, "amplitude_g", f.amplitude_g);
-  if (auto d = t.opt_vec3("direction")) {
-    if (!(d->norm() > 0)) t.fail(t.raw().get("direction"), "direction", "must not be zero");
-    f.direction = d->normalized();
+  rectification::FrequencyGrid grid;
+  t.read_described(f, grid);
+  if (std::string why; !grid.IsValid(&why)) t.fail_sentence(why);
+  if (t.has("direction")) {
+    if (!(f.direction.norm() > 0)) t.fail(t.raw().get("direction"), "direction", "must not be zero");
+    f.direction.normalize();
   }
-  f.pickoff_p2_per_rad = t.opt_number("pickoff_p2_per_rad").value_or(f.pickoff_p2_per_rad);
-  t.check_unknown({"from_Hz", "to_Hz", "points", "ode_points", "amplitude_g", "direction", "pickoff_p2_per_rad"});
+  grid.apply(f);
   c.frequency_study = f;
 }
 

@@ -20,6 +20,7 @@
 #include <toml++/toml.h>
 
 #include "io/formats/case_file.hpp"
+#include "io/formats/settings_toml.hpp"
 
 namespace vrelab::io::internal {
 
@@ -132,6 +133,30 @@ class Table {
       if (!best.empty()) msg += " (did you mean '" + best + "'?)";
       fail(&v, key, msg);
     }
+  }
+
+  // The keys of t that the descriptions of S... hold, read into s... (core/settings_description.hpp,
+  // io/formats/settings_toml.hpp): an unknown key fails with the closest match, a wrong type
+  // or a value out of its range at the value's line, "[table] key = value: must be RULE".
+  template <class... S>
+  void read_described(S&... s) {
+    std::vector<std::string_view> allowed;
+    for (const auto& keys : {core::table_keys<S>()...}) allowed.insert(allowed.end(), keys.begin(), keys.end());
+    for (auto k : allowed) used_.insert(std::string(k));
+    check_unknown(allowed);  // every key not described, with the closest described one
+    const auto fail = [&](const toml::node* n, const std::string& key, const std::string& what) {
+      throw FormatError({.file = file_, .line = line(n ? n : &t_), .table = name_, .key = key, .kind = KeyKind::toml_table},
+                        what);
+    };
+    (read_settings_fields(t_, s, fail), ...);
+  }
+
+  // A struct's IsValid sentence, "key = value: must be ..." or "key: ...", at that key's line.
+  [[noreturn]] void fail_sentence(const std::string& why) const {
+    const std::string key = why.substr(0, why.find_first_of(" :.["));
+    throw FormatError({.file = file_, .line = line(t_.get(key) ? t_.get(key) : &t_), .table = name_, .key = key,
+                       .kind = KeyKind::toml_table},
+                      why);
   }
 
   const toml::table& raw() const { return t_; }

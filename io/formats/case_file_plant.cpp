@@ -216,25 +216,11 @@ void read_plant(Table t, Case& c) {
 
 void read_readout(Table t, Case& c) {
   rectification::Readout& r = c.shake.readout;
-  r.sample_rate_Hz = t.number("sample_rate_Hz");
+  t.get("sample_rate_Hz", true);  // required here (0, the struct's default, is "no readout")
+  t.read_described(r);
   if (!(r.sample_rate_Hz > 0)) t.fail(t.raw().get("sample_rate_Hz"), "sample_rate_Hz", "must be positive");
-  r.noise_sigma_g = t.non_negative("noise_sigma_ug", 0.0) * 1e-6;
-  r.quantisation_lsb_g = t.non_negative("quantisation_lsb_ug", 0.0) * 1e-6;
-  t.check_unknown({"sample_rate_Hz", "noise_sigma_ug", "quantisation_lsb_ug"});
 }
 
-void read_shake(Table t, Case& c) {
-  rectification::ShakeSettings& s = c.shake;
-  s.relative_tolerance = t.opt_number("relative_tolerance").value_or(s.relative_tolerance);
-  s.settle_decay = t.opt_number("settle_decay").value_or(s.settle_decay);
-  s.blocks = static_cast<int>(t.integer("blocks", false, s.blocks, 2, 1000));
-  s.min_measure_s = t.non_negative("min_measure_s", s.min_measure_s);
-  std::string why;
-  if (!s.IsValid(&why)) {
-    const std::string key = why.substr(0, why.find(' '));  // IsValid's message starts with the key
-    t.fail(t.raw().get(key), key, why.substr(why.find(' ') + 1));
-  }
-  t.check_unknown({"relative_tolerance", "settle_decay", "blocks", "min_measure_s"});
-}
+void read_shake(Table t, Case& c) { t.read_described(c.shake); }
 
 }  // namespace vrelab::io::internal

@@ -1,6 +1,21 @@
 #pragma once
 // io/formats/settings_json.hpp -- a described settings struct (core/settings_description.hpp)
-// as a JSON object: every field by its name (a described field's as a nested object).
+// as a JSON object: every field by its name (a described field's as a nested object, a list
+// or a vector as an array), set_by fields too, each value as written (a scaled field in its
+// written unit).
+//
+// settings_from_json reads such an object back (the fields it holds; the others stay), so a
+// record of the settings used can be read and run again; it throws std::invalid_argument
+// naming the key for an unknown key or a value of the wrong type, and does not check ranges
+// (the struct's IsValid does).
+//
+// A field of a type of its own (the coefficients held fixed, a position, a named vector) is
+// written and read by JsonValue<T>, specialised beside the type's other io
+// (io/formats/validation_json.hpp); a struct with such a field is written where that header
+// is included (else a compile error names the type).
+#include <concepts>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 
 #include <nlohmann/json.hpp>
@@ -9,15 +24,80 @@
 
 namespace vrelab::io {
 
+// JsonValue<T>::to(x) gives the JSON of x; JsonValue<T>::from(j, x) sets x from it, throwing
+// std::invalid_argument saying what is wrong (the caller prefixes the key).
+template <class T>
+struct JsonValue;
+template <class T>
+concept HasJsonValue = requires(const T& x, T& y, const nlohmann::json& j) {
+  { JsonValue<T>::to(x) } -> std::convertible_to<nlohmann::json>;
+  JsonValue<T>::from(j, y);
+};
+
 template <class S>
 nlohmann::json settings_json(const S& s) {
   nlohmann::json j = nlohmann::json::object();
   core::for_each_field<S>([&](const auto& f) {
     using T = typename std::decay_t<decltype(f)>::Type;
-    if constexpr (core::Described<T>) j[std::string(f.name)] = settings_json(s.*f.member);
-    else j[std::string(f.name)] = s.*f.member;
+    const T& x = s.*f.member;
+    if constexpr (core::Described<T>) {
+      j[std::string(f.name)] = settings_json(x);
+    } else if constexpr (HasJsonValue<T>) {
+      j[std::string(f.name)] = JsonValue<T>::to(x);
+    } else if constexpr (core::FixedVector<T>) {
+      nlohmann::json a = nlohmann::json::array();
+      for (int i = 0; i < T::SizeAtCompileTime; ++i) a.push_back(x[i]);
+      j[std::string(f.name)] = a;
+    } else {
+      static_assert(std::is_arithmetic_v<T> || std::is_same_v<T, std::string> || core::is_number_list<T>,
+                    "settings_json: a field type without JsonValue<T> (include its io/formats header)");
+      j[std::string(f.name)] = core::written(f, x);
+    }
   });
   return j;
+}
+
+template <class S>
+void settings_from_json(const nlohmann::json& j, S& s, const std::string& prefix = "") {
+  if (!j.is_object()) throw std::invalid_argument(prefix + "settings: expected a JSON object");
+  for (const auto& [k, v] : j.items()) {
+    bool known = false;
+    core::for_each_field<S>([&](const auto& f) { known = known || f.name == k; });
+    if (!known) throw std::invalid_argument(prefix + k + ": unknown key");
+  }
+  core::for_each_field<S>([&](const auto& f) {
+    using T = typename std::decay_t<decltype(f)>::Type;
+    const std::string key(f.name);
+    if (!j.contains(key)) return;
+    const nlohmann::json& v = j.at(key);
+    T& x = s.*f.member;
+    try {
+      if constexpr (core::Described<T>) {
+        settings_from_json(v, x, prefix + key + ".");
+      } else if constexpr (HasJsonValue<T>) {
+        try {
+          JsonValue<T>::from(v, x);
+        } catch (const std::invalid_argument& e) {
+          throw std::invalid_argument(prefix + key + ": " + e.what());
+        }
+      } else if constexpr (core::FixedVector<T>) {
+        if (!v.is_array() || static_cast<int>(v.size()) != T::SizeAtCompileTime) throw std::invalid_argument("size");
+        for (int i = 0; i < T::SizeAtCompileTime; ++i) x[i] = v[static_cast<std::size_t>(i)].template get<double>();
+      } else {
+        if constexpr (std::is_same_v<T, bool>) {
+          if (!v.is_boolean()) throw std::invalid_argument("type");
+        } else if constexpr (std::is_arithmetic_v<T>) {
+          if (!v.is_number() || (std::is_integral_v<T> && !v.is_number_integer())) throw std::invalid_argument("type");
+        }
+        x = core::held(f, v.template get<T>());
+      }
+    } catch (const std::invalid_argument& e) {
+      if (std::string(e.what()).find(": ") != std::string::npos) throw;  // a nested key's own message
+      throw std::invalid_argument(prefix + key + ": a value of the wrong type or size");
+    } catch (const nlohmann::json::exception&) {
+      throw std::invalid_argument(prefix + key + ": a value of the wrong type or size");
+    }
+  });
 }
 
 }  // namespace vrelab::io

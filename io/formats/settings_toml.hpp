@@ -6,8 +6,13 @@
 // they are; for an unknown key, a value of the wrong type or out of range it calls
 // fail(node, key, what) (never returning: the caller throws its error, with its file, the
 // node's line, its table and the key as data), `what` the sentence naming the key:
-// "key: unknown key", "key: expected a number", "key = 1.5: must be in (0, 1]". A field whose type is described is a subtable, its keys
-// named "field.key". Only for sources of vrelab_formats (toml++ is private to it).
+// "key: unknown key", "key: expected a number", "key = 1.5: must be in (0, 1]". A field whose
+// type is described is a subtable, its keys named "field.key". A field set_by elsewhere is no
+// key; a scaled field's key holds the written value (the member gets it times the scale).
+//
+// read_settings_fields does the same without the unknown-key check, for a table whose keys
+// several descriptions share (check_settings_keys<S1, S2>, the union). Only for sources of
+// vrelab_formats (toml++ is private to it).
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -20,34 +25,53 @@
 
 namespace vrelab::io {
 
-template <class S, class Fail>
-void read_settings_table(const toml::table& t, S& s, const Fail& fail) {
+// fail(node, key, "key: unknown key") for a key of t that none of S... describes.
+template <class... S, class Fail>
+void check_settings_keys(const toml::table& t, const Fail& fail) {
   for (auto&& [k, v] : t) {
     const std::string name(k.str());  // a copy: clang 14 cannot capture a structured binding
     bool known = false;
-    core::for_each_field<S>([&](const auto& f) { known = known || f.name == name; });
+    const auto look = [&](const auto& f) { known = known || (f.in_table() && f.name == name); };
+    (core::for_each_field<S>(look), ...);
     if (!known) fail(&v, name, name + ": unknown key");
   }
+}
+
+namespace settings_toml_internal {
+// A finite number at n, else fail.
+template <class Fail>
+double finite_number(const toml::node* n, const std::string& key, const Fail& fail) {
+  if (!n->is_number()) fail(n, key, key + ": expected a number");
+  const double d = n->value<double>().value();
+  if (!std::isfinite(d)) fail(n, key, key + ": must be finite");
+  return d;
+}
+}  // namespace settings_toml_internal
+
+template <class S, class Fail>
+void read_settings_fields(const toml::table& t, S& s, const Fail& fail) {
+  using settings_toml_internal::finite_number;
   core::for_each_field<S>([&](const auto& f) {
     using T = typename std::decay_t<decltype(f)>::Type;
+    if (!f.in_table()) return;
     const toml::node* n = t.get(f.name);
     if (!n) return;
     const std::string key(f.name);
     T& x = s.*f.member;
     if constexpr (core::Described<T>) {
       if (!n->is_table()) fail(n, key, key + ": expected a table");
-      read_settings_table(*n->as_table(), x, [&](const toml::node* m, const std::string& sub, const std::string& what) {
+      const auto sub_fail = [&](const toml::node* m, const std::string& sub, const std::string& what) {
         fail(m, key + "." + sub, key + "." + what);
-      });
+      };
+      check_settings_keys<T>(*n->as_table(), sub_fail);
+      read_settings_fields(*n->as_table(), x, sub_fail);
     } else if constexpr (std::is_same_v<T, bool>) {
       if (!n->is_boolean()) fail(n, key, key + ": expected true or false");
       x = n->value<bool>().value();
     } else if constexpr (std::is_floating_point_v<T>) {
-      if (!n->is_number()) fail(n, key, key + ": expected a number");
-      const double d = n->value<double>().value();
-      if (!std::isfinite(d)) fail(n, key, key + ": must be finite");
-      if (!core::admissible(f, static_cast<T>(d))) fail(n, key, core::range_error(f, static_cast<T>(d)));
-      x = static_cast<T>(d);
+      const double d = finite_number(n, key, fail);
+      if (!core::admissible_value(f, static_cast<T>(d))) fail(n, key, core::range_error_written(f, static_cast<T>(d)));
+      x = core::held(f, static_cast<T>(d));
     } else if constexpr (std::is_integral_v<T>) {
       const std::string whole = key + ": expected a whole number" + (f.unit.empty() ? "" : " of " + std::string(f.unit));
       if (!n->is_integer()) fail(n, key, whole);
@@ -62,10 +86,34 @@ void read_settings_table(const toml::table& t, S& s, const Fail& fail) {
     } else if constexpr (std::is_same_v<T, std::string>) {
       if (!n->is_string()) fail(n, key, key + ": expected a string");
       x = n->value<std::string>().value();
+    } else if constexpr (core::is_number_list<T>) {
+      const toml::array* a = n->as_array();
+      if (!a || a->empty()) fail(n, key, key + ": expected a non-empty array of numbers");
+      T w;
+      for (auto&& e : *a) {
+        w.push_back(finite_number(&e, key, fail));
+        if (!core::admissible_value(f, w.back())) fail(&e, key, core::range_error_written(f, w));
+      }
+      x = core::held(f, w);
+    } else if constexpr (core::FixedVector<T>) {
+      constexpr int kSize = T::SizeAtCompileTime;
+      const toml::array* a = n->as_array();
+      if (!a || static_cast<int>(a->size()) != kSize)
+        fail(n, key, key + ": expected an array of " + std::to_string(kSize) + " numbers" + (kSize == 3 ? " [IA, PA, OA]" : ""));
+      T w;
+      for (int i = 0; i < kSize; ++i) w[i] = finite_number(a->get(static_cast<std::size_t>(i)), key, fail);
+      if (!core::admissible_value(f, w)) fail(n, key, core::range_error_written(f, w));
+      x = w;
     } else {
-      static_assert(sizeof(T) == 0, "read_settings_table: a field type TOML cannot hold");
+      static_assert(sizeof(T) == 0, "read_settings_fields: a field type TOML cannot hold");
     }
   });
+}
+
+template <class S, class Fail>
+void read_settings_table(const toml::table& t, S& s, const Fail& fail) {
+  check_settings_keys<S>(t, fail);
+  read_settings_fields(t, s, fail);
 }
 
 }  // namespace vrelab::io

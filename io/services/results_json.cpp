@@ -5,6 +5,8 @@
 #include <numbers>
 
 #include "io/formats/output.hpp"
+#include "io/formats/settings_json.hpp"
+#include "io/formats/validation_json.hpp"
 #include "rectification/measurement/vrc.hpp"
 
 namespace vrelab::io {
@@ -13,16 +15,11 @@ using nlohmann::json;
 using plant::kNumCoefficients;
 using validation::RunResult;
 
+// The described fields (the readout's noise and LSB in ug) and the solver used.
 json shake_settings_json(const rectification::ShakeSettings& s) {
-  return {{"solver", "CVODE BDF, dense direct linear solver"},
-          {"relative_tolerance", s.relative_tolerance},
-          {"settle_decay", s.settle_decay},
-          {"blocks", s.blocks},
-          {"min_measure_s", s.min_measure_s},
-          {"readout",
-           {{"sample_rate_Hz", s.readout.sample_rate_Hz},
-            {"noise_sigma_g", s.readout.noise_sigma_g},
-            {"quantisation_lsb_g", s.readout.quantisation_lsb_g}}}};
+  json j = settings_json(s);
+  j["solver"] = "CVODE BDF, dense direct linear solver";
+  return j;
 }
 
 json sweep_grid_json(const rectification::SweepGrid& g) {
@@ -32,13 +29,7 @@ json sweep_grid_json(const rectification::SweepGrid& g) {
   return {{"frequencies_Hz", g.frequencies_Hz}, {"amplitudes_g", g.amplitudes_g}, {"directions", d}, {"orientations_g", o}};
 }
 
-json frequency_study_settings_json(const rectification::FrequencyStudySettings& s) {
-  return {{"amplitude_g", s.amplitude_g},
-          {"direction", vec_json(s.direction)},
-          {"frequencies_Hz", s.frequencies_Hz},
-          {"ode_frequencies_Hz", s.ode_frequencies_Hz},
-          {"pickoff_p2_per_rad", s.pickoff_p2_per_rad}};
-}
+json frequency_study_settings_json(const rectification::FrequencyStudySettings& s) { return settings_json(s); }
 
 json series_windows_json(const rectification::SeriesWindows& w) {
   return {{"baseline_s", {w.baseline_from_s, w.baseline_to_s}},
@@ -179,10 +170,10 @@ json identify_json(const Case& c, const IdentifyStudy& s) {
   const DividingHead& head = *c.dividing_head;
   const int mc = s.settings.monte_carlo_trials;
   json j = result_record("identify", c);
-  j["settings"] = {{"monte_carlo_trials", mc},
-                   {"monte_carlo_seed", mc > 0 ? json(c.seed + 1) : json(nullptr)},
-                   {"least_squares_weights", "1 / first-order variance of each reading"},
-                   {"rank_tolerance", 1e-10}};
+  j["settings"] = settings_json(s.settings);  // as described, and what the program fixes:
+  j["settings"]["monte_carlo_seed"] = mc > 0 ? json(s.settings.seed + 1) : json(nullptr);
+  j["settings"]["least_squares_weights"] = "1 / first-order variance of each reading";
+  j["settings"]["rank_tolerance"] = 1e-10;
   json units = json::object();
   for (int i = 0; i < kNumCoefficients; ++i) units[std::string(plant::coefficient_name(i))] = unit_of(i, c);
   j["units"] = units;

@@ -81,9 +81,10 @@ IdentifyStudy identify(const Case& c, int monte_carlo_trials, const std::string&
     s.settings.monte_carlo_checkpoint.fingerprint = fmt::format(
         "case+program {:016x}", fnv1a(c.content.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + kProgramVersion + kGitDescribe));
   }
+  validation::OutputSource source;  // empty: model (1)
   if (head.from_ode) {
     const plant::PlantConfig plant = c.plant;
-    s.settings.source = [plant](const Vec3& a) { return plant.coefficients[plant::K1] * plant::settled_output_g(plant, a); };
+    source = [plant](const Vec3& a) { return plant.coefficients[plant::K1] * plant::settled_output_g(plant, a); };
   }
   if (std::string why; !s.settings.IsValid(&why)) throw InputError(c.path + ": --monte-carlo: " + why);
   // Identifiability first: a rank-deficient set is reported in words, not solved into noise.
@@ -98,7 +99,7 @@ IdentifyStudy identify(const Case& c, int monte_carlo_trials, const std::string&
            "from another test and assumes k_PP = k_OO = 0), or add positions.";
     throw InputError(msg);
   }
-  s.report = validation::run_static_test(*c.coefficients, head.positions, head.errors, s.settings);
+  s.report = validation::run_static_test(*c.coefficients, head.positions, head.errors, s.settings, source);
   return s;
 }
 
@@ -721,8 +722,8 @@ FrequencyStudy frequency(const Case& c) {
   require(c, c.coefficients.has_value(), "coefficients", "frequency");
   require(c, c.orientation_g.has_value(), "orientation", "frequency");
   FrequencyStudy s;
-  s.settings = c.frequency_study.value_or(rectification::FrequencyStudySettings{
-      rectification::spaced(1, 5000, 80, true), rectification::spaced(1, 5000, 10, true)});
+  if (c.frequency_study) s.settings = *c.frequency_study;
+  else rectification::FrequencyGrid{}.apply(s.settings);  // no table: the grid's defaults
   if (std::string why; !s.settings.IsValid(&why)) throw FormatError(table_of(c, "frequency_study"), why);
   const auto start = std::chrono::steady_clock::now();
   s.curves = rectification::frequency_study(c.plant, *c.orientation_g, s.settings);

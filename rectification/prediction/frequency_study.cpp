@@ -6,21 +6,34 @@
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/prediction/frequency.hpp"
 #include "rectification/simulation/shake.hpp"
+#include "rectification/simulation/sweep.hpp"
 
 namespace vrelab::rectification {
 
 bool FrequencyStudySettings::IsValid(std::string* why) const {
+  if (!core::validate(*this, why)) return false;
   auto fail = [&](const std::string& m) {
     if (why) *why = m;
     return false;
   };
-  if (frequencies_Hz.empty()) return fail("points: the frequency grid is empty");
-  for (const auto* grid : {&frequencies_Hz, &ode_frequencies_Hz})
-    for (double f : *grid)
-      if (!(f > 0)) return fail("from_Hz/to_Hz: frequencies must be positive");
-  if (!(amplitude_g > 0)) return fail("amplitude_g: must be positive");
+  if (frequencies_Hz.empty()) return fail("frequencies_Hz: the frequency grid is empty");
   if (!(direction.norm() > 0)) return fail("direction: must not be zero");
   return true;
+}
+
+bool FrequencyGrid::IsValid(std::string* why) const {
+  if (!core::validate(*this, why)) return false;
+  if (!(to_Hz > from_Hz)) {
+    if (why) *why = "to_Hz = " + core::format_value(to_Hz) + ": must be above from_Hz = " + core::format_value(from_Hz);
+    return false;
+  }
+  return true;
+}
+
+void FrequencyGrid::apply(FrequencyStudySettings& s) const {
+  s.frequencies_Hz = spaced(from_Hz, to_Hz, points, true);
+  s.ode_frequencies_Hz.clear();
+  if (ode_points > 0) s.ode_frequencies_Hz = spaced(from_Hz, to_Hz, ode_points, true);
 }
 
 std::vector<MechanismCurve> frequency_study(const plant::PlantConfig& plant, const Vec3& a, const FrequencyStudySettings& s) {

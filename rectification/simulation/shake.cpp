@@ -228,24 +228,6 @@ struct PeriodPass {
 }  // namespace
 
 namespace {
-constexpr double kMaxMeasure_s = 1e6;
-}  // namespace
-
-bool ShakeSettings::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& m) {
-    if (error) *error = m;
-    return false;
-  };
-  if (!(relative_tolerance > 0 && relative_tolerance < 1e-3)) return fail("relative_tolerance must lie in (0, 1e-3)");
-  if (!(settle_decay > 0 && settle_decay < 1)) return fail("settle_decay must lie in (0, 1)");
-  if (blocks < 2) return fail("blocks must be at least 2");
-  // 1e6 s (11.6 days of simulated vibration) is far beyond any run (the shipped cases ask 2 s).
-  if (!(min_measure_s >= 0 && min_measure_s <= kMaxMeasure_s))
-    return fail("min_measure_s must lie in [0, 1e6] s");
-  return true;
-}
-
-namespace {
 
 // What a sine run's two paths share: the drive, the plant at rest (equilibrium, linearisation,
 // the linear periodic solution's phasor), the solver's settings and the run's timing (settling

@@ -31,6 +31,7 @@
 #include <functional>
 #include <string>
 
+#include "core/settings_description.hpp"
 #include "plant/accelerometer.hpp"
 #include "vibration/excitation.hpp"
 #include "vibration/profile.hpp"
@@ -38,15 +39,35 @@
 namespace vrelab::rectification {
 
 // The data acquisition: sampling, noise, quantisation (input-equivalent, g). Off when
-// sample_rate_Hz = 0: the measurement then uses the continuous integral Q.
+// sample_rate_Hz = 0: the measurement then uses the continuous integral Q. Describe lists each
+// field once (core/settings_description.hpp): the case's [readout] table (noise and LSB written
+// in ug, held in g) and the JSON record of the settings used.
 struct Readout {
   double sample_rate_Hz = 0.0;
   double noise_sigma_g = 0.0;       // white, per sample
   double quantisation_lsb_g = 0.0;  // ADC step; 0 = off
   std::uint64_t seed = 1;
   bool active() const { return sample_rate_Hz > 0; }
+
+  template <class V>
+  static void Describe(V& v) {
+    using S = Readout;
+    using core::field;
+    // 0 (off) is the struct's default; a [readout] table must give a positive rate (the reader).
+    v(field("sample_rate_Hz", &S::sample_rate_Hz, "Hz", core::at_least(0),
+            "Sampling of the output (synchronous with a sine: raised to whole samples per period); 0: off"));
+    v(field("noise_sigma_ug", &S::noise_sigma_g, "ug", core::at_least(0), "White noise per sample, input-equivalent")
+          .scaled(1e-6));
+    v(field("quantisation_lsb_ug", &S::quantisation_lsb_g, "ug", core::at_least(0),
+            "ADC step, input-equivalent; 0: off")
+          .scaled(1e-6));
+    v(field("seed", &S::seed, "", core::any_value(), "Seed of the noise draws").set_by("[run] seed"));
+  }
+  bool IsValid(std::string* why) const { return core::validate(*this, why); }
 };
 
+// The measurement's settings. Describe lists each field once: the case's [shake] table, the
+// JSON record of the settings used; IsValid checks the described ranges.
 struct ShakeSettings {
   Readout readout;
   double relative_tolerance = 1e-10;
@@ -66,7 +87,28 @@ struct ShakeSettings {
   // steps then differ, and at a case's loose tolerance (rtol 1e-4) the answer moves by the
   // solver's own error (docs/performance.md: 4e-9 g of shake-sine-on-random, 1e-4 sigma).
   bool analytic_jacobian = false;
-  bool IsValid(std::string* error) const;
+
+  template <class V>
+  static void Describe(V& v) {
+    using S = ShakeSettings;
+    using core::field;
+    v(field("readout", &S::readout, "", core::any_value(), "The data acquisition").set_by("the [readout] table"));
+    v(field("relative_tolerance", &S::relative_tolerance, "", core::open(0, 1e-3),
+            "CVODE's relative tolerance (1e-4 suits random records)"));
+    v(field("settle_decay", &S::settle_decay, "", core::open(0, 1),
+            "Transients decay to this fraction before measuring"));
+    v(field("blocks", &S::blocks, "blocks", core::closed(2, 1000), "Batch means for the uncertainty"));
+    // 1e6 s (11.6 days of simulated vibration) is far beyond any run (the shipped cases ask 2 s).
+    v(field("min_measure_s", &S::min_measure_s, "s", core::closed(0, 1e6),
+            "Measure at least this long (sine: whole periods)"));
+    v(field("periodic_steady_state", &S::periodic_steady_state, "", core::any_value(),
+            "Sine: reach the periodic steady state directly; false: settle, then measure"));
+    v(field("exponential_integrator", &S::exponential_integrator, "", core::any_value(),
+            "Random: one exponential-integrator step per sample; false: CVODE"));
+    v(field("analytic_jacobian", &S::analytic_jacobian, "", core::any_value(),
+            "CVODE with the plant's analytic Jacobian; false: difference quotients"));
+  }
+  bool IsValid(std::string* why) const { return core::validate(*this, why); }
 };
 
 struct ShakeResult {

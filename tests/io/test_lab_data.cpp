@@ -18,6 +18,7 @@
 #include "io/formats/error.hpp"
 #include "io/formats/lab_data.hpp"
 #include "support/files.hpp"
+#include "support/lab_manifest.hpp"
 #include "validation/diagnosis/campaign.hpp"
 
 using namespace vrelab;
@@ -25,27 +26,8 @@ using namespace vrelab::validation;
 namespace fs = std::filesystem;
 using vrelab::test::read_file;
 using vrelab::test::TempDir;
-
-namespace {
-
-// The shipped hand-written campaign with `table` appended to its manifest.
-fs::path lab_with(const TempDir& t, const std::string& table) {
-  const fs::path dir = t.path / "lab";
-  fs::copy(fs::path(VRELAB_CASES_DIR) / "lab-example", dir, fs::copy_options::recursive);
-  std::ofstream(dir / "manifest.toml", std::ios::app) << "\n" << table;
-  return dir;
-}
-
-std::string error_of(const fs::path& dir) {
-  try {
-    io::read_campaign(dir.string());
-  } catch (const io::InputError& e) {
-    return e.what();
-  }
-  return "";
-}
-
-}  // namespace
+using vrelab::test::error_of;
+using vrelab::test::lab_with;
 
 TEST(LabData, BadRunsAreSkippedWithFileAndLineAndBadFilesStop) {
   TempDir t;

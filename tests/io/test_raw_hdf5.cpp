@@ -21,22 +21,14 @@
 #include "io/formats/raw_hdf5.hpp"
 #include "io/formats/series.hpp"
 #include "support/files.hpp"
+#include "support/lcg.hpp"
 
 namespace vrelab {
 namespace {
 
 namespace fs = std::filesystem;
+using test::Lcg;
 using test::TempDir;
-
-// A deterministic pseudo-random number in [-1, 1) (a 64-bit LCG): noise without <random>'s
-// implementation-defined distributions.
-struct Lcg {
-  std::uint64_t s = 12345;
-  double next() {
-    s = s * 6364136223846793005ull + 1442695040888963407ull;
-    return static_cast<double>(s >> 11) / static_cast<double>(1ull << 52) - 1.0;
-  }
-};
 
 struct Captured {
   std::vector<double> t, u, rt;

@@ -1,12 +1,13 @@
 # Sourced by the MPI and checkpoint test scripts: two result JSON files compared.
-same_json() {  # same_json <a> <b>: equal but for times, threads, ranks and the program record
+same_json() {  # same_json <a> <b>: equal but for times, threads, ranks, the resume file and the program record
   python3 - "$1" "$2" <<'PY'
 import json, sys
 def strip(x):
     if isinstance(x, dict):
         return {k: strip(v) for k, v in x.items()
                 if k not in ("wall_s", "simulate_s", "threads", "ranks", "program",
-                             "monte_carlo_ranks", "monte_carlo_threads_per_rank")}
+                             "monte_carlo_ranks", "monte_carlo_threads_per_rank",
+                             "monte_carlo_checkpoint")}
     if isinstance(x, list):
         return [strip(v) for v in x]
     return x

@@ -23,12 +23,15 @@
 #include "io/services/diagnosis.hpp"
 #include "io/services/diagnosis_json.hpp"
 #include "support/files.hpp"
+#include "support/lab_manifest.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/settings.hpp"
 
 using namespace vrelab;
 namespace fs = std::filesystem;
 using vrelab::test::TempDir;
+using vrelab::test::error_of;
+using vrelab::test::lab_with;
 using Settings = validation::DiagnoseSettings;
 
 namespace {
@@ -74,32 +77,6 @@ int expect_all_equal(const Settings& got, const Settings& want, const std::strin
     ++n;
   });
   return n;
-}
-
-// The shipped hand-written campaign with `table` appended to its manifest; *first_line: the
-// manifest's line number of the table's first line.
-fs::path lab_with(const TempDir& t, const std::string& table, int* first_line = nullptr) {
-  const fs::path dir = t.path / "lab";
-  fs::copy(fs::path(VRELAB_CASES_DIR) / "lab-example", dir, fs::copy_options::recursive);
-  std::ifstream in(dir / "manifest.toml");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  in.close();
-  // The text, a newline if it lacks one, a blank line, then the table.
-  int lines = 0;
-  for (char ch : text) lines += ch == '\n';
-  const bool ends = !text.empty() && text.back() == '\n';
-  std::ofstream(dir / "manifest.toml", std::ios::app) << (ends ? "" : "\n") << "\n" << table;
-  if (first_line) *first_line = lines + (ends ? 0 : 1) + 2;
-  return dir;
-}
-
-std::string error_of(const fs::path& dir) {
-  try {
-    io::read_campaign(dir.string());
-  } catch (const io::InputError& e) {
-    return e.what();
-  }
-  return "";
 }
 
 }  // namespace

@@ -8,10 +8,11 @@
 namespace vrelab::validation {
 
 StaticTestReport run_static_test(const plant::Coefficients& truth, const std::vector<Position>& positions,
-                                 const StaticTestErrors& errors, const StaticTestSettings& settings) {
+                                 const StaticTestErrors& errors, const StaticTestSettings& settings,
+                                 const OutputSource& given_source) {
   StaticTestReport report;
   std::mt19937_64 rng(settings.seed);
-  const OutputSource source = settings.source ? settings.source : model1_source(truth);
+  const OutputSource source = given_source ? given_source : model1_source(truth);
   report.readings = simulate_static_test(source, truth[plant::K1], positions, errors, rng);
 
   // Weights: 1 / first-order variance of each reading at an unweighted first fit.

@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "core/settings_description.hpp"
 #include "plant/model1.hpp"
 #include "validation/identification/dividing_head.hpp"
 #include "validation/identification/identification.hpp"
@@ -50,9 +51,26 @@ struct MonteCarloStats {
 // blocks back (a cut or altered line is dropped and its block run again) and runs only the
 // others: the result is that of an uninterrupted run to the bit. A header that differs
 // throws std::invalid_argument. The file is kept at the end (docs/mpi.md).
+//
+// Describe lists its fields (core/settings_description.hpp): both set by the command, no table.
 struct MonteCarloCheckpoint {
   std::string path;         // empty: none
   std::string fingerprint;  // one line: the case and the program (the caller's choice)
+  template <class V>
+  static void Describe(V& v) {
+    using S = MonteCarloCheckpoint;
+    v(core::field("path", &S::path, "", core::any_value(), "The trials' resume file; empty: none").set_by("--checkpoint"));
+    v(core::field("fingerprint", &S::fingerprint, "", core::any_value(),
+                  "One line naming the case and the program, checked against the file's header")
+          .set_by("the command, from the case's content and the program's version"));
+  }
+  bool IsValid(std::string* why) const {
+    if (fingerprint.find('\n') != std::string::npos) {
+      if (why) *why = "fingerprint: must be one line";
+      return false;
+    }
+    return core::validate(*this, why);
+  }
 };
 
 std::vector<MonteCarloStats> monte_carlo(const std::vector<Estimator>& estimators,

@@ -274,10 +274,10 @@ void identify_statically(const plant::PlantConfig& truth_plant, const ReproduceS
   StaticTestSettings st;
   st.fixed = s.fixed;
   st.seed = s.seed;
-  st.source = [&truth_plant](const Vec3& a) {
+  const OutputSource settled = [&truth_plant](const Vec3& a) {
     return truth_plant.coefficients[plant::K1] * plant::settled_output_g(truth_plant, a);
   };
-  out.static_test = run_static_test(truth_plant.coefficients, s.positions, s.errors, st);
+  out.static_test = run_static_test(truth_plant.coefficients, s.positions, s.errors, st, settled);
   const MethodResult& ls = out.static_test.methods.back();  // least squares is always last
   out.identified = ls.estimate.value;
   out.identified_uncertainty = ls.first_order;
