@@ -60,7 +60,8 @@ nlohmann::json settings_json(const S& s) {
 template <class S>
 void settings_from_json(const nlohmann::json& j, S& s, const std::string& prefix = "") {
   if (!j.is_object()) throw std::invalid_argument(prefix + "settings: expected a JSON object");
-  for (const auto& [k, v] : j.items()) {
+  for (const auto& item : j.items()) {
+    const std::string k = item.key();  // a copy: clang 14's lambdas cannot capture a structured binding
     bool known = false;
     core::for_each_field<S>([&](const auto& f) { known = known || f.name == k; });
     if (!known) throw std::invalid_argument(prefix + k + ": unknown key");
