@@ -152,6 +152,12 @@ std::string error_of(const fs::path& p) {
   return "";
 }
 
+// The error reading p names p, the line that starts with `start`, then `what`.
+void expect_error_at(const fs::path& p, const std::string& start, const std::string& what) {
+  const std::string e = error_of(p);
+  EXPECT_NE(e.find(p.string() + ":" + std::to_string(line_of(p, start)) + ": " + what), std::string::npos) << e;
+}
+
 }  // namespace
 
 TEST(CaseSettings, EachDescriptionListsEveryMemberOfItsStruct) {
@@ -234,30 +240,15 @@ TEST(CaseSettings, ARangeIsEnforcedFromTheCaseFileAtItsLineAndKey) {
   TempDir t;
   // [shake] blocks below its range [2, 1000].
   fs::path p = case_with(t, "shake-sine-lab.toml", "[shake]", "blocks = 1");
-  std::string e = error_of(p);
-  EXPECT_NE(e.find(p.string() + ":" + std::to_string(line_of(p, "blocks = 1")) + ": [shake] blocks = 1: must be in [2, 1000]"),
-            std::string::npos)
-      << e;
+  expect_error_at(p, "blocks = 1", "[shake] blocks = 1: must be in [2, 1000]");
   // A [readout] value below zero, in the unit written (ug).
   p = case_replacing(t, "shake-sine-lab.toml", "quantisation_lsb_ug = 1.0", "quantisation_lsb_ug = -2.0");
-  e = error_of(p);
-  EXPECT_NE(e.find(":" + std::to_string(line_of(p, "quantisation_lsb_ug = -2.0")) +
-                   ": [readout] quantisation_lsb_ug = -2: must be a non-negative number of ug"),
-            std::string::npos)
-      << e;
+  expect_error_at(p, "quantisation_lsb_ug = -2.0", "[readout] quantisation_lsb_ug = -2: must be a non-negative number of ug");
   // [frequency_study]: points out of range; to_Hz not above from_Hz, at to_Hz's line.
   p = case_replacing(t, "frequency.toml", "ode_points = 10", "ode_points = 2000");
-  e = error_of(p);
-  EXPECT_NE(e.find(":" + std::to_string(line_of(p, "ode_points = 2000")) +
-                   ": [frequency_study] ode_points = 2000: must be in [0, 1000]"),
-            std::string::npos)
-      << e;
+  expect_error_at(p, "ode_points = 2000", "[frequency_study] ode_points = 2000: must be in [0, 1000]");
   p = case_replacing(t, "frequency.toml", "to_Hz = 5000.0", "to_Hz = 0.5");
-  e = error_of(p);
-  EXPECT_NE(e.find(":" + std::to_string(line_of(p, "to_Hz = 0.5")) +
-                   ": [frequency_study] to_Hz = 0.5: must be above from_Hz = 1"),
-            std::string::npos)
-      << e;
+  expect_error_at(p, "to_Hz = 0.5", "[frequency_study] to_Hz = 0.5: must be above from_Hz = 1");
   // An unknown key names the closest described one.
   p = case_with(t, "shake-sine-lab.toml", "[shake]", "blokcs = 3");
   EXPECT_NE(error_of(p).find("[shake] blokcs: unknown key (did you mean 'blocks'?)"), std::string::npos) << error_of(p);
