@@ -13,8 +13,11 @@
 // (a generic lambda); a field whose type is itself described (has Describe) is a nested table.
 // A field's type: bool, an integer, a floating-point number, a string, a list of numbers
 // (std::vector<double>, the range applying to each), a fixed-size vector (Eigen's Vec3,
-// written [IA, PA, OA]), an array of optional numbers (std::array<std::optional<double>, N>,
-// e.g. the coefficients held fixed; the range applying to each one set) or a described struct.
+// written [IA, PA, OA]), a list of such vectors (std::vector<Vec3>, the range applying to each
+// element), a list of strings, an array of optional numbers
+// (std::array<std::optional<double>, N>, e.g. the coefficients held fixed; the range applying
+// to each one set) or a described struct (a nested table: [table.field] in TOML, an object in
+// JSON; several descriptions may share it, as they share a table).
 // A type of its own (a position, a named vector) is a field too where the adapter that
 // writes it has a converter for it (io/formats/settings_json.hpp's JsonValue); its range is
 // any_value and its checks are the struct's IsValid's.
@@ -42,6 +45,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -71,6 +75,11 @@ inline Range closed(double a, double b) { return {true, true, false, false, a, b
 inline Range closed_open(double a, double b) { return {true, true, false, true, a, b}; }   // [a, b)
 inline Range open_closed(double a, double b) { return {true, true, true, false, a, b}; }   // (a, b]
 inline Range open(double a, double b) { return {true, true, true, true, a, b}; }           // (a, b)
+// Any finite number: bounded by the infinities, so admissible_value refuses inf and NaN.
+inline Range finite() {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  return {true, true, false, false, -inf, inf};
+}
 
 // A fixed-size vector of doubles (Eigen's Vec3), known without including Eigen.
 template <class T>
@@ -80,6 +89,13 @@ concept FixedVector = requires(const T& v) {
 } && (T::SizeAtCompileTime > 0);
 template <class T>
 inline constexpr bool is_number_list = std::is_same_v<T, std::vector<double>>;
+// A list of fixed-size vectors ([[IA, PA, OA], ...]).
+template <class T>
+inline constexpr bool is_vector_list = false;
+template <FixedVector V>
+inline constexpr bool is_vector_list<std::vector<V>> = true;
+template <class T>
+inline constexpr bool is_string_list = std::is_same_v<T, std::vector<std::string>>;
 // An array of optional numbers (a value per slot or none).
 template <class T>
 inline constexpr bool is_optional_numbers = false;
@@ -183,6 +199,10 @@ std::string format_value(const T& x, int precision = 0) {
     std::string t = "[";
     for (int i = 0; i < static_cast<int>(x.size()); ++i) t += (i ? ", " : "") + format_value(static_cast<double>(x[i]), precision);
     return t + "]";
+  } else if constexpr (is_vector_list<T> || is_string_list<T>) {
+    std::string t = "[";
+    for (std::size_t i = 0; i < x.size(); ++i) t += (i ? ", " : "") + format_value(x[i], precision);
+    return t + "]";
   } else if constexpr (is_optional_numbers<T>) {
     std::string t = "[";
     for (std::size_t i = 0; i < x.size(); ++i) t += (i ? ", " : "") + (x[i] ? format_value(*x[i], precision) : std::string("none"));
@@ -199,7 +219,9 @@ std::string format_value(const T& x, int precision = 0) {
 // The range as a rule: "a positive number of sigma", "in [0, 1)", ">= 2 Hz".
 inline std::string range_text(const Range& r, std::string_view unit) {
   std::string t;
-  if (r.has_min && r.has_max) {
+  if (r.has_min && r.has_max && std::isinf(r.min) && std::isinf(r.max)) {
+    t += unit.empty() ? "a finite number" : "a finite number of";
+  } else if (r.has_min && r.has_max) {
     t += "in ";
     t += r.min_open ? '(' : '[';
     t += format_value(r.min);
@@ -237,6 +259,10 @@ bool admissible_value(const F& f, const T& w) {
     for (int i = 0; i < static_cast<int>(w.size()); ++i)
       if (!admissible_value(f, static_cast<double>(w[i]))) return false;
     return true;
+  } else if constexpr (is_vector_list<T>) {
+    for (const auto& v : w)
+      if (!admissible_value(f, v)) return false;
+    return true;
   } else if constexpr (is_optional_numbers<T>) {
     for (const auto& e : w)
       if (e && !admissible_value(f, *e)) return false;
@@ -252,7 +278,8 @@ bool admissible(const F& f, const typename F::Type& x) {
 }
 
 // "name = value: must be RULE", the message of a value out of its field's range (the value
-// as written; a list's first element out of range as name[i]).
+// as written; a list's first element out of range as name[i], a list of vectors' as
+// name[i][j]).
 template <class F, class T>
 std::string range_error_written(const F& f, const T& w) {
   if constexpr (is_number_list<T> || FixedVector<T>) {
@@ -260,6 +287,13 @@ std::string range_error_written(const F& f, const T& w) {
       if (!admissible_value(f, static_cast<double>(w[i])))
         return std::string(f.name) + "[" + std::to_string(i) + "] = " + format_value(static_cast<double>(w[i])) +
                ": must be " + range_text(f.range, f.unit);
+    return std::string(f.name) + ": must be " + range_text(f.range, f.unit);
+  } else if constexpr (is_vector_list<T>) {
+    for (std::size_t i = 0; i < w.size(); ++i)
+      for (int j = 0; j < static_cast<int>(w[i].size()); ++j)
+        if (!admissible_value(f, static_cast<double>(w[i][j])))
+          return std::string(f.name) + "[" + std::to_string(i) + "][" + std::to_string(j) +
+                 "] = " + format_value(static_cast<double>(w[i][j])) + ": must be " + range_text(f.range, f.unit);
     return std::string(f.name) + ": must be " + range_text(f.range, f.unit);
   } else if constexpr (is_optional_numbers<T>) {
     for (std::size_t i = 0; i < w.size(); ++i)
@@ -284,6 +318,27 @@ std::vector<std::string_view> table_keys() {
     if (f.in_table()) k.push_back(f.name);
   });
   return k;
+}
+
+// A key of a described table: its name, and whether it is a table of its own (a field whose
+// type is described).
+struct TableKey {
+  std::string_view name;
+  bool table = false;
+};
+// The keys of the table that `path` names below S's (each element the name of a nested
+// described field; empty: S's own table), appended to *out; none when S has no such table.
+template <class S>
+void append_table_keys(const std::vector<std::string>& path, std::vector<TableKey>* out, std::size_t depth = 0) {
+  for_each_field<S>([&](const auto& f) {
+    using T = typename std::decay_t<decltype(f)>::Type;
+    if (!f.in_table()) return;
+    if (depth == path.size()) {
+      out->push_back({f.name, Described<T>});
+    } else if constexpr (Described<T>) {
+      if (f.name == path[depth]) append_table_keys<T>(path, out, depth + 1);
+    }
+  });
 }
 
 // True when each field of s is in its range (nested tables checked through their own

@@ -7,8 +7,10 @@
 //   case_file_vibration.cpp  [vibration] (sine, random PSD, sine on random, swept sine), [shaker]
 //   case_file_plant.cpp      [coefficients], [plant] (from coefficients or physical, effects),
 //                            [readout], [shake]
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <limits>
 #include <optional>
 #include <set>
@@ -137,26 +139,35 @@ class Table {
 
   // The keys of t that the descriptions of S... hold, read into s... (core/settings_description.hpp,
   // io/formats/settings_toml.hpp): an unknown key fails with the closest match, a wrong type
-  // or a value out of its range at the value's line, "[table] key = value: must be RULE".
+  // or a value out of its range at the value's line, "[table] key = value: must be RULE". A
+  // described subtable ([table.sub]) likewise, its keys the union of the descriptions' own.
   template <class... S>
   void read_described(S&... s) {
-    std::vector<std::string_view> allowed;
-    for (const auto& keys : {core::table_keys<S>()...}) allowed.insert(allowed.end(), keys.begin(), keys.end());
-    for (auto k : allowed) used_.insert(std::string(k));
-    check_unknown(allowed);  // every key not described, with the closest described one
+    check_described<S...>({});
     const auto fail = [&](const toml::node* n, const std::string& key, const std::string& what) {
-      throw FormatError({.file = file_, .line = line(n ? n : &t_), .table = name_, .key = key, .kind = KeyKind::toml_table},
-                        what);
+      fail_described(n, key, what);
     };
     (read_settings_fields(t_, s, fail), ...);
   }
 
-  // A struct's IsValid sentence, "key = value: must be ..." or "key: ...", at that key's line.
+  // A struct's IsValid sentence, "key = value: must be ..." or "key: ...", at that key's line:
+  // a nested key "sub.key" at its line in [table.sub], an entry "key[i]" at the entry's.
   [[noreturn]] void fail_sentence(const std::string& why) const {
-    const std::string key = why.substr(0, why.find_first_of(" :.["));
-    throw FormatError({.file = file_, .line = line(t_.get(key) ? t_.get(key) : &t_), .table = name_, .key = key,
-                       .kind = KeyKind::toml_table},
-                      why);
+    const std::string place = why.substr(0, why.find_first_of(" :"));
+    const std::string key = place.substr(0, place.find('['));
+    const toml::node* n = &t_;
+    for (std::size_t from = 0; n && n->is_table() && from <= key.size();) {
+      const std::size_t dot = std::min(key.find('.', from), key.size());
+      n = n->as_table()->get(std::string_view(key).substr(from, dot - from));
+      from = dot + 1;
+    }
+    for (std::size_t at = key.size(); n && n->is_array() && at < place.size() && place[at] == '[';) {
+      const std::size_t i = std::strtoul(place.c_str() + at + 1, nullptr, 10);
+      if (i >= n->as_array()->size()) break;
+      n = n->as_array()->get(i);
+      at = place.find(']', at) + 1;  // npos + 1 = 0: the loop ends
+    }
+    fail_described(n, key, why);
   }
 
   const toml::table& raw() const { return t_; }
@@ -164,6 +175,39 @@ class Table {
   const std::string& file() const { return file_; }
 
  private:
+  // Every key of this table, `path` below the descriptions' own tables, that one of S...
+  // describes (else "unknown key" with the closest match); a described subtable's keys
+  // likewise, in [table.sub].
+  template <class... S>
+  void check_described(const std::vector<std::string>& path) {
+    std::vector<core::TableKey> keys;
+    (core::append_table_keys<S>(path, &keys), ...);
+    std::vector<std::string_view> allowed;
+    for (const core::TableKey& k : keys) allowed.push_back(k.name), used_.insert(std::string(k.name));
+    check_unknown(allowed);
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+      const toml::node* n = t_.get(keys[i].name);
+      bool first = true;  // a subtable several descriptions share is checked once
+      for (std::size_t j = 0; j < i; ++j) first = first && !(keys[j].table && keys[j].name == keys[i].name);
+      if (!keys[i].table || !first || !n || !n->is_table()) continue;
+      std::vector<std::string> sub = path;
+      sub.emplace_back(keys[i].name);
+      Table(*n->as_table(), name_.empty() ? sub.back() : name_ + "." + sub.back(), file_).check_described<S...>(sub);
+    }
+  }
+  // A described field's failure at n: a nested key "sub.key" (and the sentence naming it so)
+  // written in its own table, "[table.sub] key ...".
+  [[noreturn]] void fail_described(const toml::node* n, const std::string& key, const std::string& what) const {
+    std::string table = name_, k = key, w = what;
+    if (const std::size_t dot = key.rfind('.'); dot != std::string::npos) {
+      const std::string sub = key.substr(0, dot);
+      table = name_.empty() ? sub : name_ + "." + sub;
+      k = key.substr(dot + 1);
+      if (w.rfind(sub + ".", 0) == 0) w = w.substr(sub.size() + 1);
+    }
+    throw FormatError({.file = file_, .line = line(n ? n : &t_), .table = table, .key = k, .kind = KeyKind::toml_table}, w);
+  }
+
   static const char* type_name(const toml::node& n) {
     switch (n.type()) {
       case toml::node_type::string: return "a string";

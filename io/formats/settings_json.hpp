@@ -12,11 +12,14 @@
 // A field of a type of its own (the coefficients held fixed, a position, a named vector) is
 // written and read by JsonValue<T>, specialised beside the type's other io
 // (io/formats/validation_json.hpp); a struct with such a field is written where that header
-// is included (else a compile error names the type).
+// is included (else a compile error names the type). A list of such a type is an array of
+// their JSON values (JsonValue<std::vector<T>> here).
 #include <concepts>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -34,6 +37,30 @@ concept HasJsonValue = requires(const T& x, T& y, const nlohmann::json& j) {
   JsonValue<T>::from(j, y);
 };
 
+// A list of a type with its own converter: an array of the values' JSON; an entry that does
+// not read is named by its index.
+template <class T>
+  requires HasJsonValue<T>
+struct JsonValue<std::vector<T>> {
+  static nlohmann::json to(const std::vector<T>& x) {
+    nlohmann::json j = nlohmann::json::array();
+    for (const T& e : x) j.push_back(JsonValue<T>::to(e));
+    return j;
+  }
+  static void from(const nlohmann::json& j, std::vector<T>& x) {
+    if (!j.is_array()) throw std::invalid_argument("expected an array");
+    std::vector<T> out(j.size());
+    for (std::size_t i = 0; i < j.size(); ++i) {
+      try {
+        JsonValue<T>::from(j[i], out[i]);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("[" + std::to_string(i) + "]: " + e.what());
+      }
+    }
+    x = std::move(out);
+  }
+};
+
 template <class S>
 nlohmann::json settings_json(const S& s) {
   nlohmann::json j = nlohmann::json::object();
@@ -48,8 +75,17 @@ nlohmann::json settings_json(const S& s) {
       nlohmann::json a = nlohmann::json::array();
       for (int i = 0; i < T::SizeAtCompileTime; ++i) a.push_back(x[i]);
       j[std::string(f.name)] = a;
+    } else if constexpr (core::is_vector_list<T>) {
+      nlohmann::json a = nlohmann::json::array();
+      for (const auto& v : x) {
+        nlohmann::json e = nlohmann::json::array();
+        for (int i = 0; i < static_cast<int>(v.size()); ++i) e.push_back(v[i]);
+        a.push_back(e);
+      }
+      j[std::string(f.name)] = a;
     } else {
-      static_assert(std::is_arithmetic_v<T> || std::is_same_v<T, std::string> || core::is_number_list<T>,
+      static_assert(std::is_arithmetic_v<T> || std::is_same_v<T, std::string> || core::is_number_list<T> ||
+                        core::is_string_list<T>,
                     "settings_json: a field type without JsonValue<T> (include its io/formats header)");
       j[std::string(f.name)] = core::written(f, x);
     }
@@ -84,6 +120,16 @@ void settings_from_json(const nlohmann::json& j, S& s, const std::string& prefix
       } else if constexpr (core::FixedVector<T>) {
         if (!v.is_array() || static_cast<int>(v.size()) != T::SizeAtCompileTime) throw std::invalid_argument("size");
         for (int i = 0; i < T::SizeAtCompileTime; ++i) x[i] = v[static_cast<std::size_t>(i)].template get<double>();
+      } else if constexpr (core::is_vector_list<T>) {
+        using V = typename T::value_type;
+        if (!v.is_array()) throw std::invalid_argument("type");
+        T w(v.size());
+        for (std::size_t r = 0; r < v.size(); ++r) {
+          const nlohmann::json& e = v[r];
+          if (!e.is_array() || static_cast<int>(e.size()) != V::SizeAtCompileTime) throw std::invalid_argument("size");
+          for (int i = 0; i < V::SizeAtCompileTime; ++i) w[r][i] = e[static_cast<std::size_t>(i)].template get<double>();
+        }
+        x = w;
       } else {
         if constexpr (std::is_same_v<T, bool>) {
           if (!v.is_boolean()) throw std::invalid_argument("type");

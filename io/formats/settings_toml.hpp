@@ -11,13 +11,15 @@
 // key; a scaled field's key holds the written value (the member gets it times the scale).
 //
 // read_settings_fields does the same without the unknown-key check, for a table whose keys
-// several descriptions share (check_settings_keys<S1, S2>, the union). Only for sources of
-// vrelab_formats (toml++ is private to it).
+// several descriptions share (check_settings_keys<S1, S2>, the union, subtables included).
+// Only for sources of vrelab_formats (toml++ is private to it).
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <vector>
 
 #include <toml++/toml.h>
 
@@ -25,26 +27,41 @@
 
 namespace vrelab::io {
 
-// fail(node, key, "key: unknown key") for a key of t that none of S... describes.
+// fail(node, key, "key: unknown key") for a key of t that none of S... describes; a subtable
+// that one of them describes is checked likewise against the union of its keys (its keys
+// named "table.key"). `path`: the subtable's place below the descriptions' own tables.
 template <class... S, class Fail>
-void check_settings_keys(const toml::table& t, const Fail& fail) {
+void check_settings_keys(const toml::table& t, const Fail& fail, const std::vector<std::string>& path = {}) {
+  std::vector<core::TableKey> keys;
+  (core::append_table_keys<S>(path, &keys), ...);
+  std::string prefix;
+  for (const std::string& p : path) prefix += p + ".";
   for (auto&& [k, v] : t) {
-    const std::string name(k.str());  // a copy: clang 14 cannot capture a structured binding
-    bool known = false;
-    const auto look = [&](const auto& f) { known = known || (f.in_table() && f.name == name); };
-    (core::for_each_field<S>(look), ...);
-    if (!known) fail(&v, name, name + ": unknown key");
+    const std::string name(k.str());
+    bool known = false, table = false;
+    for (const core::TableKey& key : keys)
+      if (key.name == name) known = true, table = table || key.table;
+    if (!known) fail(&v, prefix + name, prefix + name + ": unknown key");
+    if (table && v.is_table()) {
+      std::vector<std::string> sub = path;
+      sub.push_back(name);
+      check_settings_keys<S...>(*v.as_table(), fail, sub);
+    }
   }
 }
 
 namespace settings_toml_internal {
-// A finite number at n, else fail.
+// A finite number at n, else fail (the sentence naming `what`: the key, or an entry of it).
+template <class Fail>
+double finite_number(const toml::node* n, const std::string& key, const Fail& fail, const std::string& what) {
+  if (!n->is_number()) fail(n, key, what + ": expected a number");
+  const double d = n->value<double>().value();
+  if (!std::isfinite(d)) fail(n, key, what + ": must be finite");
+  return d;
+}
 template <class Fail>
 double finite_number(const toml::node* n, const std::string& key, const Fail& fail) {
-  if (!n->is_number()) fail(n, key, key + ": expected a number");
-  const double d = n->value<double>().value();
-  if (!std::isfinite(d)) fail(n, key, key + ": must be finite");
-  return d;
+  return finite_number(n, key, fail, key);
 }
 }  // namespace settings_toml_internal
 
@@ -63,7 +80,6 @@ void read_settings_fields(const toml::table& t, S& s, const Fail& fail) {
       const auto sub_fail = [&](const toml::node* m, const std::string& sub, const std::string& what) {
         fail(m, key + "." + sub, key + "." + what);
       };
-      check_settings_keys<T>(*n->as_table(), sub_fail);
       read_settings_fields(*n->as_table(), x, sub_fail);
     } else if constexpr (std::is_same_v<T, bool>) {
       if (!n->is_boolean()) fail(n, key, key + ": expected true or false");
@@ -104,8 +120,35 @@ void read_settings_fields(const toml::table& t, S& s, const Fail& fail) {
       for (int i = 0; i < kSize; ++i) w[i] = finite_number(a->get(static_cast<std::size_t>(i)), key, fail);
       if (!core::admissible_value(f, w)) fail(n, key, core::range_error_written(f, w));
       x = w;
+    } else if constexpr (core::is_vector_list<T>) {
+      using V = typename T::value_type;
+      constexpr int kSize = V::SizeAtCompileTime;
+      const std::string vector = "an array of " + std::to_string(kSize) + " numbers" + (kSize == 3 ? " [IA, PA, OA]" : "");
+      const toml::array* a = n->as_array();
+      if (!a || a->empty()) fail(n, key, key + ": expected a non-empty array, each entry " + vector);
+      T w;
+      for (auto&& e : *a) {
+        const toml::array* ea = e.as_array();
+        const std::string at = key + "[" + std::to_string(w.size()) + "]";
+        if (!ea || static_cast<int>(ea->size()) != kSize) fail(&e, key, at + ": expected " + vector);
+        V v;
+        for (int i = 0; i < kSize; ++i) v[i] = finite_number(ea->get(static_cast<std::size_t>(i)), key, fail, at);
+        w.push_back(v);
+        if (!core::admissible_value(f, w)) fail(&e, key, core::range_error_written(f, w));
+      }
+      x = w;
+    } else if constexpr (core::is_string_list<T>) {
+      const toml::array* a = n->as_array();
+      if (!a || a->empty()) fail(n, key, key + ": expected a non-empty array of strings");
+      T w;
+      for (auto&& e : *a) {
+        if (!e.is_string()) fail(&e, key, key + "[" + std::to_string(w.size()) + "]: expected a string");
+        w.push_back(e.value<std::string>().value());
+      }
+      x = w;
     } else {
-      static_assert(sizeof(T) == 0, "read_settings_fields: a field type TOML cannot hold");
+      // A type of its own (a position, a named vector): only a field set_by elsewhere, never a key.
+      throw std::logic_error("read_settings_fields: " + key + " is of a type TOML cannot hold; it must be set_by");
     }
   });
 }
