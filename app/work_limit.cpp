@@ -95,7 +95,7 @@ void check_reproduce_work(const io::Case& c) {
   r.sample_rate_Hz = c.shake.readout.active() ? c.shake.readout.sample_rate_Hz : 0.0;
   r.drive_Hz = fmax;
   r.drive_key = "[reproduce] frequency_Hz / departure_frequencies_Hz";
-  r.simulated_s = settle_s(c, p) + std::max(measure_s(c, fmin), s.confirmation_record_s);
+  r.simulated_s = settle_s(c, p) + std::max(measure_s(c, fmin), s.confirmation.record_s);
   r.time_key = "[shake] min_measure_s and settle_decay, [reproduce.confirmation] record_s";
   r.runs = static_cast<double>(s.amplitudes_g.size() * s.directions.size() * s.orientations.size() *
                                (1 + s.departure_frequencies_Hz.size()) + 1);

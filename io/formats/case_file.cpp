@@ -79,10 +79,9 @@ nlohmann::json to_json(const toml::node& n) {
   return std::string("<date/time>");
 }
 
-// A static orientation is gravity in sensor axes, in units of the local g: |a| = 1 g. Within
-// 1e-3: a vector typed with four digits (0.7071) is off by ~1e-4, while a norm of 0 g (no
-// gravity) or 10 g (a centrifuge, or m/s^2 typed for g) is not a static test on the earth.
-constexpr double kGravityNormTolerance = 1e-3;
+// A static orientation is gravity in sensor axes, in units of the local g: |a| = 1 g, within
+// validation::kGravityNormTolerance_g (reproduce.hpp says why).
+constexpr double kGravityNormTolerance = validation::kGravityNormTolerance_g;
 void check_gravity(const Table& t, const toml::node* n, std::string_view key, const Vec3& a) {
   if (!(std::abs(a.norm() - 1) <= kGravityNormTolerance))
     t.fail(n, key,
@@ -253,58 +252,18 @@ void read_frequency_study(Table t, Case& c) {
   c.frequency_study = f;
 }
 
-// Names for a list of vectors: given (one per vector) or the vectors written out.
-std::vector<validation::NamedVector> named_vectors(Table& t, std::string_view key, std::string_view names_key,
-                                                   bool unit) {
-  const std::vector<Vec3> v = vec3_list(t, key, unit);
-  if (v.empty()) t.fail(nullptr, key, "missing (required)");
-  std::vector<std::string> names;
-  if (const toml::node* n = t.get(names_key, false)) {
-    const toml::array* a = n->as_array();
-    if (!a || a->size() != v.size()) t.fail(n, names_key, "expected an array of " + std::to_string(v.size()) + " strings, one per entry of " + std::string(key));
-    for (auto&& x : *a) {
-      if (!x.is_string() || x.as_string()->get().empty()) t.fail(&x, names_key, "expected a non-empty string");
-      names.push_back(x.as_string()->get());
-    }
-  }
-  std::vector<validation::NamedVector> out;
-  for (std::size_t i = 0; i < v.size(); ++i)
-    out.push_back({names.empty() ? fmt::format("[{:.3g}, {:.3g}, {:.3g}]", v[i][0], v[i][1], v[i][2]) : names[i], v[i]});
-  return out;
-}
-
+// [reproduce] through its description (ReproduceSettings, its lists as written through
+// ReproduceLists), then what needs the other tables: the sampling of [readout], and the static
+// test, the seed and the measurement.
 void read_reproduce(Table t, Case& c) {
   validation::ReproduceSettings r;
-  r.frequency_Hz = t.number("frequency_Hz");
-  if (!(r.frequency_Hz > 0)) t.fail(t.raw().get("frequency_Hz"), "frequency_Hz", "must be positive");
-  r.amplitudes_g = number_list(t, "amplitudes_g");
-  if (r.amplitudes_g.empty()) t.fail(nullptr, "amplitudes_g", "missing (required)");
-  for (double a : r.amplitudes_g)
-    if (!(a > 0)) t.fail(t.raw().get("amplitudes_g"), "amplitudes_g", "amplitudes must be positive");
-  for (double a : r.amplitudes_g) check_amplitude(t, "amplitudes_g", a);
-  r.directions = named_vectors(t, "directions", "direction_names", true);
-  r.orientations = named_vectors(t, "orientations_g", "orientation_names", false);
-  for (const auto& o : r.orientations)
-    if (std::abs(o.v.norm() - 1) > 1e-3)
-      t.fail(t.raw().get("orientations_g"), "orientations_g",
-             fmt::format("a static orientation is gravity in sensor axes, |a| = 1 g; '{}' has |a| = {:.6g} g", o.name, o.v.norm()));
-  r.departure_frequencies_Hz = number_list(t, "departure_frequencies_Hz");
-  for (double f : r.departure_frequencies_Hz)
-    if (!(f > 0)) t.fail(t.raw().get("departure_frequencies_Hz"), "departure_frequencies_Hz", "frequencies must be positive");
-  r.invisible_shift_per_g = t.opt_number("invisible_shift_per_g").value_or(0.0);
-  r.threads = static_cast<int>(t.integer("threads", false, 0, 0, 1024));
+  validation::ReproduceLists lists;
+  for (std::string_view key : {"frequency_Hz", "amplitudes_g", "directions", "orientations_g"}) t.get(key, true);
   auto conf = t.subtable("confirmation", true);
-  const auto index = [&](std::string_view key, std::size_t n) {
-    return static_cast<std::size_t>(conf->integer(key, false, 1, 1, static_cast<std::int64_t>(n)) - 1);
-  };
-  r.confirmation_orientation = r.orientations[index("orientation", r.orientations.size())];
-  r.confirmation_direction = r.directions[index("direction", r.directions.size())];
-  r.confirmation_amplitude_g = conf->number("amplitude_g");
-  check_amplitude(*conf, "amplitude_g", r.confirmation_amplitude_g);
-  if (!(r.confirmation_amplitude_g > 0)) conf->fail(conf->raw().get("amplitude_g"), "amplitude_g", "must be positive");
-  r.confirmation_record_s = conf->number("record_s");
-  if (!(r.confirmation_record_s > 0)) conf->fail(conf->raw().get("record_s"), "record_s", "must be positive");
-  conf->check_unknown({"orientation", "direction", "amplitude_g", "record_s"});
+  for (std::string_view key : {"amplitude_g", "record_s"}) conf->get(key, true);
+  t.read_described(r, lists);
+  if (std::string why; !lists.IsValid(&why)) t.fail_sentence(why);
+  lists.apply(r);
   // Each run is sampled with at least 10 samples per period (shake.hpp).
   if (c.shake.readout.active()) {
     if (10 * r.frequency_Hz > c.shake.readout.sample_rate_Hz)
@@ -316,10 +275,7 @@ void read_reproduce(Table t, Case& c) {
         t.fail(t.raw().get("departure_frequencies_Hz"), "departure_frequencies_Hz",
                fmt::format("{:g} Hz needs at least 10 samples per period: [readout] sample_rate_Hz >= {:g}", f, 10 * f));
   }
-  t.check_unknown({"frequency_Hz", "amplitudes_g", "directions", "direction_names", "orientations_g",
-                   "orientation_names", "departure_frequencies_Hz", "invisible_shift_per_g", "threads",
-                   "confirmation"});
-  // The rest of the configuration from the tables read before this one.
+  // The fields set_by the tables read before this one.
   if (c.dividing_head) r.positions = c.dividing_head->positions, r.errors = c.dividing_head->errors;
   r.fixed = c.fixed;
   r.seed = c.seed;

@@ -212,7 +212,7 @@ void report_confirmation(Report& rep, const Case& c, const ReproduceSettings& s,
                          const std::string& figures_missing) {
   const validation::ConfirmationRecord& cf = res.confirmation;
   const double K1 = res.truth[plant::K1];
-  const Vec3 conf_dir = s.confirmation_direction.v.normalized();
+  const Vec3 conf_dir = s.confirmation.direction.v.normalized();
   const double conf_diff = cf.shake.measured_g - cf.predicted.value_g;
   const double conf_comb = std::hypot(cf.shake.sigma_g, cf.predicted.sigma_g);
   rep.heading("2. The confirmation plot");
@@ -237,8 +237,8 @@ void report_confirmation(Report& rep, const Case& c, const ReproduceSettings& s,
       "straight line alone gives {} ug{}. The whole-period mean of the output is {} +- {} ug, and eq. (3) from the "
       "identified coefficients predicts {} +- {} ug: a difference of {} ug ({:.2f} combined sigma{}). The figure shows "
       "the integral with the fitted swing taken off.",
-      s.confirmation_amplitude_g, s.frequency_Hz, s.confirmation_direction.name, vec_text(conf_dir),
-      s.confirmation_orientation.name, vec_text(s.confirmation_orientation.v), acquisition,
+      s.confirmation.amplitude_g, s.frequency_Hz, s.confirmation.direction.name, vec_text(conf_dir),
+      s.confirmation.orientation.name, vec_text(s.confirmation.orientation.v), acquisition,
       cf.t_s.empty() ? 0.0 : -cf.t_s.front(), cf.t_measure_start_s, cf.t_end_s - cf.t_measure_start_s, swing,
       c.output_unit, ug(cf.shake.measured_g, 1), K1 * cf.shake.measured_g, c.output_unit,
       swing > 0 ? std::abs(K1 * cf.shake.measured_g) / swing : 0.0, cf.oscillation_amplitude_g_s * 1e3,
@@ -331,7 +331,7 @@ void report_frequency(Report& rep, const ReproduceSettings& s, const ReproduceRe
       "change from the reference run with its own uncertainty (the coefficient errors do not cancel: the terms scale "
       "differently with frequency); measured and predicted changes agree within {:.2f} combined sigma at worst ({:g} Hz). "
       "With the true coefficients the predicted change is within {:.2f} sigma of the measured one (measurement sigma only).",
-      s.confirmation_amplitude_g, s.confirmation_direction.name, s.confirmation_orientation.name, fr.size(),
+      s.confirmation.amplitude_g, s.confirmation.direction.name, s.confirmation.orientation.name, fr.size(),
       fr.front().frequency_Hz, fr.back().frequency_Hz, d.reference_Hz,
       departs.empty() ? std::string("no frequency measured") : departs + " Hz", ug(top.measured_g), top.frequency_Hz,
       ug(ref.measured_g), d.reference_Hz, d.worst_z_change, d.worst_z_change_Hz, d.worst_z_true));

@@ -39,40 +39,12 @@ json series_windows_json(const rectification::SeriesWindows& w) {
           {"blocks", w.blocks}};
 }
 
-namespace {
-json named_json(const validation::NamedVector& v) { return {{"name", v.name}, {"vector", vec_json(v.v)}}; }
-json named_list_json(const std::vector<validation::NamedVector>& v) {
-  json j = json::array();
-  for (const auto& x : v) j.push_back(named_json(x));
-  return j;
-}
-}  // namespace
-
+// ReproduceSettings as described (validation_json.hpp for its positions and named vectors), the
+// shaker runs' settings with their solver.
 json reproduce_settings_json(const validation::ReproduceSettings& s) {
-  json fixed = json::object();
-  for (int i = 0; i < kNumCoefficients; ++i)
-    if (s.fixed[i]) fixed[std::string(plant::coefficient_name(i))] = *s.fixed[i];
-  return {{"static_test",
-           {{"positions", s.positions.size()},
-            {"initial_error_rad", vec_json(s.errors.initial_error_rad)},
-            {"angle_sigma_rad", s.errors.angle_sigma_rad},
-            {"noise_sigma_g", s.errors.noise_sigma_g},
-            {"repeats", s.errors.repeats},
-            {"fixed", fixed}}},
-          {"seed", s.seed},
-          {"shake", shake_settings_json(s.shake)},
-          {"frequency_Hz", s.frequency_Hz},
-          {"amplitudes_g", s.amplitudes_g},
-          {"directions", named_list_json(s.directions)},
-          {"orientations", named_list_json(s.orientations)},
-          {"confirmation",
-           {{"orientation", named_json(s.confirmation_orientation)},
-            {"direction", named_json(s.confirmation_direction)},
-            {"amplitude_g", s.confirmation_amplitude_g},
-            {"record_s", s.confirmation_record_s}}},
-          {"departure_frequencies_Hz", s.departure_frequencies_Hz},
-          {"invisible_shift_per_g", s.invisible_shift_per_g},
-          {"threads", s.threads}};
+  json j = settings_json(s);
+  j["shake"] = shake_settings_json(s.shake);
+  return j;
 }
 
 double vibration_input_rms_g(const VibrationSpec& v) {
@@ -372,11 +344,11 @@ json reproduce_confirmation_json(const Case& c, const validation::ReproduceSetti
   return {{"output_unit", c.output_unit},
           {"K1", res.truth[plant::K1]},
           {"frequency_Hz", s.frequency_Hz},
-          {"amplitude_g", s.confirmation_amplitude_g},
-          {"direction", vec_json(s.confirmation_direction.v.normalized())},
-          {"direction_name", s.confirmation_direction.name},
-          {"orientation_g", vec_json(s.confirmation_orientation.v)},
-          {"orientation_name", s.confirmation_orientation.name},
+          {"amplitude_g", s.confirmation.amplitude_g},
+          {"direction", vec_json(s.confirmation.direction.v.normalized())},
+          {"direction_name", s.confirmation.direction.name},
+          {"orientation_g", vec_json(s.confirmation.orientation.v)},
+          {"orientation_name", s.confirmation.orientation.name},
           {"t_measure_start_s", cf.t_measure_start_s},
           {"t_end_s", cf.t_end_s},
           {"sample_rate_Hz", cf.shake.sample_rate_Hz},
@@ -389,9 +361,9 @@ json reproduce_confirmation_json(const Case& c, const validation::ReproduceSetti
           {"predicted_g", cf.predicted.value_g},
           {"sigma_predicted_g", cf.predicted.sigma_g},
           // A sine of peak amplitude_g along the direction: input rms amplitude_g / sqrt(2).
-          {"input_rms_g", s.confirmation_amplitude_g / std::numbers::sqrt2},
-          {"measured_vrc_ug_per_g2", vrc_json(cf.shake.measured_g, s.confirmation_amplitude_g / std::numbers::sqrt2)},
-          {"predicted_vrc_ug_per_g2", vrc_json(cf.predicted.value_g, s.confirmation_amplitude_g / std::numbers::sqrt2)}};
+          {"input_rms_g", s.confirmation.amplitude_g / std::numbers::sqrt2},
+          {"measured_vrc_ug_per_g2", vrc_json(cf.shake.measured_g, s.confirmation.amplitude_g / std::numbers::sqrt2)},
+          {"predicted_vrc_ug_per_g2", vrc_json(cf.predicted.value_g, s.confirmation.amplitude_g / std::numbers::sqrt2)}};
 }
 
 namespace {

@@ -26,8 +26,10 @@
 #include <functional>
 #include <random>
 #include <utility>
+#include <string>
 #include <vector>
 
+#include "core/settings_description.hpp"
 #include "plant/model1.hpp"
 
 namespace vrelab::validation {
@@ -55,11 +57,26 @@ Position vector_position(const Vec3& a_g);  // unit vector expected
 // True when `p` is the paper's 3 x 8 set in the paper's order.
 bool is_paper_set(const std::vector<Position>& p);
 
+// The test's error sources (above). Describe lists each field once
+// (core/settings_description.hpp), in the units held: the record of the settings used and
+// IsValid. A case's [dividing_head] writes them in arcsec and ug.
 struct StaticTestErrors {
   Vec3 initial_error_rad = Vec3::Zero();
   double angle_sigma_rad = 0.0;
   double noise_sigma_g = 0.0;  // per reading, input-equivalent
   int repeats = 1;
+
+  template <class V>
+  static void Describe(V& v) {
+    using S = StaticTestErrors;
+    using core::field;
+    v(field("initial_error_rad", &S::initial_error_rad, "rad", core::finite(),
+            "Initial orientation error: the sensor frame's rotation about [IA, PA, OA], the same in every position"));
+    v(field("angle_sigma_rad", &S::angle_sigma_rad, "rad", core::at_least(0), "Set-angle error of each visit (sigma)"));
+    v(field("noise_sigma_g", &S::noise_sigma_g, "g", core::at_least(0), "Reading noise, input-equivalent (sigma)"));
+    v(field("repeats", &S::repeats, "visits", core::closed(1, 100000), "Visits of each position"));
+  }
+  bool IsValid(std::string* why) const { return core::validate(*this, why); }
 };
 
 struct Reading {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include <Eigen/Dense>
+#include <fmt/format.h>
 
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
@@ -121,30 +122,90 @@ Prediction predict_with_uncertainty(const Model& f, const Coefficients& c,
   return {f(c), std::sqrt(std::max(var, 0.0))};
 }
 
+namespace {
+
+// Why a static orientation a is not gravity in sensor axes; "" when it is.
+std::string gravity_problem(const Vec3& a) {
+  if (std::abs(a.norm() - 1) <= kGravityNormTolerance_g) return "";
+  return fmt::format("a static orientation is gravity in sensor axes [IA, PA, OA], |a| = 1 g (within {:g}); got |a| = {:.6g} g",
+                     kGravityNormTolerance_g, a.norm());
+}
+
+bool fail_with(std::string* why, const std::string& m) {
+  if (why) *why = m;
+  return false;
+}
+
+}  // namespace
+
+bool ConfirmationSettings::IsValid(std::string* why) const {
+  if (!core::validate(*this, why)) return false;
+  if (!(direction.v.norm() > 0)) return fail_with(why, "direction: not set (a zero vector)");
+  if (const std::string p = gravity_problem(orientation.v); !p.empty())
+    return fail_with(why, "orientation '" + orientation.name + "': " + p);
+  return true;
+}
+
 bool ReproduceSettings::IsValid(std::string* why) const {
-  auto fail = [&](const std::string& m) {
-    if (why) *why = m;
-    return false;
-  };
-  if (amplitudes_g.empty() || directions.empty() || orientations.empty())
-    return fail("[reproduce] amplitudes_g, directions, orientations_g: the amplitude study needs each");
-  if (!(frequency_Hz > 0)) return fail("[reproduce] frequency_Hz: must be positive");
-  for (double a : amplitudes_g)
-    if (!(a > 0)) return fail("[reproduce] amplitudes_g: amplitudes must be positive");
-  for (double f : departure_frequencies_Hz)
-    if (!(f > 0)) return fail("[reproduce] departure_frequencies_Hz: frequencies must be positive");
-  if (!(confirmation_amplitude_g > 0)) return fail("[reproduce.confirmation] amplitude_g: must be positive");
-  if (!(confirmation_record_s > 0)) return fail("[reproduce.confirmation] record_s: must be positive");
-  if (!(confirmation_direction.v.norm() > 0)) return fail("[reproduce.confirmation] direction: not set");
-  if (!std::isfinite(invisible_shift_per_g)) return fail("[reproduce] invisible_shift_per_g: must be finite");
-  if (threads < 0) return fail("[reproduce] threads: must not be negative");
-  if (std::string w; !shake.IsValid(&w)) return fail("[shake] " + w);
-  if (positions.empty()) return fail("[dividing_head]: the static test needs positions");
+  if (!core::validate(*this, why)) return false;
+  const std::string needs = ": none; the amplitude study needs amplitudes, directions and orientations";
+  if (amplitudes_g.empty()) return fail_with(why, "amplitudes_g" + needs);
+  if (directions.empty()) return fail_with(why, "directions" + needs);
+  if (orientations.empty()) return fail_with(why, "orientations" + needs);
+  for (const NamedVector& d : directions)
+    if (!(d.v.norm() > 0)) return fail_with(why, "directions: '" + d.name + "' is a zero vector");
+  for (const NamedVector& o : orientations)
+    if (const std::string p = gravity_problem(o.v); !p.empty()) return fail_with(why, "orientations: '" + o.name + "': " + p);
+  if (positions.empty()) return fail_with(why, "positions: none; the static test needs them ([dividing_head])");
   const Identifiability ident = identifiability(positions, fixed);
   if (!ident.full_rank())
-    return fail("[dividing_head] with [identification] fixed: rank " + std::to_string(ident.rank) + " of " +
-                std::to_string(ident.parameters) + "; fix more coefficients (the paper fixes k1_asym, k_PP and k_OO)");
+    return fail_with(why, "positions: rank " + std::to_string(ident.rank) + " of " + std::to_string(ident.parameters) +
+                              " with the coefficients held fixed ([dividing_head] with [identification] fixed); fix more "
+                              "coefficients (the paper fixes k1_asym, k_PP and k_OO)");
   return true;
+}
+
+bool ReproduceLists::IsValid(std::string* why) const {
+  if (!core::validate(*this, why)) return false;
+  const auto names_fit = [&](const char* key, const std::vector<std::string>& names, const char* of, std::size_t n) {
+    if (!names.empty() && names.size() != n)
+      return fail_with(why, fmt::format("{}: expected an array of {} strings, one per entry of {} (got {})", key, n, of,
+                                        names.size()));
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i].empty()) return fail_with(why, fmt::format("{}[{}]: must not be empty", key, i));
+    return true;
+  };
+  if (directions.empty()) return fail_with(why, "directions: none; the amplitude study needs at least one");
+  if (orientations_g.empty()) return fail_with(why, "orientations_g: none; the amplitude study needs at least one");
+  if (!names_fit("direction_names", direction_names, "directions", directions.size())) return false;
+  if (!names_fit("orientation_names", orientation_names, "orientations_g", orientations_g.size())) return false;
+  for (std::size_t i = 0; i < directions.size(); ++i)
+    if (!(directions[i].norm() > 0))
+      return fail_with(why, fmt::format("directions[{}] = {}: a direction must not be zero", i, core::format_value(directions[i])));
+  for (std::size_t i = 0; i < orientations_g.size(); ++i)
+    if (const std::string p = gravity_problem(orientations_g[i]); !p.empty())
+      return fail_with(why, fmt::format("orientations_g[{}] = {}: {}", i, core::format_value(orientations_g[i]), p));
+  const auto index_fits = [&](const char* key, int index, const char* of, std::size_t n) {
+    if (static_cast<std::size_t>(index) <= n) return true;
+    return fail_with(why, fmt::format("confirmation.{} = {}: must be at most {}, the entries of {}", key, index, n, of));
+  };
+  return index_fits("orientation", confirmation.orientation, "orientations_g", orientations_g.size()) &&
+         index_fits("direction", confirmation.direction, "directions", directions.size());
+}
+
+void ReproduceLists::apply(ReproduceSettings& s) const {
+  const auto named = [](const std::vector<Vec3>& v, const std::vector<std::string>& names, bool unit) {
+    std::vector<NamedVector> out;
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      const Vec3 x = unit ? v[i].normalized() : v[i];
+      out.push_back({names.empty() ? fmt::format("[{:.3g}, {:.3g}, {:.3g}]", x[0], x[1], x[2]) : names[i], x});
+    }
+    return out;
+  };
+  s.directions = named(directions, direction_names, true);
+  s.orientations = named(orientations_g, orientation_names, false);
+  s.confirmation.orientation = s.orientations.at(static_cast<std::size_t>(confirmation.orientation - 1));
+  s.confirmation.direction = s.directions.at(static_cast<std::size_t>(confirmation.direction - 1));
 }
 
 std::string run_label(const RunResult& r) {
@@ -329,11 +390,11 @@ void fit_running_integral(ConfirmationRecord& c, double frequency_Hz) {
 void confirmation_run(const plant::PlantConfig& truth_plant, const ReproduceSettings& s, const plant::PlantConfig& nominal,
                       const Covariance& cov, ConfirmationRecord& c) {
   rectification::ShakeSettings cs = s.shake;
-  cs.min_measure_s = s.confirmation_record_s;
+  cs.min_measure_s = s.confirmation.record_s;
   c.K1 = truth_plant.coefficients[plant::K1];
   const vibration::SineVibration v =
-      sine_of(s.confirmation_direction.v.normalized(), s.confirmation_amplitude_g, s.frequency_Hz);
-  c.shake = rectification::shake_sine(truth_plant, s.confirmation_orientation.v, v, cs,
+      sine_of(s.confirmation.direction.v.normalized(), s.confirmation.amplitude_g, s.frequency_Hz);
+  c.shake = rectification::shake_sine(truth_plant, s.confirmation.orientation.v, v, cs,
                                       [&c](double t, const Vec3&, double u) {
                                         c.t_s.push_back(t);
                                         c.output.push_back(u);
@@ -346,8 +407,8 @@ void confirmation_run(const plant::PlantConfig& truth_plant, const ReproduceSett
   c.t_end_s = c.t_s.empty() ? 0.0 : c.t_s.back();
   fit_running_integral(c, s.frequency_Hz);
   RunResult r;
-  r.orientation_g = s.confirmation_orientation.v, r.direction_unit = s.confirmation_direction.v.normalized();
-  r.amplitude_g = s.confirmation_amplitude_g, r.frequency_Hz = s.frequency_Hz;
+  r.orientation_g = s.confirmation.orientation.v, r.direction_unit = s.confirmation.direction.v.normalized();
+  r.amplitude_g = s.confirmation.amplitude_g, r.frequency_Hz = s.frequency_Hz;
   predict_run(r, nominal, cov);
   c.predicted = r.predicted;
 }
@@ -405,8 +466,8 @@ void invisible_shift(const plant::PlantConfig& truth_plant, const ReproduceSetti
                  std::abs(plant::settled_output_g(other, p.nominal_g) - plant::settled_output_g(truth_plant, p.nominal_g)));
   const std::vector<NamedVector> axes = {{"IA", Vec3(1, 0, 0)}, {"PA", Vec3(0, 1, 0)}, {"OA", Vec3(0, 0, 1)}};
   say("invisible shift: 3 x " + std::to_string(s.amplitudes_g.size()) + " shaker runs on the second instrument");
-  const rectification::SweepGrid ig = grid_of({s.frequency_Hz}, s.amplitudes_g, axes, {s.confirmation_orientation});
-  inv.runs = shake_grid(other, section_shake(s, 3), ig, axes, {s.confirmation_orientation}, threads, progress,
+  const rectification::SweepGrid ig = grid_of({s.frequency_Hz}, s.amplitudes_g, axes, {s.confirmation.orientation});
+  inv.runs = shake_grid(other, section_shake(s, 3), ig, axes, {s.confirmation.orientation}, threads, progress,
                         "invisible shift");
   fit_invisible_shift(inv, out.nominal, out.identified, cov);
 }
@@ -444,10 +505,10 @@ ReproduceResult reproduce(const plant::PlantConfig& truth_plant, const Reproduce
   // 4. The departure in frequency.
   if (!s.departure_frequencies_Hz.empty()) {
     say("frequency departure: " + std::to_string(s.departure_frequencies_Hz.size()) + " shaker runs");
-    const rectification::SweepGrid fg = grid_of(s.departure_frequencies_Hz, {s.confirmation_amplitude_g},
-                                                {s.confirmation_direction}, {s.confirmation_orientation});
+    const rectification::SweepGrid fg = grid_of(s.departure_frequencies_Hz, {s.confirmation.amplitude_g},
+                                                {s.confirmation.direction}, {s.confirmation.orientation});
     out.frequency_runs =
-        shake_grid(truth_plant, section_shake(s, 2), fg, {s.confirmation_direction}, {s.confirmation_orientation},
+        shake_grid(truth_plant, section_shake(s, 2), fg, {s.confirmation.direction}, {s.confirmation.orientation},
                    threads, progress, "frequency departure");
     std::sort(out.frequency_runs.begin(), out.frequency_runs.end(),
               [](const RunResult& a, const RunResult& b) { return a.frequency_Hz < b.frequency_Hz; });

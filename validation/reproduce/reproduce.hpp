@@ -40,6 +40,39 @@ struct NamedVector {
   Vec3 v = Vec3::Zero();
 };
 
+// A static orientation is gravity in sensor axes, in units of the local g: |a| = 1 g, within
+// this. A vector typed with four digits (0.7071) is off by ~1e-4, while a norm of 0 g (no
+// gravity) or 10 g (a centrifuge, or m/s^2 typed for g) is not a static test on the earth.
+inline constexpr double kGravityNormTolerance_g = 1e-3;
+
+// The confirmation run: the record (rest, then vibration) of one condition. Described as the
+// nested table [reproduce.confirmation]; a case names the orientation and the direction by
+// their index in [reproduce]'s lists (ConfirmationIndices, through ReproduceLists::apply).
+struct ConfirmationSettings {
+  NamedVector orientation, direction;
+  double amplitude_g = 3.0;
+  double record_s = 2.0;  // at rest, and measured under vibration
+
+  template <class V>
+  static void Describe(V& v) {
+    using S = ConfirmationSettings;
+    using core::field;
+    v(field("orientation", &S::orientation, "g", core::any_value(), "Gravity in sensor axes during the run, named")
+          .set_by("orientation, an index into [reproduce] orientations_g (ReproduceLists)"));
+    v(field("direction", &S::direction, "", core::any_value(), "Vibration direction in sensor axes (in phase), named")
+          .set_by("direction, an index into [reproduce] directions (ReproduceLists)"));
+    v(field("amplitude_g", &S::amplitude_g, "g", core::open_closed(0, 1000), "Peak amplitude along direction"));
+    v(field("record_s", &S::record_s, "s", core::open_closed(0, 1e6),
+            "Length of the record at rest and of the measured interval (as [shake] min_measure_s)"));
+  }
+  // The ranges, a direction set (not zero) and an orientation of |a| = 1 g.
+  bool IsValid(std::string* why) const;
+};
+
+// The experiment's settings. Describe lists each field once (core/settings_description.hpp):
+// the case's [reproduce] table (its lists through ReproduceLists below), the JSON record of the
+// settings used, and IsValid. The static test, the seed and the measurement come from other
+// tables, as their set_by says.
 struct ReproduceSettings {
   // Static test (readings: the plant settled in each position).
   std::vector<Position> positions;
@@ -52,20 +85,96 @@ struct ReproduceSettings {
   std::vector<double> amplitudes_g;
   std::vector<NamedVector> directions;    // unit vectors, sensor axes (in phase)
   std::vector<NamedVector> orientations;  // gravity in sensor axes, g
-  // The confirmation run: orientation, direction, amplitude; measured over record_s seconds.
-  NamedVector confirmation_orientation, confirmation_direction;
-  double confirmation_amplitude_g = 3.0;
-  double confirmation_record_s = 2.0;
+  ConfirmationSettings confirmation;
   // The departure in frequency (the confirmation condition); empty: skipped.
   std::vector<double> departure_frequencies_Hz;
   // The invisible shift c (1/g); 0: skipped.
   double invisible_shift_per_g = 0.0;
   int threads = 0;  // 0: all cores
 
-  // True when the settings describe a run: the amplitude study has amplitudes, directions
-  // and orientations, the numbers are positive, the confirmation run is set. Else false,
-  // with the reason (naming the setting) in *why when given.
+  template <class V>
+  static void Describe(V& v) {
+    using S = ReproduceSettings;
+    using core::field;
+    v(field("positions", &S::positions, "", core::any_value(), "The static test's positions on the dividing head")
+          .set_by("[dividing_head] positions_per_series (and series), positions or orientations_g"));
+    v(field("errors", &S::errors, "", core::any_value(), "The static test's error sources")
+          .set_by("[dividing_head] initial_error_arcsec, angle_sigma_arcsec, noise_sigma_ug, repeats"));
+    v(field("fixed", &S::fixed, "", core::any_value(), "Coefficients held at a given value, not identified")
+          .set_by("[identification] fixed"));
+    v(field("seed", &S::seed, "", core::any_value(), "Seed of the static test's draws")
+          .set_by("[run] seed"));
+    v(field("shake", &S::shake, "", core::any_value(), "Every shaker run's measurement (the readout's seed offset per run)")
+          .set_by("the [shake] and [readout] tables"));
+    v(field("frequency_Hz", &S::frequency_Hz, "Hz", core::above(0),
+            "Frequency of the amplitude study and the confirmation run"));
+    // At most 1000 g, as every amplitude of a case (shakers reach ~100 g).
+    v(field("amplitudes_g", &S::amplitudes_g, "g", core::open_closed(0, 1000), "Peak amplitudes of the amplitude study"));
+    v(field("directions", &S::directions, "", core::any_value(), "Vibration directions in sensor axes, named")
+          .set_by("directions and direction_names (ReproduceLists)"));
+    v(field("orientations", &S::orientations, "g", core::any_value(), "Static orientations, gravity in sensor axes, named")
+          .set_by("orientations_g and orientation_names (ReproduceLists)"));
+    v(field("confirmation", &S::confirmation, "", core::any_value(), "The confirmation run"));
+    v(field("departure_frequencies_Hz", &S::departure_frequencies_Hz, "Hz", core::above(0),
+            "The confirmation condition measured over these frequencies; none: skipped"));
+    v(field("invisible_shift_per_g", &S::invisible_shift_per_g, "1/g", core::finite(),
+            "c of the second instrument, (k0, k2, k_PP, k_OO) += c (1, -1, -1, -1); 0: skipped"));
+    v(field("threads", &S::threads, "threads", core::closed(0, 1024), "Threads of the shaker runs; 0: all cores"));
+  }
+
+  // True when the settings describe a run: the described ranges; the amplitude study has
+  // amplitudes, directions (none zero) and orientations (each |a| = 1 g); the confirmation run
+  // is set; the position set identifies the coefficients not held fixed (full rank). Else
+  // false, with the reason (naming the setting) in *why when given.
   bool IsValid(std::string* why) const;
+};
+
+// [reproduce.confirmation]'s orientation and direction as a case writes them: 1-based indices
+// into [reproduce] orientations_g and directions.
+struct ConfirmationIndices {
+  int orientation = 1, direction = 1;
+
+  template <class V>
+  static void Describe(V& v) {
+    using S = ConfirmationIndices;
+    using core::field;
+    v(field("orientation", &S::orientation, "", core::at_least(1), "The run's orientation: its index in orientations_g, from 1"));
+    v(field("direction", &S::direction, "", core::at_least(1), "The run's direction: its index in directions, from 1"));
+  }
+  bool IsValid(std::string* why) const { return core::validate(*this, why); }
+};
+
+// [reproduce]'s lists as a case writes them: the vectors, with their names in a list beside
+// them (none: each named by its vector written out), and the confirmation run's condition as
+// indices into them. ReproduceSettings holds each vector with its name, so the keys are
+// described here, as written, and apply() is the one conversion.
+struct ReproduceLists {
+  std::vector<Vec3> directions;
+  std::vector<std::string> direction_names;
+  std::vector<Vec3> orientations_g;
+  std::vector<std::string> orientation_names;
+  ConfirmationIndices confirmation;
+
+  template <class V>
+  static void Describe(V& v) {
+    using S = ReproduceLists;
+    using core::field;
+    v(field("directions", &S::directions, "", core::any_value(),
+            "Vibration directions in sensor axes [IA, PA, OA] (normalised; in phase)"));
+    v(field("direction_names", &S::direction_names, "", core::any_value(),
+            "One name per direction; none: the vector written out"));
+    v(field("orientations_g", &S::orientations_g, "g", core::any_value(),
+            "Static orientations: gravity in sensor axes [IA, PA, OA], |a| = 1 g"));
+    v(field("orientation_names", &S::orientation_names, "", core::any_value(), "One name per orientation"));
+    v(field("confirmation", &S::confirmation, "", core::any_value(), "The confirmation run's condition"));
+  }
+  // The ranges; each list given; a name per vector, none empty; no zero direction; each
+  // orientation |a| = 1 g; the indices within their lists. Else false, the reason naming the
+  // key ("orientations_g[1] = [0, 0.6, 0.9]: ...", "confirmation.orientation = 3: ...").
+  bool IsValid(std::string* why) const;
+  // s's directions (normalised), orientations and confirmation orientation and direction
+  // from these lists; for lists IsValid accepts.
+  void apply(ReproduceSettings& s) const;
 };
 
 struct Prediction {
