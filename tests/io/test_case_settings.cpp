@@ -1,19 +1,25 @@
 // The case file's settings structs described once (core/settings_description.hpp): ShakeSettings
 // with its Readout, FrequencyStudySettings with the FrequencyGrid it is read through, and
-// SolverSettings, and StaticTestSettings with its MonteCarloCheckpoint (no table: recorded and
-// validated only; the coefficients held fixed through JsonValue). A range is enforced from the case file with the file, the line, the table
-// and the key in the message; a scaled key ([readout] noise_sigma_ug) arrives in g and is
-// recorded as written; each struct's JSON record reads back to the same struct; and each
-// description lists every member of its struct (counted from the aggregate itself), so a
-// member added but not described fails here. Readers only: fast.
+// SolverSettings, StaticTestSettings with its MonteCarloCheckpoint (no table: recorded and
+// validated only; the coefficients held fixed through JsonValue), and ReproduceSettings with
+// StaticTestErrors and ConfirmationSettings, read through ReproduceLists (lists of vectors and
+// of names; the nested [reproduce.confirmation] shared by both). A range is enforced from the
+// case file with the file, the line, the table and the key in the message; a scaled key
+// ([readout] noise_sigma_ug) arrives in g and is recorded as written; each struct's JSON record
+// reads back to the same struct; and each description lists every member of its struct
+// (counted from the aggregate itself), so a member added but not described fails here.
+// Readers only: fast.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -29,7 +35,9 @@
 #include "support/files.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/settings.hpp"
+#include "validation/identification/dividing_head.hpp"
 #include "validation/identification/static_test.hpp"
+#include "validation/reproduce/reproduce.hpp"
 
 using namespace vrelab;
 namespace fs = std::filesystem;
@@ -69,6 +77,11 @@ T other_value(const F& f, const T& d) {
     return d + "-other";
   } else if constexpr (core::is_number_list<T>) {
     return T{0.5, 2.0, 7.25};  // every list here is of positive numbers
+  } else if constexpr (core::is_vector_list<T>) {
+    using V = typename T::value_type;
+    return T{V(0, 0.6, 0.8), V(1, 0, 0)};  // unit vectors: each list here is of directions or orientations
+  } else if constexpr (core::is_string_list<T>) {
+    return T{"first", "second"};  // as long as the vector lists
   } else if constexpr (core::FixedVector<T>) {
     T v = d;
     for (int i = 0; i < T::SizeAtCompileTime; ++i) v[i] = d[i] + 0.5 * (i + 1);
@@ -102,6 +115,8 @@ void expect_same(const S& a, const S& b, const std::string& where) {
   core::for_each_field<S>([&](const auto& f) {
     using T = typename std::decay_t<decltype(f)>::Type;
     if constexpr (core::Described<T>) expect_same(a.*f.member, b.*f.member, where + std::string(f.name) + ".");
+    else if constexpr (io::HasJsonValue<T>)  // a type of its own, compared through its (lossless) JSON
+      EXPECT_EQ(io::JsonValue<T>::to(a.*f.member), io::JsonValue<T>::to(b.*f.member)) << where << f.name;
     else EXPECT_TRUE(a.*f.member == b.*f.member) << where << f.name;
   });
 }
@@ -176,6 +191,19 @@ TEST(CaseSettings, EachDescriptionListsEveryMemberOfItsStruct) {
   EXPECT_EQ(member_count<validation::StaticTestSettings>(), core::field_count<validation::StaticTestSettings>());
   EXPECT_EQ(member_count<validation::MonteCarloCheckpoint>(), core::field_count<validation::MonteCarloCheckpoint>());
   EXPECT_TRUE(core::table_keys<validation::StaticTestSettings>().empty());
+  // The experiment's, the table's lists as written, and their nested structs.
+  EXPECT_EQ(member_count<validation::ReproduceSettings>(), core::field_count<validation::ReproduceSettings>());
+  EXPECT_EQ(member_count<validation::ConfirmationSettings>(), core::field_count<validation::ConfirmationSettings>());
+  EXPECT_EQ(member_count<validation::StaticTestErrors>(), core::field_count<validation::StaticTestErrors>());
+  EXPECT_EQ(member_count<validation::ReproduceLists>(), core::field_count<validation::ReproduceLists>());
+  EXPECT_EQ(member_count<validation::ConfirmationIndices>(), core::field_count<validation::ConfirmationIndices>());
+  // [reproduce]'s keys: the settings' own and the lists as written (the rest set_by).
+  using K = std::vector<std::string_view>;
+  EXPECT_EQ(core::table_keys<validation::ReproduceSettings>(),
+            (K{"frequency_Hz", "amplitudes_g", "confirmation", "departure_frequencies_Hz", "invisible_shift_per_g", "threads"}));
+  EXPECT_EQ(core::table_keys<validation::ReproduceLists>(),
+            (K{"directions", "direction_names", "orientations_g", "orientation_names", "confirmation"}));
+  EXPECT_EQ(core::table_keys<validation::ConfirmationSettings>(), (K{"amplitude_g", "record_s"}));
   // And the JSON record holds them by the names written here by hand (the documented keys).
   using V = std::vector<std::string>;
   EXPECT_EQ(keys_of(io::settings_json(rectification::Readout{})),
@@ -191,6 +219,13 @@ TEST(CaseSettings, EachDescriptionListsEveryMemberOfItsStruct) {
   EXPECT_EQ(keys_of(io::settings_json(validation::StaticTestSettings{})),
             (V{"fixed", "monte_carlo_checkpoint", "monte_carlo_trials", "seed"}));
   EXPECT_EQ(keys_of(io::settings_json(validation::MonteCarloCheckpoint{})), (V{"fingerprint", "path"}));
+  EXPECT_EQ(keys_of(io::settings_json(validation::ReproduceSettings{})),
+            (V{"amplitudes_g", "confirmation", "departure_frequencies_Hz", "directions", "errors", "fixed", "frequency_Hz",
+               "invisible_shift_per_g", "orientations", "positions", "seed", "shake", "threads"}));
+  EXPECT_EQ(keys_of(io::settings_json(validation::ConfirmationSettings{})),
+            (V{"amplitude_g", "direction", "orientation", "record_s"}));
+  EXPECT_EQ(keys_of(io::settings_json(validation::StaticTestErrors{})),
+            (V{"angle_sigma_rad", "initial_error_rad", "noise_sigma_g", "repeats"}));
 }
 
 // adjust: for a struct whose IsValid asks more than the ranges (StaticTestSettings: not 1 trial).
@@ -218,6 +253,17 @@ TEST(CaseSettings, EachJsonRecordReadsBackToTheSameSettings) {
   expect_round_trip<validation::MonteCarloCheckpoint>("MonteCarloCheckpoint");
   expect_round_trip<validation::StaticTestSettings>("StaticTestSettings",
                                                     [](validation::StaticTestSettings& s) { s.monte_carlo_trials = 16; });
+  expect_round_trip<validation::ReproduceLists>("ReproduceLists");
+  // The fields of types of their own set (other_value leaves them), so the set is a run.
+  expect_round_trip<validation::ReproduceSettings>("ReproduceSettings", [](validation::ReproduceSettings& s) {
+    s.positions = validation::equally_spaced_positions(8);
+    s.positions.push_back(validation::vector_position(Vec3(0, 0.6, 0.8)));
+    s.fixed = {};
+    s.fixed[plant::k1_asym] = 2e-5, s.fixed[plant::k_PP] = 0.0, s.fixed[plant::k_OO] = 0.0;
+    s.directions = {{"IA", Vec3(1, 0, 0)}, {"oblique", Vec3(1, 1, 1).normalized()}};
+    s.orientations = {{"IA up", Vec3(1, 0, 0)}, {"tilted", Vec3(0, 0.6, 0.8)}};
+    s.confirmation.orientation = s.orientations[1], s.confirmation.direction = s.directions[1];
+  });
   // The coefficients held fixed by name; a name that is not a coefficient is refused, by name.
   validation::StaticTestSettings st;
   io::settings_from_json(nlohmann::json{{"fixed", {{"k1_asym", 2e-5}, {"k_PP", 0}}}}, st);
@@ -234,6 +280,77 @@ TEST(CaseSettings, EachJsonRecordReadsBackToTheSameSettings) {
   rectification::ShakeSettings s;
   EXPECT_THROW(io::settings_from_json(nlohmann::json{{"blockz", 3}}, s), std::invalid_argument);
   EXPECT_THROW(io::settings_from_json(nlohmann::json{{"readout", {{"noise_sigma_g", 1}}}}, s), std::invalid_argument);
+}
+
+TEST(CaseSettings, ReproduceReadsFromTheCaseAndItsRecordReadsBack) {
+  // cases/paper.toml: TOML -> ReproduceSettings -> JSON text -> ReproduceSettings, the same.
+  const io::Case c = io::read_case(std::string(VRELAB_CASES_DIR) + "/paper.toml");
+  ASSERT_TRUE(c.reproduce.has_value());
+  const validation::ReproduceSettings& s = *c.reproduce;
+  std::string why;
+  EXPECT_TRUE(s.IsValid(&why)) << why;
+  // The lists as written, named and indexed from 1; the directions normalised.
+  ASSERT_EQ(s.directions.size(), 4u);
+  EXPECT_EQ(s.directions[3].name, "oblique [1,1,1]");
+  EXPECT_NEAR(s.directions[3].v[1], 1 / std::sqrt(3.0), 1e-15);
+  EXPECT_EQ(s.confirmation.orientation.name, "IA at 45 deg");  // orientation = 2
+  EXPECT_EQ(s.confirmation.direction.name, "IA");              // direction = 1
+  EXPECT_EQ(s.confirmation.amplitude_g, 2.0);
+  // The fields set by the other tables.
+  EXPECT_EQ(s.positions.size(), 24u);
+  EXPECT_EQ(s.errors.noise_sigma_g, c.dividing_head->errors.noise_sigma_g);
+  EXPECT_EQ(s.errors.repeats, 4);
+  EXPECT_EQ(s.fixed[plant::k1_asym], 2e-5);
+  EXPECT_EQ(s.shake.blocks, 16);
+  const nlohmann::json j = nlohmann::json::parse(io::settings_json(s).dump());
+  EXPECT_EQ(j["confirmation"]["orientation"]["name"], "IA at 45 deg");
+  EXPECT_EQ(j["directions"][0]["vector"].get<std::vector<double>>(), (std::vector<double>{1, 0, 0}));
+  EXPECT_EQ(j["positions"].size(), 24u);
+  EXPECT_EQ(j["errors"]["repeats"], 4);
+  EXPECT_EQ(j["shake"]["readout"]["noise_sigma_ug"], 20.0);
+  validation::ReproduceSettings back;
+  io::settings_from_json(j, back);
+  expect_same(back, s, "ReproduceSettings.");
+  EXPECT_EQ(io::settings_json(back), j);
+  // A named vector without its name, or a position without its series, is refused by key.
+  try {
+    io::settings_from_json(nlohmann::json::parse(R"({"directions": [{"vector": [1, 0, 0]}]})"), back);
+    ADD_FAILURE() << "a direction without its name read";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("directions: [0]: expected an object with 'name'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(io::settings_from_json(nlohmann::json::parse(R"({"positions": [{"angle_rad": 0}]})"), back),
+               std::invalid_argument);
+}
+
+TEST(CaseSettings, ABadReproduceValueIsNamedAtItsLineAndKey) {
+  TempDir t;
+  // A range of the settings' own, on the list's entry; in the nested [reproduce.confirmation].
+  fs::path p = case_replacing(t, "paper.toml", "amplitudes_g = [0.5, 1.0, 1.5", "amplitudes_g = [0.5, 1.0, 1500.0");
+  expect_error_at(p, "amplitudes_g = [0.5, 1.0, 1500.0", "[reproduce] amplitudes_g[2] = 1500: must be in (0, 1000] g");
+  p = case_replacing(t, "paper.toml", "record_s = 2.0", "record_s = 0.0");
+  expect_error_at(p, "record_s = 0.0", "[reproduce.confirmation] record_s = 0: must be in (0, 1000000] s");
+  // The lists as written: an index past its list, an orientation that is not gravity, an
+  // entry of the wrong type.
+  p = case_replacing(t, "paper.toml", "direction = 1 ", "direction = 5 ");
+  expect_error_at(p, "direction = 5", "[reproduce.confirmation] direction = 5: must be at most 4, the entries of directions");
+  // (the list over two lines: the message at the entry's)
+  p = case_replacing(t, "paper.toml", "[0.0, 0.7071067811865476, 0.7071067811865476]]", "\n  [0.0, 0.7071, 0.8]]");
+  expect_error_at(p, "  [0.0, 0.7071, 0.8]]",
+                  "[reproduce] orientations_g[2] = [0, 0.7071, 0.8]: a static orientation is gravity in sensor axes "
+                  "[IA, PA, OA], |a| = 1 g (within 0.001); got |a| = 1.0677 g");
+  p = case_replacing(t, "paper.toml", "direction_names = [\"IA\"", "direction_names = [1");
+  expect_error_at(p, "direction_names = [1", "[reproduce] direction_names[0]: expected a string");
+  p = case_replacing(t, "paper.toml", "directions = [[1.0, 0.0, 0.0]", "directions = [[1.0, 0.0]");
+  expect_error_at(p, "directions = [[1.0, 0.0]", "[reproduce] directions[0]: expected an array of 3 numbers [IA, PA, OA]");
+  // Unknown keys, in either table, with the closest; a key set by another table is none here.
+  p = case_with(t, "paper.toml", "[reproduce.confirmation]", "orientaton = 2");
+  expect_error_at(p, "orientaton = 2", "[reproduce.confirmation] orientaton: unknown key (did you mean 'orientation'?)");
+  p = case_with(t, "paper.toml", "[reproduce]", "seed = 3");
+  expect_error_at(p, "seed = 3", "[reproduce] seed: unknown key");
+  // A required key missing.
+  p = case_replacing(t, "paper.toml", "record_s = 2.0", "");
+  EXPECT_NE(error_of(p).find("[reproduce.confirmation] record_s: missing (required)"), std::string::npos) << error_of(p);
 }
 
 TEST(CaseSettings, ARangeIsEnforcedFromTheCaseFileAtItsLineAndKey) {
@@ -302,4 +419,27 @@ TEST(CaseSettings, IsValidFollowsTheDescribedRanges) {
   st.monte_carlo_checkpoint.fingerprint = "two\nlines";
   EXPECT_FALSE(st.IsValid(&why));
   EXPECT_EQ(why, "monte_carlo_checkpoint.fingerprint: must be one line");
+  // ReproduceSettings: the ranges (nested ones by their path), then what no range says.
+  const io::Case c = io::read_case(std::string(VRELAB_CASES_DIR) + "/paper.toml");
+  const validation::ReproduceSettings good = *c.reproduce;
+  validation::ReproduceSettings r = good;
+  r.invisible_shift_per_g = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(r.IsValid(&why));
+  EXPECT_EQ(why, "invisible_shift_per_g = inf: must be a finite number of 1/g");
+  r = good;
+  r.errors.repeats = 0;
+  EXPECT_FALSE(r.IsValid(&why));
+  EXPECT_EQ(why, "errors.repeats = 0: must be in [1, 100000] visits");
+  r = good;
+  r.confirmation.direction.v = Vec3::Zero();
+  EXPECT_FALSE(r.IsValid(&why));
+  EXPECT_EQ(why, "confirmation.direction: not set (a zero vector)");
+  r = good;
+  r.orientations[0].v = Vec3(0, 0, 10);
+  EXPECT_FALSE(r.IsValid(&why));
+  EXPECT_NE(why.find("orientations: 'IA vertical': a static orientation is gravity"), std::string::npos) << why;
+  r = good;
+  r.positions.resize(4);  // 4 positions cannot identify the 10 coefficients not held fixed
+  EXPECT_FALSE(r.IsValid(&why));
+  EXPECT_EQ(why.rfind("positions: rank ", 0), 0u) << why;
 }

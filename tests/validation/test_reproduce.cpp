@@ -348,12 +348,12 @@ TEST(Reproduce, BadReproduceTableIsNamedWithFileLineAndKey) {
     }
     EXPECT_FALSE(fs::exists(d.path / "bad-out" / "summary.json"));
   };
-  expect_rejects("orientation = 1\n", "orientation = 3\n", R"(:\d+: \[reproduce.confirmation\] orientation: must be at most 2)");
-  expect_rejects(R"(\[0\.0, 0\.6, 0\.8\])", "[0.0, 0.6, 0.9]", R"(\[reproduce\] orientations_g: .*\|a\| = 1 g)");
+  expect_rejects("orientation = 1\n", "orientation = 3\n", R"(:\d+: \[reproduce.confirmation\] orientation = 3: must be at most 2, the entries of orientations_g)");
+  expect_rejects(R"(\[0\.0, 0\.6, 0\.8\])", "[0.0, 0.6, 0.9]", R"(\[reproduce\] orientations_g\[1\] = \[0, 0\.6, 0\.9\]: .*\|a\| = 1 g.*got \|a\| = 1\.08167 g)");
   expect_rejects(R"(direction_names = \[[^\]]*\])", R"(direction_names = ["IA"])", R"(\[reproduce\] direction_names: expected an array of 2)");
   expect_rejects(R"(departure_frequencies_Hz = \[20\.0, 300\.0\])", "departure_frequencies_Hz = [20.0, 800.0]",
                  R"(departure_frequencies_Hz: 800 Hz needs at least 10 samples per period)");
-  expect_rejects("amplitude_g = 2.0\n", "amplitude_g = -2.0\n", R"(\[reproduce.confirmation\] amplitude_g: must be positive)");
+  expect_rejects("amplitude_g = 2.0\n", "amplitude_g = -2.0\n", R"(\[reproduce.confirmation\] amplitude_g = -2: must be in \(0, 1000\] g)");
   expect_rejects("frequency_Hz = 20.0\n", "frequency_Hz = 600.0\n",
                  R"(\[reproduce\] frequency_Hz: 600 Hz needs at least 10 samples per period)");
 }
@@ -390,14 +390,14 @@ TEST(ReproduceSettings, IsValidNamesTheKeyAndRefusesARankDeficientPositionSet) {
   EXPECT_EQ(s.seed, 11u);
   EXPECT_EQ(s.positions.size(), c.dividing_head->positions.size());
   EXPECT_EQ(s.shake.blocks, 10);
-  EXPECT_EQ(s.confirmation_direction.name, "IA");
+  EXPECT_EQ(s.confirmation.direction.name, "IA");
 
   validation::ReproduceSettings bad = s;
   bad.amplitudes_g.clear();
   EXPECT_FALSE(bad.IsValid(&why));
   EXPECT_NE(why.find("amplitudes_g"), std::string::npos) << why;
   bad = s;
-  bad.confirmation_record_s = 0;
+  bad.confirmation.record_s = 0;
   EXPECT_FALSE(bad.IsValid(&why));
   EXPECT_NE(why.find("record_s"), std::string::npos) << why;
   // Nothing fixed: k1_asym, k_PP and k_OO cannot all be told from the others by a static test.
