@@ -253,6 +253,47 @@ TEST(BlindScoring, SinglesAreScoredByTheGapAsTheLabSeesItTheLargestRunSizeBeside
   EXPECT_NE(brief.find("sized by the largest run, >= 5 sigma in some run: 1/2 = 50 %"), std::string::npos) << brief;
 }
 
+// Two-effect campaigns are scored by the set of effects an "explained" verdict chose, in
+// either order: both chosen (written B then A), one of them alone, and one of them with a third
+// effect (neither). The results go through the results file's lines as a resumed run reads them.
+TEST(BlindScoring, TwoEffectCampaignsAreScoredByTheChosenSetInEitherOrder) {
+  BlindSettings s;
+  s.n = 40, s.seed = 9103, s.threads = 1;
+  std::vector<int> two;  // the three given verdicts
+  int two_all = 0;        // the others are called clean: neither
+  std::map<int, std::string> done;
+  for (int i = 0; i < s.n; ++i) {
+    BlindCampaign k = blind_key(i, s.seed);
+    EffectFit e;
+    e.name = k.hidden.empty() ? std::string("pickoff_nonlinearity") : k.hidden[0].name;
+    k.diagnosis.effects = {e};
+    k.top = e.name;
+    k.called = "clean";
+    k.diagnosis.verdict = Verdict::no_significant_gap;
+    k.effect_max_sigma = 40, k.effect_gap_sigma = 40;
+    k.gap_rms_before_g = 1e-6, k.gap_rms_after_g = 0.5e-6;
+    two_all += k.category == "two";
+    if (k.category == "two" && two.size() < 3) {
+      two.push_back(i);
+      const std::string& a = k.hidden.at(0).name;
+      const std::string& b = k.hidden.at(1).name;
+      const std::string third = a != "pickoff_nonlinearity" && b != "pickoff_nonlinearity" ? "pickoff_nonlinearity" : "fixture_rocking";
+      k.diagnosis.chosen.names = two.size() == 1 ? std::vector<std::string>{b, a}
+                                 : two.size() == 2 ? std::vector<std::string>{a}
+                                                   : std::vector<std::string>{a, third};
+      k.diagnosis.explained = k.diagnosis.gap_significant = true;
+      k.diagnosis.verdict = Verdict::explained;
+      k.called = to_string(k.diagnosis.chosen);
+    }
+    done[i] = campaign_result_text(k);
+  }
+  ASSERT_EQ(two.size(), 3u) << "seed 9103's first 40 campaigns hold three with two effects";
+  const BlindScores& sc = run_blind(s, {}, done, {}).scores;
+  EXPECT_EQ(sc.two_by_both, 1);
+  EXPECT_EQ(sc.two_by_one, 1);
+  EXPECT_EQ(sc.two, two_all);
+}
+
 namespace {
 // P(X >= k) and P(X <= k) for X ~ Binomial(n, p), summed term by term (not through the beta
 // function Boost's bounds invert).

@@ -410,10 +410,14 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
 
   } else {
     ++s.two;
+    // The effects of an unambiguous "explained" verdict (what `called` names).
+    std::vector<std::string> chosen;
+    if (k.error.empty() && d.ambiguous_with.empty() && d.gap_significant && d.explained) chosen = d.chosen.names;
+    std::sort(chosen.begin(), chosen.end());
     const std::string& a = k.hidden[0].name;
     const std::string& b = k.hidden[1].name;
-    s.two_by_one += called == a || called == b;
-    s.two_by_both += called == a + " + " + b || called == b + " + " + a;
+    s.two_by_one += chosen == std::vector<std::string>{a} || chosen == std::vector<std::string>{b};
+    s.two_by_both += chosen == std::vector<std::string>{std::min(a, b), std::max(a, b)};
   }
 }
 
