@@ -20,6 +20,8 @@
 #include "app/commands.hpp"
 #include "rectification/simulation/work_estimate.hpp"
 
+namespace test_cli {
+
 using namespace vrelab::app;
 using namespace vrelab::io;
 namespace fs = std::filesystem;
@@ -515,3 +517,5 @@ TEST(WorkEstimate, StepsFollowTheHighestFrequencyAndTheLimitNamesTheKey) {
     EXPECT_NE(std::string(x.what()).find("--no-work-limit"), std::string::npos) << x.what();
   }
 }
+
+}  // namespace test_cli

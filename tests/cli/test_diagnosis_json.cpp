@@ -8,6 +8,8 @@
 #include "io/services/diagnosis.hpp"
 #include "io/services/diagnosis_json.hpp"
 
+namespace test_diagnosis_json {
+
 using namespace vrelab;
 
 TEST(DiagnosisJson, AFolderReadButNotDiagnosedIsWrittenAsRead) {
@@ -25,3 +27,5 @@ TEST(DiagnosisJson, AFolderReadButNotDiagnosedIsWrittenAsRead) {
   EXPECT_EQ(run.at("measured_g").get<double>(), f.campaign.runs.front().measured_g);
   EXPECT_FALSE(run.contains("predicted_g"));  // no prediction made
 }
+
+}  // namespace test_diagnosis_json

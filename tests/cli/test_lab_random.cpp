@@ -11,29 +11,24 @@
 
 #include "io/formats/lab_data.hpp"
 #include "plant/effects/effects.hpp"
+#include "support/diagnosis_lookup.hpp"
 #include "support/files.hpp"
+#include "support/instrument.hpp"
 #include "validation/diagnosis/diagnose.hpp"
+
+namespace test_lab_random {
 
 using namespace vrelab;
 namespace fs = std::filesystem;
 using vrelab::test::read_file;
+using vrelab::test::run_with_id;
 using vrelab::test::TempDir;
 
 namespace {
 
-const validation::RunRecord& run(const validation::Campaign& c, const std::string& id) {
-  for (const auto& r : c.runs)
-    if (r.id == id) return r;
-  throw std::runtime_error("no run " + id);
-}
-
 // The example's truth (cases/campaign.toml with its hidden pickoff nonlinearity, p2 = 15/rad).
 plant::PlantConfig truth() {
-  plant::PlantConfig p;
-  auto& k = p.coefficients;
-  k[plant::K1] = 1.25, k[plant::k0] = 1.5e-3, k[plant::k1_asym] = 2e-5, k[plant::k2] = 1.5e-5, k[plant::k3] = 1e-6;
-  k[plant::k4] = 2e-7, k[plant::delta_OA] = 1e-4, k[plant::delta_PA] = -5e-5, k[plant::k_IP] = 8e-6, k[plant::k_IO] = -5e-6;
-  k[plant::k_PO] = 3e-6;
+  plant::PlantConfig p = test::paper_like_plant();
   p.effects.push_back(std::make_shared<plant::PickoffNonlinearity>(15.0));
   return p;
 }
@@ -44,7 +39,7 @@ TEST(LabRandom, RunsAreReadDescribedAndPredictedAsTheShakerMeasuredThem) {
   const validation::Campaign c = io::read_campaign(std::string(VRELAB_CASES_DIR) + "/lab-random");
   ASSERT_TRUE(c.skipped.empty()) << c.skipped.front();
   EXPECT_EQ(c.runs.size(), 15u);
-  const auto& nav = run(c, "navmat-ia-plus");
+  const auto& nav = run_with_id(c, "navmat-ia-plus");
   ASSERT_TRUE(nav.random.has_value());
   EXPECT_FALSE(nav.sine_part);
   // NAVMAT P-9492: 6.06 g rms; described as sqrt(2) rms along IA.
@@ -52,9 +47,9 @@ TEST(LabRandom, RunsAreReadDescribedAndPredictedAsTheShakerMeasuredThem) {
   EXPECT_NEAR((nav.direction - Vec3::UnitX()).norm(), 0.0, 1e-12);
   EXPECT_GT(nav.frequency_Hz, 350);
   EXPECT_LT(nav.frequency_Hz, 1000);
-  const auto& both = run(c, "navmat-ia-pa-plus");
+  const auto& both = run_with_id(c, "navmat-ia-pa-plus");
   EXPECT_NEAR(both.direction[0], std::sqrt(0.5), 1e-12);
-  const auto& sor = run(c, "sor-ia-100Hz-plus");
+  const auto& sor = run_with_id(c, "sor-ia-100Hz-plus");
   EXPECT_TRUE(sor.sine_part);
   EXPECT_EQ(sor.frequency_Hz, 100.0);
   // Each random run predicted as diagnose predicts it (the truth's plant) within the virtual
@@ -91,3 +86,5 @@ TEST(LabRandom, BadRandomRowsAreSkippedNamingFileLineAndColumn) {
   EXPECT_TRUE(std::regex_search(all, std::regex(R"(runs\.csv:\d+: column kind: must be sine, random or sine_on_random, got 'sinus')")))
       << all;
 }
+
+}  // namespace test_lab_random

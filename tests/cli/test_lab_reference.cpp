@@ -21,32 +21,31 @@
 #include <fmt/format.h>
 
 #include "io/formats/lab_data.hpp"
+#include "support/constants.hpp"
+#include "support/diagnosis_lookup.hpp"
 #include "support/files.hpp"
+#include "support/instrument.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 #include "vibration/random.hpp"
 
+namespace test_lab_reference {
+
 using namespace vrelab;
 namespace fs = std::filesystem;
+using vrelab::test::kPi;
+using vrelab::test::run_with_id;
 using vrelab::test::TempDir;
 
 namespace {
 
-constexpr double kPi = std::numbers::pi;
 constexpr double kTransverseAt1kHz = 0.4;  // the truth: 10 % at 250 Hz
 constexpr double kRandomTransverse = 0.1;   // the random runs' PA part, coherent with IA
 constexpr double kRefNoise_g = 0.005;       // per sample, each reference axis
 constexpr double kOutputNoise_g = 10e-6;    // per sample, the output over K1
 
-plant::PlantConfig truth() {
-  plant::PlantConfig p;
-  auto& k = p.coefficients;
-  k[plant::K1] = 1.25, k[plant::k0] = 1.5e-3, k[plant::k1_asym] = 2e-5, k[plant::k2] = 1.5e-5, k[plant::k3] = 1e-6;
-  k[plant::k4] = 2e-7, k[plant::delta_OA] = 1e-4, k[plant::delta_PA] = -5e-5, k[plant::k_IP] = 8e-6, k[plant::k_IO] = -5e-6;
-  k[plant::k_PO] = 3e-6;
-  return p;
-}
+plant::PlantConfig truth() { return test::paper_like_plant(); }
 
 vibration::PsdTable flat(double level) {
   vibration::PsdTable t;
@@ -134,12 +133,6 @@ void write_lab(const fs::path& dir, bool bad = false) {
   std::ofstream(dir / "runs.csv") << runs;
 }
 
-const validation::RunRecord& run(const validation::Campaign& c, const std::string& id) {
-  for (const auto& r : c.runs)
-    if (r.id == id) return r;
-  throw std::runtime_error("no run " + id);
-}
-
 }  // namespace
 
 TEST(LabReferenceCampaign, TransverseMotionIsMeasuredNotFitted) {
@@ -172,13 +165,13 @@ TEST(LabReferenceCampaign, TransverseMotionIsMeasuredNotFitted) {
       EXPECT_NEAR(m.rms_ratio, std::sqrt(1.01), 0.01) << r.id;
     }
   }
-  EXPECT_NEAR(run(c, "ia-250Hz-4g-plus").motion->departure.transverse_ratio, 0.10, 2e-3);
+  EXPECT_NEAR(run_with_id(c, "ia-250Hz-4g-plus").motion->departure.transverse_ratio, 0.10, 2e-3);
   // A random run predicted (the truth's plant) from its Welch PSD against the exact profile.
   for (const char* id : {"random-ia-plus", "random-ia-minus"}) {
-    validation::RunRecord exact = run(c, id), commanded = run(c, id);
+    validation::RunRecord exact = run_with_id(c, id), commanded = run_with_id(c, id);
     exact.motion.reset(), commanded.motion.reset();
     exact.random->psd[1] = flat(0.02 * kRandomTransverse * kRandomTransverse);
-    const double from_welch = validation::predict_run_g(truth(), run(c, id), nullptr, 0);
+    const double from_welch = validation::predict_run_g(truth(), run_with_id(c, id), nullptr, 0);
     const double from_exact = validation::predict_run_g(truth(), exact, nullptr, 0);
     const double from_command = validation::predict_run_g(truth(), commanded, nullptr, 0);
     // The Welch PSD carries the transverse part the command lacks (8 ug here); its spread over
@@ -253,12 +246,12 @@ TEST(LabReferenceCampaign, PartialReferencesKeepTheTableMotionEffectsForTheOther
   validation::Campaign c = io::read_campaign(std::string(VRELAB_CASES_DIR) + "/lab-reference");
   ASSERT_TRUE(c.skipped.empty()) << c.skipped.front();
   ASSERT_EQ(c.runs.size(), 18u);
-  EXPECT_NEAR(run(c, "ia-250Hz-4g-plus").motion->departure.transverse_ratio, 0.10, 2e-3);
+  EXPECT_NEAR(run_with_id(c, "ia-250Hz-4g-plus").motion->departure.transverse_ratio, 0.10, 2e-3);
   for (auto& r : c.runs)
     if (!r.random && r.frequency_Hz == 100) r.motion.reset();
   const validation::Effect& e = *validation::find_effect("shaker_transverse_motion");
-  const auto& with = run(c, "ia-250Hz-4g-plus");
-  const auto& without = run(c, "ia-100Hz-4g-plus");
+  const auto& with = run_with_id(c, "ia-250Hz-4g-plus");
+  const auto& without = run_with_id(c, "ia-100Hz-4g-plus");
   const plant::PlantConfig p = truth();
   EXPECT_EQ(validation::predict_run_g(p, with, &e, 0.3), validation::predict_run_g(p, with, nullptr, 0));
   EXPECT_NE(validation::predict_run_g(p, without, &e, 0.3), validation::predict_run_g(p, without, nullptr, 0));
@@ -271,3 +264,5 @@ TEST(LabReferenceCampaign, PartialReferencesKeepTheTableMotionEffectsForTheOther
   for (const auto& f : d.effects) candidate = candidate || f.name == "shaker_transverse_motion";
   EXPECT_TRUE(candidate);
 }
+
+}  // namespace test_lab_reference

@@ -18,6 +18,8 @@
 #include "io/formats/lab_data.hpp"
 #include "support/files.hpp"
 
+namespace test_lab_windows {
+
 using namespace vrelab;
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -89,3 +91,5 @@ TEST(LabWindows, MeasureAndDiagnoseReadAHalfOpenWindowAlike) {
         << e.what();
   }
 }
+
+}  // namespace test_lab_windows

@@ -14,6 +14,8 @@
 #include "app/commands.hpp"
 #include "support/files.hpp"
 
+namespace test_vrc {
+
 using namespace vrelab::app;
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -130,3 +132,5 @@ TEST(Vrc, MeasureTakesTheInputRmsFromTheRecordsReferenceChannels) {
   EXPECT_NEAR(shake["input_rms_g"].get<double>(), std::sqrt(5.0), 1e-12 * std::sqrt(5.0));
   EXPECT_NEAR(m["vrc_ug_per_g2"].get<double>(), 1e6 * m["measured_g"].get<double>() / std::pow(m["input_rms_g"].get<double>(), 2), 1e-9);
 }
+
+}  // namespace test_vrc

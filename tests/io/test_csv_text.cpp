@@ -8,6 +8,8 @@
 #include "io/formats/csv.hpp"
 #include "io/formats/error.hpp"
 
+namespace test_csv_text {
+
 using namespace vrelab;
 
 // Numbers as a lab writes them: finite decimals only. strtod alone reads "0x1E" as 30, "inf"
@@ -54,3 +56,5 @@ TEST(CsvText, ClosestColumnNameIsSuggested) {
   EXPECT_EQ(io::closest_name("amplitud_g", names), "amplitude_g");
   EXPECT_EQ(io::closest_name("temperature_C", names), "");
 }
+
+}  // namespace test_csv_text

@@ -17,6 +17,8 @@
 #include "io/formats/lab_data.hpp"
 #include "support/files.hpp"
 
+namespace test_format_error {
+
 using namespace vrelab;
 namespace fs = std::filesystem;
 using vrelab::test::read_file;
@@ -215,3 +217,5 @@ TEST(FormatError, AMessageWithoutAPlaceIsTheMessage) {
   EXPECT_EQ(e.where().line, 0);
   EXPECT_EQ(e.where().kind, io::KeyKind::none);
 }
+
+}  // namespace test_format_error

@@ -21,6 +21,8 @@
 #include "support/lab_manifest.hpp"
 #include "validation/diagnosis/campaign.hpp"
 
+namespace test_lab_data {
+
 using namespace vrelab;
 using namespace vrelab::validation;
 namespace fs = std::filesystem;
@@ -178,3 +180,5 @@ TEST(DiagnoseSettings, ABadKeyOrValueNamesTheFileTheKeyAndWhy) {
     EXPECT_NE(error_of(lab_with(t, "[diagnose]\nmodel_accuracy = -0.1\n")).find("model_accuracy = -0.1"), std::string::npos);
   }
 }
+
+}  // namespace test_lab_data

@@ -23,7 +23,7 @@
 #include "support/files.hpp"
 #include "support/lcg.hpp"
 
-namespace vrelab {
+namespace vrelab::test_raw_hdf5 {
 namespace {
 
 namespace fs = std::filesystem;
@@ -102,4 +102,4 @@ TEST(RawHdf5, AWriterNotCommittedLeavesNoFile) {
 }
 
 }  // namespace
-}  // namespace vrelab
+}  // namespace vrelab::test_raw_hdf5

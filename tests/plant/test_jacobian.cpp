@@ -19,6 +19,8 @@
 #include "rectification/simulation/shake.hpp"
 #include "vibration/profile.hpp"
 
+namespace test_jacobian {
+
 using namespace vrelab;
 using namespace vrelab::plant;
 
@@ -199,3 +201,5 @@ TEST(AnalyticJacobian, TransientShakeEqualsCvodesDifferenceQuotientsWithin1e9g) 
                 a.rhs_evaluations, q.measured_g, q.rhs_evaluations);
   }
 }
+
+}  // namespace test_jacobian

@@ -7,6 +7,8 @@
 #include "plant/model1.hpp"
 #include "support/random_coefficients.hpp"
 
+namespace test_model1 {
+
 using namespace vrelab;
 using namespace vrelab::plant;
 
@@ -62,3 +64,5 @@ TEST(Model1, NamesRoundTrip) {
   for (int i = 0; i < kNumCoefficients; ++i) EXPECT_EQ(*coefficient_from_name(coefficient_name(i)), i);
   EXPECT_FALSE(coefficient_from_name("k5").has_value());
 }
+
+}  // namespace test_model1

@@ -15,13 +15,16 @@
 #include "plant/physical.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/simulation/shake.hpp"
+#include "support/constants.hpp"
 #include "support/instrument.hpp"
 #include "support/random_coefficients.hpp"
 #include "validation/identification/dividing_head.hpp"
 
+namespace test_plant {
+
 using namespace vrelab;
 using namespace vrelab::plant;
-constexpr double kPi = std::numbers::pi;
+using vrelab::test::kPi;
 
 namespace {
 
@@ -286,3 +289,5 @@ TEST(PlantEffects, SqueezeFilmDampingDoesNotRectifyByItself) {
   v.frequency_Hz = 500;
   EXPECT_GT(std::abs(rectification::shake_sine(nl, a, v).measured_g - rectification::shake_sine(nominal, a, v).measured_g), 0.5e-6);
 }
+
+}  // namespace test_plant

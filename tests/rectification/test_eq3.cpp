@@ -15,13 +15,16 @@
 
 #include "plant/model1.hpp"
 #include "rectification/prediction/eq3.hpp"
+#include "support/constants.hpp"
 #include "support/quadrature.hpp"
 #include "support/random_coefficients.hpp"
+
+namespace test_eq3 {
 
 using namespace vrelab;
 using namespace vrelab::plant;
 using namespace vrelab::rectification;
-constexpr double kPi = std::numbers::pi;
+using vrelab::test::kPi;
 
 namespace {
 
@@ -196,3 +199,5 @@ TEST(Eq3Random, MatchesTheNotesClosedFormsForOneAxis) {
   EXPECT_NEAR(t.g[t_k3], 3 * 2e-6 * 0.6 * 4, 1e-18);
   EXPECT_NEAR(t.g[t_k4], 3e-7 * (6 * 0.36 * 4 + 3 * 16), 1e-18);
 }
+
+}  // namespace test_eq3

@@ -29,6 +29,8 @@
 #include "plant/effects/squeeze_film_damping.hpp"
 #include "rectification/prediction/frequency.hpp"
 
+namespace test_film_speed_paths {
+
 using namespace vrelab;
 using namespace vrelab::plant;
 
@@ -284,3 +286,5 @@ TEST(FilmSpeedPaths, FilmBalanceKeyTellsPartsOfVariableLengthApart) {
   EXPECT_EQ(kt.size(), kl.size());
   EXPECT_NE(kt, kl);
 }
+
+}  // namespace test_film_speed_paths

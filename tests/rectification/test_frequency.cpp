@@ -25,6 +25,8 @@
 #include "vibration/decorators.hpp"
 #include "vibration/excitation.hpp"
 
+namespace test_frequency {
+
 using namespace vrelab;
 using namespace vrelab::plant;
 
@@ -320,3 +322,5 @@ TEST(PeriodicRectification, SqueezeFilmDescribingFunctionPredictsTheOdesChange) 
     EXPECT_NEAR(predicted, measured, 0.15 * std::abs(measured)) << f << " Hz, c0 x " << c0_factor;
   }
 }
+
+}  // namespace test_frequency

@@ -19,6 +19,8 @@
 #include "rectification/prediction/frequency.hpp"
 #include "support/instrument.hpp"
 
+namespace test_prepared_rectification {
+
 using namespace vrelab;
 using namespace vrelab::plant;
 
@@ -117,3 +119,5 @@ TEST(PreparedRectification, ALoopResponderLinearisedOnceGivesEachFrequencysRespo
   }
   EXPECT_THROW(responder(0.0), std::invalid_argument);
 }
+
+}  // namespace test_prepared_rectification

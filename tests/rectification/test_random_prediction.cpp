@@ -15,6 +15,9 @@
 #include "rectification/simulation/shake.hpp"
 #include "rectification/simulation/shaker_motion.hpp"
 #include "support/instrument.hpp"
+#include "support/vibrations.hpp"
+
+namespace test_random_prediction {
 
 using namespace vrelab;
 using namespace vrelab::plant;
@@ -25,12 +28,6 @@ vibration::PsdTable table(std::vector<std::pair<double, double>> rows) {
   vibration::PsdTable t;
   for (auto [f, p] : rows) t.rows.push_back(vibration::PsdRow::level(f, p));
   return t;
-}
-
-vibration::RandomProfile gevs_ia() {
-  vibration::RandomProfile p;
-  p.psd[IA] = table({{20, 0.026}, {50, 0.16}, {800, 0.16}, {2000, 0.026}});
-  return p;
 }
 
 // Two axes with common phases and different shapes (correlation < 1), one independent case.
@@ -177,7 +174,7 @@ TEST(RandomAtFrequencyCampaign, MatchesTheOdeForGevsAndSineOnRandom) {
   {
     rectification::VibrationRequest v;  // cases/shake-random-gevs.toml
     v.type = rectification::VibrationKind::random;
-    v.psd = gevs_ia();
+    v.psd = test::gevs_on_ia();
     const OdeCheck c = ode_check(cfg, a, v, 4.0, 1);
     EXPECT_NEAR(c.measured_g, c.predicted_g, 3 * c.sigma_g + 0.01 * std::abs(c.predicted_g)) << "GEVS";
     // And eq. (3) quasi-static is excluded by the same bound (27.4 mg vs 21.5 mg measured).
@@ -218,3 +215,5 @@ TEST(RandomAtFrequencyCampaign, EffectsMatchTheOde) {
     EXPECT_GT(std::abs(c.predicted_g), 10 * c.sigma_g);  // the check has teeth
   }
 }
+
+}  // namespace test_random_prediction

@@ -9,14 +9,15 @@
 #include <random>
 
 #include "rectification/measurement/reference.hpp"
+#include "support/constants.hpp"
+
+namespace test_reference {
 
 using namespace vrelab;
 using rectification::ReferenceAnalyzer;
 using rectification::ReferenceWindow;
 
-namespace {
-constexpr double kPi = std::numbers::pi;
-}
+using vrelab::test::kPi;
 
 TEST(Reference, SineHarmonicsAndTransversePartWithinTheirSigma) {
   // IA: 2 g at 80 Hz, phase 0.3, 2nd harmonic 5 % at phase 1.1, 3rd 2 % at -0.4; PA: 10 % of
@@ -180,3 +181,5 @@ TEST(Reference, BadChannelsAreRefused) {
     EXPECT_THROW(an.finish(), std::invalid_argument);
   }
 }
+
+}  // namespace test_reference

@@ -14,6 +14,8 @@
 #include "rectification/simulation/shaker_motion.hpp"
 #include "support/instrument.hpp"
 
+namespace test_shake {
+
 using namespace vrelab;
 using namespace vrelab::plant;
 
@@ -183,3 +185,5 @@ TEST(ShakePeriodic, AStronglyNonlinearLoopFallsBackToTheTransient) {
   EXPECT_EQ(r.path, "transient");
   EXPECT_NEAR(r.measured_g, 0.0, 1e-7);
 }
+
+}  // namespace test_shake

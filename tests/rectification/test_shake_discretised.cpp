@@ -12,21 +12,15 @@
 #include "rectification/simulation/discretised.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/instrument.hpp"
+#include "support/vibrations.hpp"
 #include "vibration/sampled.hpp"
+
+namespace test_shake_discretised {
 
 using namespace vrelab;
 using namespace vrelab::plant;
 
 namespace {
-
-vibration::RandomProfile gevs_ia() {
-  vibration::RandomProfile p;
-  vibration::PsdTable t;
-  t.rows = {vibration::PsdRow::level(20, 0.026), vibration::PsdRow::level(50, 0.16), vibration::PsdRow::level(800, 0.16),
-            vibration::PsdRow::level(2000, 0.026)};
-  p.psd[IA] = t;
-  return p;
-}
 
 // cases/shake-random-gevs.toml's instrument: every model (1) term, IA terms in the loop.
 PlantConfig gevs_plant() {
@@ -57,7 +51,7 @@ TEST(ExponentialIntegrator, InputIsTheExcitationsSplineAtEveryGridPoint) {
   // sees is RandomExcitation's own quintic spline, rebuilt from its samples with the same
   // prefilter (truncation ~3e-18 of the signal) and evaluated in monomial form rather than
   // the factorised one: equal to the rounding, 1e-10 g of peaks near 60 g (measured 5e-11).
-  const vibration::RandomExcitation ex(gevs_ia(), 16000, 7);
+  const vibration::RandomExcitation ex(test::gevs_on_ia(), 16000, 7);
   const PlantConfig cfg = gevs_plant();
   const Accelerometer rest(cfg, kTilted);
   const Accelerometer::Linear lin = rest.linearise();
@@ -76,7 +70,7 @@ TEST(ExponentialIntegrator, LinearPlantOutputEqualsCvodeSampleBySample) {
   // output sample by sample differs from CVODE at rtol 1e-12 by CVODE's error only (the
   // output is ~14 g rms, peaks near 60 g; CVODE at rtol 1e-10 is 4.3e-7 g away, at 1e-12
   // 8.5e-9 g: it converges on the discretisation).
-  const vibration::RandomExcitation ex(gevs_ia(), 16000, 3);
+  const vibration::RandomExcitation ex(test::gevs_on_ia(), 16000, 3);
   const PlantConfig cfg = test::paper_like_linear_plant();
   std::vector<double> a, b;
   const auto ra = run(cfg, ex, 0.1, 20000, true, 1e-10, [&](double t, const Vec3&, double u) {
@@ -104,7 +98,7 @@ TEST(ExponentialIntegrator, GevsRectificationAgreesWithCvodeFarInsideItsSigma) {
   // exponential integrator is within 5e-8 g sampled at 20 kHz and 9e-8 g continuous (the
   // block edges between grid points by Hermite interpolation), measured; the bounds leave a
   // factor 5 and are 4e-4 sigma. CVODE at the case's own rtol 1e-4 is 1e-5 g off.
-  const vibration::RandomExcitation ex(gevs_ia(), 16000, 1);
+  const vibration::RandomExcitation ex(test::gevs_on_ia(), 16000, 1);
   const PlantConfig cfg = gevs_plant();
   for (double rate : {20000.0, 0.0}) {
     const auto e = run(cfg, ex, 1.0, rate, true, 1e-4);
@@ -121,7 +115,7 @@ TEST(ExponentialIntegrator, SmoothEffectsWithStatesAgreeWithCvode) {
   // Pendulum geometry (vibropendulous: GEVS on IA and PA, common phases) and a mechanical
   // mode at 3 kHz (6 more states: the general kernel): measured 4e-8 g apart on a ~19 mg
   // answer whose sigma is 1.7 mg; bound 1e-4 sigma.
-  vibration::RandomProfile p = gevs_ia();
+  vibration::RandomProfile p = test::gevs_on_ia();
   p.psd[PA] = p.psd[IA];
   const vibration::RandomExcitation ex(p, 16000, 5);
   PlantConfig cfg = gevs_plant();
@@ -134,7 +128,7 @@ TEST(ExponentialIntegrator, SmoothEffectsWithStatesAgreeWithCvode) {
 }
 
 TEST(ExponentialIntegrator, NonSmoothEffectsAndSlowReadoutsRunCvodeAndSaySo) {
-  const vibration::RandomExcitation ex(gevs_ia(), 16000, 2);
+  const vibration::RandomExcitation ex(test::gevs_on_ia(), 16000, 2);
   PlantConfig cfg = gevs_plant();
   EXPECT_EQ(run(cfg, ex, 0.05, 5000, true, 1e-4).path, "CVODE: the output is sampled below the excitation's sample rate");
   EXPECT_EQ(run(cfg, ex, 0.05, 17000 * std::sqrt(2.0), true, 1e-4).path,
@@ -146,3 +140,5 @@ TEST(ExponentialIntegrator, NonSmoothEffectsAndSlowReadoutsRunCvodeAndSaySo) {
   const auto r = run(cfg, ex, 0.05, 20000, true, 1e-4);
   EXPECT_EQ(r.path.rfind("CVODE: current_saturation is not smooth", 0), 0u) << r.path;
 }
+
+}  // namespace test_shake_discretised

@@ -14,6 +14,8 @@
 #include "vibration/sampled.hpp"
 #include "vibration/sweep.hpp"
 
+namespace test_shake_random {
+
 using namespace vrelab;
 using namespace vrelab::plant;
 
@@ -128,3 +130,5 @@ TEST(ShakeRandom, LinearCompanionCancelsALinearPlantUnderGevs) {
   EXPECT_LT(std::abs(r.measured_g), 1e-6);
   EXPECT_LT(r.sigma_g, 1e-6);
 }
+
+}  // namespace test_shake_random

@@ -9,6 +9,8 @@
 
 #include "rectification/simulation/vibration_kind.hpp"
 
+namespace test_vibration_kind {
+
 using vrelab::rectification::parse_vibration_kind;
 using vrelab::rectification::VibrationKind;
 
@@ -28,3 +30,5 @@ TEST(VibrationKind, OtherTextIsNoKind) {
   for (const char* text : {"", "Sine", "sine ", "sine-on-random", "swept", "gaussian"})
     EXPECT_FALSE(parse_vibration_kind(text).has_value()) << '"' << text << '"';
 }
+
+}  // namespace test_vibration_kind

@@ -22,6 +22,8 @@
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 
+namespace test_blind_scoring {
+
 using namespace vrelab;
 using namespace vrelab::validation;
 using vrelab::test::small_design;
@@ -349,3 +351,5 @@ TEST(BlindScoring, TheIssuesCriteriaAreCountedFromTheFamilies) {
   EXPECT_EQ(by["drift"].n, 0);
   EXPECT_FALSE(by["drift"].met());  // no campaigns: nothing shown
 }
+
+}  // namespace test_blind_scoring

@@ -19,6 +19,7 @@
 
 #include <fmt/format.h>
 
+#include "support/effect_check.hpp"
 #include "support/files.hpp"
 #include "support/instrument.hpp"
 #include "io/formats/case_file.hpp"
@@ -31,9 +32,13 @@
 #include "validation/diagnosis/diagnosis_text.hpp"
 #include "vibration/excitation.hpp"
 
+namespace test_diagnose {
+
 using namespace vrelab;
 using namespace vrelab::validation;
+using vrelab::test::identified_by_static_test;
 using vrelab::test::small_design;
+using vrelab::test::strong_run;
 namespace fs = std::filesystem;
 using vrelab::test::read_file;
 using vrelab::test::TempDir;
@@ -42,16 +47,6 @@ namespace {
 
 plant::PlantConfig truth() { return test::paper_like_plant(); }
 
-}  // namespace
-
-namespace {
-// The run where every effect acts: 4 g along IA+PA, the static a_IA +0.71 g.
-RunRecord strong_run(double frequency_Hz) {
-  RunRecord r;
-  r.frequency_Hz = frequency_Hz, r.amplitude_g = 4, r.direction = Vec3(1, 1, 0).normalized();
-  r.orientation_g = Vec3(1, 0, 1).normalized();
-  return r;
-}
 }  // namespace
 
 TEST(EffectLibrary, EachEffectsPredictionMatchesTheOdeWithThatEffect) {
@@ -170,22 +165,6 @@ TEST(EffectRegistry, BlindDrawsKeepTheirRngCalls) {
     EXPECT_TRUE(e.is_valid(h.values(e))) << e.name;
   }
 }
-
-namespace {
-// What the static test of `instrument` identifies (12 equally spaced positions per series,
-// noise-free, k_PP held at 0), as the diagnosis does it.
-plant::Coefficients identified_by_static_test(const plant::PlantConfig& instrument) {
-  const std::vector<Position> positions = equally_spaced_positions(12);
-  const std::vector<double> weights(positions.size(), 1.0);
-  FixedSet fixed{};
-  fixed[plant::k_PP] = 0.0;
-  std::vector<Reading> readings;
-  const double K1 = instrument.coefficients[plant::K1];
-  for (std::size_t i = 0; i < positions.size(); ++i)
-    readings.push_back({static_cast<int>(i), K1 * plant::settled_output_g(instrument, positions[i].nominal_g)});
-  return least_squares(positions, readings, weights, fixed).estimate.value;
-}
-}  // namespace
 
 TEST(EffectRegistry, EachEffectsTruthAndHypothesisMakeTheSameChange) {
   // The virtual lab's truth (the effect's truth hook: plant modules, shaker decorators; on the
@@ -486,3 +465,5 @@ seed = 43
   EXPECT_EQ(verdict_text(d), "explained by pickoff_nonlinearity");
   EXPECT_NEAR(d.effects.front().value, 30.0, 0.6);
 }
+
+}  // namespace test_diagnose

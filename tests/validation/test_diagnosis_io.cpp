@@ -19,6 +19,8 @@
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 
+namespace test_diagnosis_io {
+
 using namespace vrelab;
 namespace fs = std::filesystem;
 using vrelab::test::TempDir;
@@ -175,3 +177,5 @@ TEST(DiagnosisJson, RunVrcIsErrorOverTheSineAndRandomPartsMeanSquareInMicroGPerG
   EXPECT_GE(kinds[1], 4);
   EXPECT_GE(kinds[2], 1);
 }
+
+}  // namespace test_diagnosis_io

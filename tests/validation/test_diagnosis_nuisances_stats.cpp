@@ -9,6 +9,8 @@
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/internal/nuisances.hpp"
 
+namespace test_diagnosis_nuisances_stats {
+
 using namespace vrelab::validation;
 
 namespace {
@@ -48,3 +50,5 @@ TEST(DiagnosisNuisances, NeighbourCorrelationPairsRunsOneStepApart) {
   EXPECT_NEAR(rho, 5.5 / std::sqrt(22 * 5.25), 1e-12);
   EXPECT_EQ(pairs, 3);
 }
+
+}  // namespace test_diagnosis_nuisances_stats

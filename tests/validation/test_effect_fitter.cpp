@@ -24,6 +24,8 @@
 #include "validation/diagnosis/internal/effect_fitter.hpp"
 #include "validation/diagnosis/internal/likelihood.hpp"
 
+namespace test_effect_fitter {
+
 using namespace vrelab::validation;
 using namespace vrelab::validation::internal;
 
@@ -343,3 +345,5 @@ TEST(EffectFitter, HoldsAParameterTheDataDoNotPin) {
     EXPECT_NEAR(mf.sigma[0], sigma, 1e-6 * sigma);
   }
 }
+
+}  // namespace test_effect_fitter

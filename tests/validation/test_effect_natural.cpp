@@ -11,13 +11,17 @@
 #include <numbers>
 #include <string>
 
+#include "support/diagnosis_lookup.hpp"
 #include "support/instrument.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 
+namespace test_effect_natural {
+
 using namespace vrelab;
 using namespace vrelab::validation;
+using vrelab::test::parameter_named;
 
 namespace {
 
@@ -32,12 +36,6 @@ CampaignDesign design(std::vector<double> frequencies_Hz, std::vector<Vec3> dire
   d.directions = std::move(directions);
   d.orientations_g = {Vec3(1, 0, 1).normalized()};
   return d;
-}
-
-const FittedParameter& parameter(const EffectFit& e, const std::string& name) {
-  for (const FittedParameter& q : e.parameters)
-    if (q.name == name) return q;
-  throw std::logic_error(e.name + " has no parameter " + name);
 }
 
 // Every parameter the fit reports as fitted lies within 3 sigma of the truth (3 sigma: the
@@ -91,8 +89,8 @@ TEST(NaturalFormCampaign, AModeAlongPaWithLowDampingIsFoundWithItsParameters) {
   EXPECT_TRUE(d.explained) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "mechanical_mode") << verdict_text(d);
   const EffectFit& e = d.effects.front();
-  EXPECT_EQ(parameter(e, "axis").status, ParameterStatus::chosen);
-  EXPECT_EQ(parameter(e, "damping_ratio").status, ParameterStatus::fitted);
+  EXPECT_EQ(parameter_named(e, "axis").status, ParameterStatus::chosen);
+  EXPECT_EQ(parameter_named(e, "damping_ratio").status, ParameterStatus::fitted);
   expect_within_3_sigma(e, v);
 }
 
@@ -107,7 +105,7 @@ TEST(NaturalFormCampaign, ASecondHarmonicAtNinetyDegreesIsFoundWithItsPhase) {
   ASSERT_TRUE(d.gap_significant) << d.where;
   EXPECT_TRUE(d.explained) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "shaker_harmonic_distortion") << verdict_text(d);
-  EXPECT_EQ(parameter(d.effects.front(), "second_harmonic_phase_rad").status, ParameterStatus::fitted);
+  EXPECT_EQ(parameter_named(d.effects.front(), "second_harmonic_phase_rad").status, ParameterStatus::fitted);
   expect_within_3_sigma(d.effects.front(), v);
 }
 
@@ -123,7 +121,7 @@ TEST(NaturalFormCampaign, AMisalignmentAboutPaAndOaIsFoundWithBothAngles) {
   ASSERT_TRUE(d.gap_significant) << d.where;
   EXPECT_TRUE(d.explained) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "mounting_misalignment") << verdict_text(d);
-  EXPECT_EQ(parameter(d.effects.front(), "angle_about_PA_rad").status, ParameterStatus::fitted);
+  EXPECT_EQ(parameter_named(d.effects.front(), "angle_about_PA_rad").status, ParameterStatus::fitted);
   expect_within_3_sigma(d.effects.front(), v);
 }
 
@@ -177,8 +175,8 @@ TEST(NaturalFormCampaign, TransverseMotionOutOfPhaseOnTheOtherAxisIsFoundWithIts
   ASSERT_TRUE(d.gap_significant) << d.where;
   EXPECT_TRUE(d.explained) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "shaker_transverse_motion") << verdict_text(d);
-  EXPECT_EQ(parameter(d.effects.front(), "axis_cycle").status, ParameterStatus::chosen);
-  EXPECT_EQ(parameter(d.effects.front(), "frequency_power").status, ParameterStatus::fitted);
+  EXPECT_EQ(parameter_named(d.effects.front(), "axis_cycle").status, ParameterStatus::chosen);
+  EXPECT_EQ(parameter_named(d.effects.front(), "frequency_power").status, ParameterStatus::fitted);
   expect_within_3_sigma(d.effects.front(), v);
 }
 
@@ -194,6 +192,8 @@ TEST(NaturalFormCampaign, RockingAboutPaIsFoundWithItsAxis) {
   ASSERT_TRUE(d.gap_significant) << d.where;
   EXPECT_TRUE(d.explained) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "fixture_rocking") << verdict_text(d);
-  EXPECT_EQ(parameter(d.effects.front(), "axis").status, ParameterStatus::chosen);
+  EXPECT_EQ(parameter_named(d.effects.front(), "axis").status, ParameterStatus::chosen);
   expect_within_3_sigma(d.effects.front(), v);
 }
+
+}  // namespace test_effect_natural

@@ -37,6 +37,7 @@
 #include <vector>
 
 #include "rectification/simulation/shake.hpp"
+#include "support/effect_check.hpp"
 #include "support/instrument.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
@@ -44,8 +45,12 @@
 #include "validation/identification/dividing_head.hpp"
 #include "validation/identification/identification.hpp"
 
+namespace test_effect_sweep {
+
 using namespace vrelab;
 using namespace vrelab::validation;
+using vrelab::test::identified_by_static_test;
+using vrelab::test::strong_run;
 
 namespace {
 
@@ -55,13 +60,6 @@ double relative_tolerance(const std::string& name) {
   static const std::map<std::string, double> rel{{"squeeze_film_damping", 0.02}};
   const auto it = rel.find(name);
   return it == rel.end() ? 0.01 : it->second;
-}
-
-RunRecord strong_run(double frequency_Hz) {
-  RunRecord r;
-  r.frequency_Hz = frequency_Hz, r.amplitude_g = 4, r.direction = Vec3(1, 1, 0).normalized();
-  r.orientation_g = Vec3(1, 0, 1).normalized();
-  return r;
 }
 
 // The values of the effect's (first) parameter to sweep: the extremes of what blind draws
@@ -130,20 +128,6 @@ std::vector<std::vector<double>> sweep_points(const Effect& e, bool whole_range)
 struct Point {
   double predicted_g, ode_g;
 };
-
-// What the static test of `instrument` identifies (12 equally spaced positions per series,
-// noise-free, k_PP held at 0), as the diagnosis does it (test_diagnose.cpp has the same).
-plant::Coefficients identified_by_static_test(const plant::PlantConfig& instrument) {
-  const std::vector<Position> positions = equally_spaced_positions(12);
-  const std::vector<double> weights(positions.size(), 1.0);
-  FixedSet fixed{};
-  fixed[plant::k_PP] = 0.0;
-  std::vector<Reading> readings;
-  const double K1 = instrument.coefficients[plant::K1];
-  for (std::size_t i = 0; i < positions.size(); ++i)
-    readings.push_back({static_cast<int>(i), K1 * plant::settled_output_g(instrument, positions[i].nominal_g)});
-  return least_squares(positions, readings, weights, fixed).estimate.value;
-}
 
 // As the diagnosis meets an effect: its hypothesis applied to the coefficients the static test
 // identified from the truth instrument with the effect, less what the static test took up of
@@ -252,3 +236,5 @@ TEST(EffectSweepCampaign, EveryEffectAtTheBandsEndsMatchesTheOde) { sweep({10.0,
 // The whole sweep (label "campaign"): 8 frequencies log-spaced 10 Hz - 2 kHz, the drawn
 // extremes and the grid's ends.
 TEST(EffectSweepCampaign, EveryEffectOverItsRangeAndTheBandMatchesTheOde) { sweep(log_spaced(10, 2000, 8), true); }
+
+}  // namespace test_effect_sweep

@@ -21,6 +21,8 @@
 #include "validation/diagnosis/gaussian_likelihood.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 
+namespace test_gaussian_likelihood {
+
 using namespace vrelab;
 using namespace vrelab::validation;
 
@@ -218,3 +220,5 @@ TEST(NaturalMissesCampaign, ALargePickoffIsNotOutrankedByAnInfiniteEvidence) {
   EXPECT_LE(std::abs(p.value - k.hidden[0].parameter), 3 * p.sigma);
   EXPECT_EQ(r.scores.families.at("single").right, 1);
 }
+
+}  // namespace test_gaussian_likelihood

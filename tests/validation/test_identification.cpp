@@ -17,6 +17,8 @@
 #include "validation/identification/dividing_head.hpp"
 #include "validation/identification/identification.hpp"
 
+namespace test_identification {
+
 using namespace vrelab;
 using namespace vrelab::plant;
 using namespace vrelab::validation;
@@ -257,3 +259,5 @@ TEST(FitCheck, RefusesAbsurdCoefficientsAndResidualsBeyondSigma) {
   const FitCheck f = check_fit(p, r, off, var, 11);
   EXPECT_NE(f.problem.find("does not reproduce its readings"), std::string::npos) << f.problem;
 }
+
+}  // namespace test_identification

@@ -27,12 +27,12 @@
 #include <sstream>
 
 #include <fmt/format.h>
-#include <hdf5.h>
 
 #include "io/formats/lab_data.hpp"
 #include "plant/effects/pendulum_geometry.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/files.hpp"
+#include "support/hdf5_file.hpp"
 #include "support/instrument.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
@@ -40,8 +40,11 @@
 #include "vibration/random.hpp"
 #include "vibration/sampled.hpp"
 
+namespace test_lab_reference_cross {
+
 using namespace vrelab;
 namespace fs = std::filesystem;
+using vrelab::test::write_h5;
 
 namespace {
 
@@ -216,24 +219,6 @@ TEST(LabReferenceCross, SineOnRandomRunIsPredictedFromItsMeasuredSineAndSpectra)
   EXPECT_GT(std::abs(from_command - ode.measured_g), 10 * ode.sigma_g);
 }
 
-namespace {
-
-// A record as HDF5 datasets (float64, contiguous), each of its own length.
-void write_h5(const std::string& path, const std::vector<std::pair<std::string, std::vector<double>>>& datasets) {
-  const hid_t file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  ASSERT_GE(file, 0);
-  for (const auto& [name, x] : datasets) {
-    const hsize_t n = x.size();
-    const hid_t space = H5Screate_simple(1, &n, nullptr);
-    const hid_t d = H5Dcreate2(file, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, x.data());
-    H5Dclose(d), H5Sclose(space);
-  }
-  H5Fclose(file);
-}
-
-}  // namespace
-
 // Issue 16's bad input: a reference channel at another rate. In CSV it shares the time column,
 // so another rate is a cell missing on some rows (file:line:column, "missing value": the test
 // in tests/cli/test_lab_reference.cpp, and by hand `diagnose` exits 2 on it); in HDF5 it is a
@@ -289,3 +274,5 @@ TEST(LabReferenceCross, Hdf5ReferenceAtAnotherRateSkipsTheRunNamingFileAndDatase
   EXPECT_TRUE(std::regex_search(c.skipped[0], std::regex(R"(runs\.csv:\d+ \(run 'random-ia-plus'\): .*random-ia-plus\.h5: dataset ref_IA_g has \d+ samples, time_s has \d+)")))
       << c.skipped[0];
 }
+
+}  // namespace test_lab_reference_cross

@@ -20,6 +20,8 @@
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 
+namespace test_loop_dynamics {
+
 using namespace vrelab;
 using namespace vrelab::validation;
 
@@ -224,3 +226,5 @@ TEST(LoopDynamicsCampaign, AManifestThatIsRightGivesNoGap) {
   ASSERT_NE(servo, d.effects.end()) << "servo_dynamics is not among the " << d.effects.size() << " effects judged";
   EXPECT_LT(servo->evidence, 25);
 }
+
+}  // namespace test_loop_dynamics

@@ -15,7 +15,7 @@
 #include "support/result_line.hpp"
 #include "validation/diagnosis/blind.hpp"
 
-namespace vrelab::validation {
+namespace vrelab::validation::test_natural_blind {
 namespace {
 
 // A mode along PA moves the pendulum's base along PA only (plant::MechanicalMode's mask), so
@@ -142,4 +142,4 @@ TEST(NaturalBlind, TheResultLineCarriesTheTopEffectsParameters) {
 }
 
 }  // namespace
-}  // namespace vrelab::validation
+}  // namespace vrelab::validation::test_natural_blind

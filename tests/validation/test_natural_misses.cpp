@@ -13,21 +13,19 @@
 #include <string>
 
 #include "support/blind_replay.hpp"
+#include "support/diagnosis_lookup.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 
+namespace test_natural_misses {
+
 using namespace vrelab;
 using namespace vrelab::validation;
+using vrelab::test::parameter_named;
 
 namespace {
 
 BlindResult replay(std::uint64_t seed, int index) { return test::replay_blind_campaign(seed, index); }
-
-const FittedParameter& parameter(const EffectFit& e, const std::string& name) {
-  for (const FittedParameter& q : e.parameters)
-    if (q.name == name) return q;
-  throw std::logic_error(e.name + " has no parameter " + name);
-}
 
 // A harmonic's campaign replayed: the verdict's top effect is the hidden harmonic, its phase
 // fitted and a claim (3 sigma below pi), ratio and phase within 3 sigma of the key's, and the
@@ -42,8 +40,8 @@ FittedParameter expect_harmonic_within_3_sigma(std::uint64_t seed, int index, co
   std::printf("  %s\n", verdict_text(d).c_str());
   EXPECT_EQ(d.effects.front().name, effect);
   if (d.effects.front().name != effect) return {};
-  const FittedParameter& ratio = parameter(d.effects.front(), ratio_name);
-  const FittedParameter& phase = parameter(d.effects.front(), phase_name);
+  const FittedParameter& ratio = parameter_named(d.effects.front(), ratio_name);
+  const FittedParameter& phase = parameter_named(d.effects.front(), phase_name);
   const double ratio_truth = k.hidden[0].parameter, phase_truth = k.hidden[0].form.at(0);
   std::printf("  ratio %.4f +- %.4f (truth %.4f), phase %.4f +- %.4f rad (truth %.4f)\n", ratio.value, ratio.sigma,
               ratio_truth, phase.value, phase.sigma, phase_truth);
@@ -70,7 +68,7 @@ TEST(NaturalMissesCampaign, AThirdHarmonicsPhaseSigmaIsWhatTheLikelihoodSays) {
   const Diagnosis& d = k.diagnosis;
   std::printf("  %s\n", verdict_text(d).c_str());
   ASSERT_EQ(d.effects.front().name, "shaker_third_harmonic");
-  const FittedParameter& phase = parameter(d.effects.front(), "third_harmonic_phase_rad");
+  const FittedParameter& phase = parameter_named(d.effects.front(), "third_harmonic_phase_rad");
   const double truth = k.hidden[0].form.at(0);
   std::printf("  phase %.4f +- %.4f rad (truth %.4f)\n", phase.value, phase.sigma, truth);
   EXPECT_EQ(phase.status, ParameterStatus::fitted);
@@ -98,7 +96,7 @@ TEST(NaturalMissesCampaign, AThirdHarmonicsPhaseIsFoundInItsValleyAndExplainsThe
   EXPECT_TRUE(d.explained);
   EXPECT_EQ(to_string(d.chosen), "shaker_third_harmonic");
   ASSERT_EQ(d.effects.front().name, "shaker_third_harmonic");
-  const FittedParameter& phase = parameter(d.effects.front(), "third_harmonic_phase_rad");
+  const FittedParameter& phase = parameter_named(d.effects.front(), "third_harmonic_phase_rad");
   const double truth = k.hidden[0].form.at(0);
   std::printf("  phase %.4f +- %.4f rad (truth %.4f)\n", phase.value, phase.sigma, truth);
   EXPECT_NEAR(truth, 2.255, 0.001);  // the campaign this test is about
@@ -169,8 +167,8 @@ TEST(NaturalMissesCampaign, AResonancesFrequencyAndDampingAreFoundInTheirNarrowV
   std::printf("  %s\n", verdict_text(d).c_str());
   EXPECT_TRUE(d.explained);
   ASSERT_EQ(d.effects.front().name, "mechanical_mode");
-  const FittedParameter& f = parameter(d.effects.front(), "frequency_Hz");
-  const FittedParameter& z = parameter(d.effects.front(), "damping_ratio");
+  const FittedParameter& f = parameter_named(d.effects.front(), "frequency_Hz");
+  const FittedParameter& z = parameter_named(d.effects.front(), "damping_ratio");
   const double f_truth = k.hidden[0].parameter, z_truth = k.hidden[0].form.at(0);
   std::printf("  frequency %.3f +- %.3f Hz (truth %.3f), damping %.5f +- %.5f (truth %.5f)\n", f.value, f.sigma, f_truth,
               z.value, z.sigma, z_truth);
@@ -179,3 +177,5 @@ TEST(NaturalMissesCampaign, AResonancesFrequencyAndDampingAreFoundInTheirNarrowV
   EXPECT_LE(std::abs(z.value - z_truth), 3 * z.sigma);
   EXPECT_EQ(r.scores.families.at("natural").right, 1);
 }
+
+}  // namespace test_natural_misses

@@ -20,6 +20,8 @@
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 
+namespace test_nuisances {
+
 using namespace vrelab;
 using namespace vrelab::validation;
 using vrelab::test::small_design;
@@ -187,3 +189,5 @@ TEST(NuisancesCampaign, TheDriftTestFlagsNoDriftAtItsStatedRate) {
     EXPECT_NEAR(flagged, expected, 4.5 * sd) << readings << " readings: " << flagged << " of " << kTrials << " flagged";
   }
 }
+
+}  // namespace test_nuisances

@@ -19,6 +19,8 @@
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 
+namespace test_nuisances_blind {
+
 using namespace vrelab;
 using namespace vrelab::validation;
 using vrelab::test::small_design;
@@ -166,3 +168,5 @@ TEST(NuisanceTransport, BlindResultLineCarriesTheVerdictAmbiguityAndNuisances) {
   // A line cut short is refused, not read as fewer nuisances.
   test::expect_refused_not_outdated(test::cut_before_gap(campaign_result_text(k)), "a line cut short");
 }
+
+}  // namespace test_nuisances_blind

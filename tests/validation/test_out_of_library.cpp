@@ -12,20 +12,16 @@
 #include "plant/effects/vibration_heating.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/instrument.hpp"
+#include "support/vibrations.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/effect.hpp"
 
-namespace vrelab {
+namespace vrelab::test_out_of_library {
 namespace {
 
 using plant::PlantConfig;
 
-vibration::SineVibration sine(const Vec3& amplitude_g, double f_Hz) {
-  vibration::SineVibration v;
-  v.amplitude_g = amplitude_g;
-  v.frequency_Hz = f_Hz;
-  return v;
-}
+using test::sine;
 
 // Vibration heating on the linear instrument, 4 g along PA with a_IA = 0.71 g: the IA input
 // a_IA (1 + kappa (P - 1)) with <P> = 1 + A^2 / 2 (gravity has no PA part, so |a|^2 has no
@@ -107,4 +103,4 @@ TEST(OutOfLibrary, TheRegistryHoldsSeveralAndEachIsDrawable) {
 }
 
 }  // namespace
-}  // namespace vrelab
+}  // namespace vrelab::test_out_of_library

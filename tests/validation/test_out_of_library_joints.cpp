@@ -12,18 +12,14 @@
 #include "plant/effects/proof_mass_torsion.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/instrument.hpp"
+#include "support/vibrations.hpp"
 
-namespace vrelab {
+namespace vrelab::test_out_of_library_joints {
 namespace {
 
 using plant::PlantConfig;
 
-vibration::SineVibration sine(const Vec3& amplitude_g, double f_Hz) {
-  vibration::SineVibration v;
-  v.amplitude_g = amplitude_g;
-  v.frequency_Hz = f_Hz;
-  return v;
-}
+using test::sine;
 
 double change_g(const PlantConfig& plain, const std::shared_ptr<const plant::Effect>& effect, const Vec3& gravity,
                 const vibration::SineVibration& v) {
@@ -138,4 +134,4 @@ TEST(OutOfLibraryJoints, ProofMassTorsionRectifiesKappaTimesReHAlongOa) {
 }
 
 }  // namespace
-}  // namespace vrelab
+}  // namespace vrelab::test_out_of_library_joints

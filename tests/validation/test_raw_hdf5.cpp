@@ -20,7 +20,6 @@
 #include <unistd.h>
 
 #include <fmt/format.h>
-#include <hdf5.h>
 #include <nlohmann/json.hpp>
 
 #include "app/commands.hpp"
@@ -31,30 +30,17 @@
 #include "io/formats/raw_hdf5.hpp"
 #include "io/formats/series.hpp"
 #include "support/files.hpp"
+#include "support/hdf5_file.hpp"
 #include "support/lcg.hpp"
 
-namespace vrelab {
+namespace vrelab::test_raw_hdf5 {
 namespace {
 
 namespace fs = std::filesystem;
 using test::read_file;
 using test::Lcg;
+using test::write_h5;
 using test::TempDir;
-
-// A raw HDF5 file from datasets given whole (the test's own writer, with the C API, for
-// files the library's writer would never make: missing or mismatched datasets).
-void write_h5(const fs::path& p, const std::vector<std::pair<std::string, std::vector<double>>>& datasets) {
-  const hid_t f = H5Fcreate(p.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  ASSERT_GE(f, 0);
-  for (const auto& [name, x] : datasets) {
-    const hsize_t n = x.size();
-    const hid_t space = H5Screate_simple(1, &n, nullptr);
-    const hid_t d = H5Dcreate2(f, name.c_str(), H5T_IEEE_F64LE, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    H5Dwrite(d, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, x.data());
-    H5Dclose(d), H5Sclose(space);
-  }
-  H5Fclose(f);
-}
 
 // cases/lab-example with three runs given as raw records (records/<id>.csv): 10 kHz, 0.3 s at
 // rest then the vibration window; the output carries the summary's measured value (x K1) on a
@@ -295,4 +281,4 @@ seed = 43
 }
 
 }  // namespace
-}  // namespace vrelab
+}  // namespace vrelab::test_raw_hdf5

@@ -23,10 +23,13 @@
 #include "io/formats/report.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/prediction/gradient.hpp"
+#include "support/constants.hpp"
 #include "support/instrument.hpp"
 #include "support/random_coefficients.hpp"
 #include "validation/reproduce/reproduce.hpp"
 #include "validation/identification/static_test.hpp"
+
+namespace test_reproduce {
 
 using namespace vrelab;
 using namespace vrelab::plant;
@@ -36,7 +39,7 @@ namespace fs = std::filesystem;
 using vrelab::test::read_file;
 using vrelab::test::TempDir;
 using nlohmann::json;
-constexpr double kArcsec = std::numbers::pi / (180 * 3600);
+using vrelab::test::kArcsec;
 
 namespace {
 
@@ -430,3 +433,5 @@ TEST(ReproduceAnalysis, AgreementCountsRunsWithinTwoAndThreeCombinedSigma) {
   EXPECT_NEAR(a.max_abs_residual_g, 20e-6, 1e-15);
   EXPECT_NEAR(a.median_relative, 0.125, 1e-12);  // |residual|/|prediction|: 0.05, 0.125, 0.2
 }
+
+}  // namespace test_reproduce

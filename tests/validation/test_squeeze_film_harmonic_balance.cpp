@@ -30,6 +30,8 @@
 #include "rectification/simulation/shake.hpp"
 #include "support/instrument.hpp"
 
+namespace test_squeeze_film_harmonic_balance {
+
 using namespace vrelab;
 
 namespace {
@@ -118,3 +120,5 @@ TEST(SqueezeFilmHarmonicBalance, MatchesTheOdeWithAMechanicalModeAlongIa) {
     }
   }
 }
+
+}  // namespace test_squeeze_film_harmonic_balance

@@ -26,6 +26,8 @@
 #include "validation/diagnosis/effect.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 
+namespace test_transverse_quadrature {
+
 using namespace vrelab;
 using namespace vrelab::validation;
 
@@ -211,3 +213,5 @@ TEST(NaturalMissesCampaign, ATransverseQuadraturesSizeIsJudgedNotItsSign) {
   EXPECT_LE(std::abs(q.value - std::abs(truth)), 3 * q.sigma);
   EXPECT_EQ(r.scores.families.at("natural").right, 1);
 }
+
+}  // namespace test_transverse_quadrature

@@ -9,15 +9,18 @@
 #include <random>
 #include <string>
 
+#include "support/constants.hpp"
 #include "support/instrument.hpp"
 #include "plant/model1.hpp"
 #include "validation/identification/static_test.hpp"
+
+namespace test_uncertainty {
 
 using namespace vrelab;
 using namespace vrelab::plant;
 using namespace vrelab::validation;
 using vrelab::test::paper_like_coefficients;
-constexpr double kArcsec = std::numbers::pi / (180 * 3600);
+using vrelab::test::kArcsec;
 
 namespace {
 
@@ -128,3 +131,5 @@ TEST(Propagation, WeightedLeastSquaresIsNoWorseThanTheClosedForms) {
     }
   }
 }
+
+}  // namespace test_uncertainty

@@ -12,6 +12,8 @@
 #include "vibration/detail.hpp"
 #include "vibration/sampled.hpp"
 
+namespace test_random_synthesis {
+
 using namespace vrelab;
 using namespace vrelab::vibration;
 
@@ -116,3 +118,5 @@ TEST(RandomExcitation, SamplesIntoReusedStorageEqualSamples) {
     }
   }
 }
+
+}  // namespace test_random_synthesis

@@ -12,27 +12,25 @@
 #include <stdexcept>
 #include <string>
 
+#include "support/constants.hpp"
 #include "support/quadrature.hpp"
+#include "support/vibrations.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/demand.hpp"
 #include "vibration/sampled.hpp"
 
+namespace test_vibration_decorators {
+
 using namespace vrelab;
 using namespace vrelab::vibration;
-constexpr double kPi = std::numbers::pi;
-constexpr double kG = 9.80665;
+using vrelab::test::gevs_on_ia;
+using vrelab::test::kG;
+using vrelab::test::kPi;
 
 namespace {
 
 std::shared_ptr<const SineExcitation> sine(Vec3 amp, Vec3 phase, double f) {
   return std::make_shared<const SineExcitation>(SineVibration{amp, phase, f});
-}
-
-RandomProfile gevs_on_ia() {
-  RandomProfile p;
-  p.psd[IA] = PsdTable{
-      {PsdRow::level(20, 0.026), PsdRow::level(50, 0.16), PsdRow::level(800, 0.16), PsdRow::level(2000, 0.026)}};
-  return p;
 }
 
 // Mean over one period [0, 1/f] of component `axis`, by 32 x 20-point Gauss-Legendre
@@ -202,3 +200,5 @@ TEST(Rocking, LeverArmKinematicsAgainstFiniteDifferences) {
   spec.g_m_per_s2 = 0;
   EXPECT_THROW(Rocking(silent, spec), std::invalid_argument);
 }
+
+}  // namespace test_vibration_decorators

@@ -7,20 +7,18 @@
 #include <stdexcept>
 #include <string>
 
+#include "support/constants.hpp"
+#include "support/vibrations.hpp"
 #include "vibration/demand.hpp"
+
+namespace test_vibration_demand {
 
 using namespace vrelab;
 using namespace vrelab::vibration;
-constexpr double kG = 9.80665;
+using vrelab::test::gevs_on_ia;
+using vrelab::test::kG;
 
 namespace {
-
-RandomProfile gevs_on_ia() {
-  RandomProfile p;
-  p.psd[IA] = PsdTable{
-      {PsdRow::level(20, 0.026), PsdRow::level(50, 0.16), PsdRow::level(800, 0.16), PsdRow::level(2000, 0.026)}};
-  return p;
-}
 
 std::string message(auto&& f) {
   try {
@@ -111,3 +109,5 @@ TEST(ShakerDemand, FeasibilityCheckNamesLimitAndNeed) {
   EXPECT_NEAR(sr.acceleration_peak_g[IA], 3 + 3 * 14.13561372, 3e-7);
   EXPECT_NEAR(sr.acceleration_rms_g[IA], std::sqrt(4.5 + 14.13561372 * 14.13561372), 1e-7);
 }
+
+}  // namespace test_vibration_demand

@@ -11,12 +11,17 @@
 #include <string>
 #include <vector>
 
+#include "support/constants.hpp"
 #include "support/quadrature.hpp"
+#include "support/vibrations.hpp"
 #include "vibration/psd.hpp"
 
+namespace test_vibration_psd {
+
 using namespace vrelab::vibration;
-constexpr double kPi = std::numbers::pi;
-constexpr double kG = 9.80665;
+using vrelab::test::gevs_psd;
+using vrelab::test::kG;
+using vrelab::test::kPi;
 
 namespace {
 
@@ -25,9 +30,6 @@ PsdTable table(const std::vector<std::pair<double, double>>& rows) {
   for (auto [f, p] : rows) t.rows.push_back(PsdRow::level(f, p));
   return t;
 }
-
-// GSFC-STD-7000A (GEVS) qualification, <= 22.7 kg; the standard quotes 14.1 g rms.
-PsdTable gevs() { return table({{20, 0.026}, {50, 0.16}, {800, 0.16}, {2000, 0.026}}); }
 
 // Integral of f^m P(f) df by quadrature in u = ln f, P interpolated linearly in (ln f, ln P).
 // The integrand e^{(m+1)u} P(e^u) is an exponential in u on each segment: 16 pieces of
@@ -58,7 +60,7 @@ std::string message_of(const PsdTable& t) {
 // mean of their levels; breakpoints are returned exactly; the PSD is 0 outside the band.
 // Tolerance 1e-14 relative: one pow/log chain, a few ulp.
 TEST(PsdTable, LogLogInterpolationAtGeometricMidpoints) {
-  const ResolvedPsd p = resolve(gevs());
+  const ResolvedPsd p = resolve(gevs_psd());
   EXPECT_NEAR(psd_g2_per_Hz(p, std::sqrt(20.0 * 50.0)), std::sqrt(0.026 * 0.16), 1e-14 * 0.1);
   EXPECT_NEAR(psd_g2_per_Hz(p, std::sqrt(800.0 * 2000.0)), std::sqrt(0.16 * 0.026), 1e-14 * 0.1);
   EXPECT_NEAR(psd_g2_per_Hz(p, 300.0), 0.16, 1e-15);
@@ -82,7 +84,7 @@ TEST(PsdTable, SlopeRowsInDecibelsPerOctave) {
   EXPECT_NEAR(10 * std::log10(p.psd_g2_per_Hz[1] / p.psd_g2_per_Hz[0]) / std::log2(50.0 / 20.0), 6.0, 1e-12);
   EXPECT_NEAR(10 * std::log10(p.psd_g2_per_Hz[3] / p.psd_g2_per_Hz[2]) / std::log2(2000.0 / 800.0), -6.0, 1e-12);
   EXPECT_NEAR(p.psd_g2_per_Hz[1], 0.16, 0.01 * 0.16);
-  EXPECT_NEAR(rms_g(t), rms_g(gevs()), 0.01 * rms_g(gevs()));
+  EXPECT_NEAR(rms_g(t), rms_g(gevs_psd()), 0.01 * rms_g(gevs_psd()));
   // 3 dB/octave is a factor 10^0.3 ~ 1.995 per octave: 20 -> 80 Hz (2 octaves) at +3 dB/oct.
   PsdTable n;
   n.rows = {PsdRow::level(20, 0.01), PsdRow::slope(80, 3.0)};
@@ -117,9 +119,9 @@ TEST(PsdTable, RmsOfStandardSpecsClosedFormVersusQuadrature) {
     }
   }
   // Independent figures from a numpy trapezoid on 2e6 log-spaced points (agree to 1e-8).
-  EXPECT_NEAR(rms_g(gevs()), 14.13561372, 1e-7);
-  EXPECT_NEAR(velocity_rms_m_per_s(gevs(), kG), 0.1103126913, 1e-9);
-  EXPECT_NEAR(displacement_rms_m(gevs(), kG), 3.819183224e-4, 1e-11);
+  EXPECT_NEAR(rms_g(gevs_psd()), 14.13561372, 1e-7);
+  EXPECT_NEAR(velocity_rms_m_per_s(gevs_psd(), kG), 0.1103126913, 1e-9);
+  EXPECT_NEAR(displacement_rms_m(gevs_psd(), kG), 3.819183224e-4, 1e-11);
 }
 
 // Hand integrals: a 1/f segment (the ln case of the closed form, c = 0): P = 0.1 (100/f)
@@ -161,6 +163,8 @@ TEST(PsdTable, ValidationNamesFieldAndRow) {
   expect(t, {"row 2", "slope_dB_per_octave"});
   t.rows = {PsdRow::level(1, 0.1), PsdRow::slope(1e300, 1e5)};  // overflows
   expect(t, {"row 2", "slope_dB_per_octave", "not a finite"});
-  EXPECT_THROW(velocity_rms_m_per_s(gevs(), 0.0), std::invalid_argument);
-  EXPECT_EQ(message_of(gevs()), "(no exception)");
+  EXPECT_THROW(velocity_rms_m_per_s(gevs_psd(), 0.0), std::invalid_argument);
+  EXPECT_EQ(message_of(gevs_psd()), "(no exception)");
 }
+
+}  // namespace test_vibration_psd

@@ -17,27 +17,21 @@
 #include <string>
 #include <vector>
 
+#include "support/constants.hpp"
+#include "support/vibrations.hpp"
 #include "vibration/psd.hpp"
 #include "vibration/random.hpp"
 #include "vibration/sampled.hpp"
 
+namespace test_vibration_random {
+
 using namespace vrelab;
 using namespace vrelab::vibration;
-constexpr double kPi = std::numbers::pi;
+using vrelab::test::gevs_on_ia;
+using vrelab::test::gevs_psd;
+using vrelab::test::kPi;
 
 namespace {
-
-PsdTable gevs() {
-  PsdTable t;
-  t.rows = {PsdRow::level(20, 0.026), PsdRow::level(50, 0.16), PsdRow::level(800, 0.16), PsdRow::level(2000, 0.026)};
-  return t;
-}
-
-RandomProfile gevs_on_ia() {
-  RandomProfile p;
-  p.psd[IA] = gevs();
-  return p;
-}
 
 // Verification set-up shared by the spec tests: fs = 2.56 x 2000 Hz, 32 s, Welch segments
 // of 1024 samples (5 Hz bins, 319 segments).
@@ -136,7 +130,7 @@ TEST(RandomSynthesis, BinAmplitudeIsSqrtTwoGfsOverN) {
       im -= x[i] * std::sin(ph);
     }
     const double measured = 2.0 / static_cast<double>(n) * std::hypot(re, im);
-    const double expected = std::sqrt(2 * psd_g2_per_Hz(gevs(), static_cast<double>(k) * fs / n) * fs / n);
+    const double expected = std::sqrt(2 * psd_g2_per_Hz(gevs_psd(), static_cast<double>(k) * fs / n) * fs / n);
     EXPECT_NEAR(measured, expected, 1e-10 * 0.6 + 1e-10 * expected) << "bin " << k;
   }
   for (double v : s.samples_g[PA]) ASSERT_EQ(v, 0.0);  // an axis without a table is at rest
@@ -148,10 +142,10 @@ TEST(RandomSynthesis, ParsevalMeanSquareIsTheSpecIntegral) {
   const SampledSignal s = synthesize_random(gevs_on_ia(), 4.0, kFs, 11);
   const std::size_t n = s.size();
   double sum_g = 0;
-  for (std::size_t k = 1; 2 * k < n; ++k) sum_g += psd_g2_per_Hz(gevs(), static_cast<double>(k) * kFs / n) * kFs / n;
+  for (std::size_t k = 1; 2 * k < n; ++k) sum_g += psd_g2_per_Hz(gevs_psd(), static_cast<double>(k) * kFs / n) * kFs / n;
   const double ms = moments(s.samples_g[IA]).rms * moments(s.samples_g[IA]).rms;
   EXPECT_NEAR(ms, sum_g, 1e-12 * sum_g);
-  EXPECT_NEAR(std::sqrt(ms), rms_g(gevs()), 1e-4 * rms_g(gevs()));
+  EXPECT_NEAR(std::sqrt(ms), rms_g(gevs_psd()), 1e-4 * rms_g(gevs_psd()));
 }
 
 // The estimator: a tone at an exact bin, amplitude A. Hann^2 = 3/8 - cos/2 + cos(2.)/8 has
@@ -188,16 +182,16 @@ TEST(Welch, ToneIntegratesToHalfSquareAmplitudeAndWhiteNoiseIsFlat) {
 TEST(RandomSynthesis, GevsWelchWithin1p5dBRmsWithin1PercentGaussian) {
   const SampledSignal s = synthesize_random(gevs_on_ia(), kDuration, kFs, 2024);
   const PsdEstimate e = welch_psd(s.samples_g[IA], kFs, kSegment);
-  const BandCheck c = check_band(e, gevs());
+  const BandCheck c = check_band(e, gevs_psd());
   const Moments m = moments(s.samples_g[IA]);
   std::printf(
       "[ one FFT ] Welch max deviation %.3f dB over %zu bins (30-1990 Hz); rms %.5f g vs spec %.5f g "
       "(%+.4f %%); kurtosis %.4f; tails %.4f %.5f %.5f\n",
-      c.max_dev_dB, c.bins, m.rms, rms_g(gevs()), 100 * (m.rms / rms_g(gevs()) - 1), m.kurtosis, m.tail1, m.tail2,
+      c.max_dev_dB, c.bins, m.rms, rms_g(gevs_psd()), 100 * (m.rms / rms_g(gevs_psd()) - 1), m.kurtosis, m.tail1, m.tail2,
       m.tail3);
   EXPECT_EQ(c.bins, 393u);
   EXPECT_LT(c.max_dev_dB, 1.5);
-  EXPECT_NEAR(m.rms, rms_g(gevs()), 0.01 * rms_g(gevs()));
+  EXPECT_NEAR(m.rms, rms_g(gevs_psd()), 0.01 * rms_g(gevs_psd()));
   expect_gaussian(m);
 }
 
@@ -209,15 +203,15 @@ TEST(RandomExcitation, StreamWelchWithin1p5dBRmsWithin1PercentGaussian) {
   const RandomExcitation r(gevs_on_ia(), kFs, 2024, 8192);
   const SampledSignal s = r.samples(-1000, static_cast<std::size_t>(kDuration * kFs));
   const PsdEstimate e = welch_psd(s.samples_g[IA], kFs, kSegment);
-  const BandCheck c = check_band(e, gevs());
+  const BandCheck c = check_band(e, gevs_psd());
   const Moments m = moments(s.samples_g[IA]);
   std::printf(
       "[ stream  ] Welch max deviation %.3f dB over %zu bins (30-1990 Hz); rms %.5f g vs spec %.5f g "
       "(%+.4f %%); kurtosis %.4f; tails %.4f %.5f %.5f\n",
-      c.max_dev_dB, c.bins, m.rms, rms_g(gevs()), 100 * (m.rms / rms_g(gevs()) - 1), m.kurtosis, m.tail1, m.tail2,
+      c.max_dev_dB, c.bins, m.rms, rms_g(gevs_psd()), 100 * (m.rms / rms_g(gevs_psd()) - 1), m.kurtosis, m.tail1, m.tail2,
       m.tail3);
   EXPECT_LT(c.max_dev_dB, 1.5);
-  EXPECT_NEAR(m.rms, rms_g(gevs()), 0.01 * rms_g(gevs()));
+  EXPECT_NEAR(m.rms, rms_g(gevs_psd()), 0.01 * rms_g(gevs_psd()));
   expect_gaussian(m);
   for (double v : s.samples_g[OA]) ASSERT_EQ(v, 0.0);
 }
@@ -247,7 +241,7 @@ TEST(RandomSynthesis, SeedsReproduceAndDiffer) {
 // standard errors of 0 (N_eff = 2 x 1980 x 4 = 15840).
 TEST(RandomSynthesis, CommonPhasesGiveOneDirectionIndependentAxesAreUncorrelated) {
   RandomProfile p = gevs_on_ia();
-  PsdTable quarter = gevs();
+  PsdTable quarter = gevs_psd();
   for (auto& r : quarter.rows) *r.psd_g2_per_Hz *= 0.25;
   p.psd[PA] = quarter;
   p.coupling = AxisCoupling::common;
@@ -256,7 +250,7 @@ TEST(RandomSynthesis, CommonPhasesGiveOneDirectionIndependentAxesAreUncorrelated
   p.coupling = AxisCoupling::independent;
   const SampledSignal t = synthesize_random(p, 4.0, kFs, 3);
   EXPECT_LT(std::abs(correlation(t.samples_g[IA], t.samples_g[PA])), 6 / std::sqrt(15840.0));
-  EXPECT_NEAR(moments(t.samples_g[PA]).rms, 0.5 * rms_g(gevs()), 1e-3 * rms_g(gevs()));
+  EXPECT_NEAR(moments(t.samples_g[PA]).rms, 0.5 * rms_g(gevs_psd()), 1e-3 * rms_g(gevs_psd()));
   EXPECT_EQ(t.samples_g[IA], s.samples_g[IA]);  // IA draws first either way
 }
 
@@ -273,7 +267,7 @@ TEST(RandomSynthesis, InvalidInputNamesTheField) {
   EXPECT_NE(message([] { synthesize_random(gevs_on_ia(), 0.0, kFs, 1); }).find("duration_s"), std::string::npos);
   EXPECT_NE(message([] { synthesize_random(RandomProfile{}, 1.0, kFs, 1); }).find("psd"), std::string::npos);
   RandomProfile bad = gevs_on_ia();
-  bad.psd[PA] = gevs();
+  bad.psd[PA] = gevs_psd();
   bad.psd[PA]->rows[1].psd_g2_per_Hz = -1.0;
   const std::string m = message([&] { synthesize_random(bad, 1.0, kFs, 1); });
   EXPECT_NE(m.find("psd[PA]"), std::string::npos) << m;
@@ -286,3 +280,5 @@ TEST(RandomSynthesis, InvalidInputNamesTheField) {
   EXPECT_NE(message([&] { RandomExcitation(narrow, kFs, 1, 1024); }).find("block_length"), std::string::npos);
   EXPECT_EQ(message([] { RandomExcitation(gevs_on_ia(), kFs, 1, 1024); }), "(no exception)");
 }
+
+}  // namespace test_vibration_random

@@ -10,11 +10,14 @@
 #include <random>
 #include <stdexcept>
 
+#include "support/constants.hpp"
 #include "vibration/sampled.hpp"
+
+namespace test_vibration_sampled {
 
 using namespace vrelab;
 using namespace vrelab::vibration;
-constexpr double kPi = std::numbers::pi;
+using vrelab::test::kPi;
 
 namespace {
 
@@ -126,3 +129,5 @@ TEST(RandomExcitation, InterpolantEqualsOneShotSplineAcrossStretches) {
   EXPECT_EQ(r.memory_bytes(), (4 * 3 * 1024 + 3 * 3 * 512) * sizeof(double));
   EXPECT_LT(RandomExcitation(p, 20000, 1, 32768).memory_bytes(), 4.5e6);
 }
+
+}  // namespace test_vibration_sampled

@@ -8,12 +8,15 @@
 #include <stdexcept>
 #include <string>
 
+#include "support/constants.hpp"
 #include "support/quadrature.hpp"
 #include "vibration/sweep.hpp"
 
+namespace test_vibration_sweep {
+
 using namespace vrelab;
 using namespace vrelab::vibration;
-constexpr double kPi = std::numbers::pi;
+using vrelab::test::kPi;
 
 namespace {
 
@@ -147,3 +150,5 @@ TEST(SweptSine, ValidationNamesTheField) {
   EXPECT_NE(message(s).find("amplitude_g[OA]"), std::string::npos);
   EXPECT_THROW(SweptSineExcitation{s}, std::invalid_argument);
 }
+
+}  // namespace test_vibration_sweep
