@@ -12,8 +12,6 @@
 #include "io/services/studies.hpp"
 
 namespace vrelab::app {
-using namespace vrelab::io;
-
 namespace {
 
 // The first number of a result that is not finite ("" if none), as a JSON path.
@@ -29,81 +27,82 @@ std::string first_non_finite(const nlohmann::json& j, const std::string& at) {
 }
 
 // A result with inf or NaN is not written (nor printed as if it were one): exit 2, naming it.
-void check_finite(const Case& c, const nlohmann::json& j) {
+void check_finite(const io::Case& c, const nlohmann::json& j) {
   if (const std::string p = first_non_finite(j, ""); !p.empty())
-    throw InputError(c.path + ": the result " + p +
+    throw io::InputError(c.path + ": the result " + p +
                      " is not a finite number: a value of the case drives the computation out of range");
 }
 
 void write_json(const std::string& path, const nlohmann::json& j) {
-  if (!path.empty()) write_atomic(path, json_text(j));
+  if (!path.empty()) io::write_atomic(path, io::json_text(j));
 }
 
 }  // namespace
 
 void run_identify(const IdentifyOptions& o, std::ostream& out) {
-  if (!o.checkpoint_path.empty() && o.monte_carlo == 0) throw InputError("--checkpoint needs --monte-carlo N");
-  Case c = read_case(o.case_path);
+  if (!o.checkpoint_path.empty() && o.monte_carlo == 0) throw io::InputError("--checkpoint needs --monte-carlo N");
+  io::Case c = io::read_case(o.case_path);
   if (o.seed) c.seed = *o.seed;
   if (o.work_limit) check_identify_work(c, o.monte_carlo);
-  const IdentifyStudy s = identify(c, o.monte_carlo, o.checkpoint_path);
+  const io::IdentifyStudy s = io::identify(c, o.monte_carlo, o.checkpoint_path);
   if (!core::is_root_process()) return;  // under mpirun the Monte Carlo's results are rank 0's
-  nlohmann::json j = identify_json(c, s);
+  nlohmann::json j = io::identify_json(c, s);
   if (o.monte_carlo > 0) {  // where the trials ran (they do not depend on it: blocks seeded by their index)
     j["settings"]["monte_carlo_ranks"] = core::process_count();
     j["settings"]["monte_carlo_threads_per_rank"] = core::threads_per_process(0);
   }
   check_finite(c, j);
-  out << identify_report(c, s);
+  out << io::identify_report(c, s);
   write_json(o.json_path, j);
 }
 
 void run_predict(const PredictOptions& o, std::ostream& out) {
-  const Case c = read_case(o.case_path);
-  const PredictStudy s = predict(c, o.frequency_dependent);
-  const nlohmann::json j = predict_json(c, s);
+  const io::Case c = io::read_case(o.case_path);
+  const io::PredictStudy s = io::predict(c, o.frequency_dependent);
+  const nlohmann::json j = io::predict_json(c, s);
   check_finite(c, j);
-  out << predict_report(c, s);
+  out << io::predict_report(c, s);
   write_json(o.json_path, j);
 }
 
 void run_shake(const ShakeOptions& o, std::ostream& out) {
-  Case c = read_case(o.case_path);
+  io::Case c = io::read_case(o.case_path);
   if (o.seed) c.seed = *o.seed, c.shake.readout.seed = *o.seed;
   if (o.work_limit) check_shake_work(c);
-  const ShakeStudy s = shake(c, o.series_path);
-  const nlohmann::json j = shake_json(c, s);
+  const io::ShakeStudy s = io::shake(c, o.series_path);
+  const nlohmann::json j = io::shake_json(c, s);
   check_finite(c, j);
-  out << shake_report(c, s);
+  out << io::shake_report(c, s);
   write_json(o.json_path, j);
 }
 
 void run_measure(const MeasureOptions& o, std::ostream& out) {
-  if (o.on_s.size() != 2 || o.baseline_s.size() != 2) throw InputError("--on and --baseline each take FROM,TO in seconds");
+  if (o.on_s.size() != 2 || o.baseline_s.size() != 2)
+    throw io::InputError("--on and --baseline each take FROM,TO in seconds");
   rectification::SeriesWindows w;
   w.on_from_s = o.on_s[0], w.on_to_s = o.on_s[1];
   w.baseline_from_s = o.baseline_s[0], w.baseline_to_s = o.baseline_s[1];
   w.frequency_Hz = o.frequency_Hz, w.K1 = o.K1, w.blocks = o.blocks, w.input_rms_g = o.input_rms_g;
-  const MeasureStudy s = measure(o.series_path, o.column, w);
-  out << measure_report(s);
-  write_json(o.json_path, measure_json(s));
+  const io::MeasureStudy s = io::measure(o.series_path, o.column, w);
+  out << io::measure_report(s);
+  write_json(o.json_path, io::measure_json(s));
 }
 
 int run_sweep(const SweepOptions& o, std::ostream& out) {
-  const Case c = read_case(o.case_path);
+  const io::Case c = io::read_case(o.case_path);
   if (o.work_limit) check_sweep_work(c);
-  const SweepStudy s = sweep(c, o.out_path, o.restart, o.threads, o.progress, out);
-  out << sweep_report(s, o.out_path);
+  const io::SweepStudy s = io::sweep(c, o.out_path, o.restart, o.threads, o.progress, out);
+  out << io::sweep_report(s, o.out_path);
   return static_cast<int>(s.failures.size());
 }
 
 void run_frequency(const FrequencyOptions& o, std::ostream& out) {
-  const Case c = read_case(o.case_path);
+  const io::Case c = io::read_case(o.case_path);
   if (o.work_limit) check_frequency_work(c);
-  const FrequencyStudy s = frequency(c);
-  out << frequency_report(c, s);
-  write_frequency_data(c, s, o.out_dir);
-  const std::string why = run_plot_script("frequency.py", o.out_dir);
+  const io::FrequencyStudy s = io::frequency(c);
+  out << io::frequency_report(c, s);
+  io::write_frequency_data(c, s, o.out_dir);
+  const std::string why = io::run_plot_script("frequency.py", o.out_dir);
   if (!why.empty())
     out << "Figures skipped: " << why << ". The data are in " << o.out_dir << "\n";
   else

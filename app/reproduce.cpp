@@ -11,10 +11,9 @@
 #include "vrelab_version.hpp"
 
 namespace vrelab::app {
-using namespace vrelab::io;
 
 void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
-  const Case c = read_case(o.case_path);
+  const io::Case c = io::read_case(o.case_path);
   if (o.work_limit) check_reproduce_work(c);
   // The header line before the first progress line: after the checks, so bad input prints nothing.
   bool header = false;
@@ -24,7 +23,7 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
                          c.seed, o.out_dir);
     header = true;
   };
-  const ReproduceRun run = reproduce_to_folder(
+  const io::ReproduceRun run = io::reproduce_to_folder(
       c, o.out_dir, o.threads, o.plots,
       [&](const std::string& m) {
         print_header();
@@ -32,7 +31,7 @@ void run_reproduce(const ReproduceOptions& o, std::ostream& out) {
       },
       &std::cerr);
   print_header();
-  out << reproduce_brief_report(run.result);
+  out << io::reproduce_brief_report(run.result);
   if (!run.figures_missing.empty()) out << "Figures skipped: " << run.figures_missing << "\n";
   out << fmt::format("Wrote {}/report.html, report.md and the data ({:.1f} s wall)\n", o.out_dir, run.wall_s);
 }

@@ -6,16 +6,14 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
-#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
 namespace vrelab::vibration {
 namespace {
 
-constexpr const char* kAxis[3] = {"IA", "PA", "OA"};
-constexpr double kTwoPi = 2 * std::numbers::pi;
-
+using detail::kAxisName;
+using detail::kTwoPi;
 using detail::num;
 
 void check_axis(int axis, const char* field) {
@@ -121,8 +119,8 @@ Vec3 TransverseMotion::acceleration_g(double t) const {
 }
 
 std::string TransverseMotion::describe() const {
-  return inner_->describe() + "; transverse " + num(spec_.ratio) + " x " + kAxis[spec_.from_axis] + " on " +
-         kAxis[spec_.to_axis] + " at " + num(spec_.phase_rad) + " rad" + (tone_ ? "" : " (time-shift form)");
+  return inner_->describe() + "; transverse " + num(spec_.ratio) + " x " + kAxisName[spec_.from_axis] + " on " +
+         kAxisName[spec_.to_axis] + " at " + num(spec_.phase_rad) + " rad" + (tone_ ? "" : " (time-shift form)");
 }
 
 // ---------------------------------------------------------------- HarmonicDistortion
@@ -180,14 +178,14 @@ std::string HarmonicDistortion::describe() const {
 
 void validate(const RockingSpec& s) {
   for (int i = 0; i < 3; ++i) {
-    check_finite(s.axis[i], std::string("axis[") + kAxis[i] + "]");
-    check_finite(s.static_gravity_g[i], std::string("static_gravity_g[") + kAxis[i] + "]");
+    check_finite(s.axis[i], std::string("axis[") + kAxisName[i] + "]");
+    check_finite(s.static_gravity_g[i], std::string("static_gravity_g[") + kAxisName[i] + "]");
   }
   if (s.axis.norm() == 0) throw std::invalid_argument("axis is the zero vector");
   check_non_negative(s.amplitude_rad, "amplitude_rad");
   check_finite(s.phase_rad, "phase_rad");
   if (s.lever_arm_m) {
-    for (int i = 0; i < 3; ++i) check_finite((*s.lever_arm_m)[i], std::string("lever_arm_m[") + kAxis[i] + "]");
+    for (int i = 0; i < 3; ++i) check_finite((*s.lever_arm_m)[i], std::string("lever_arm_m[") + kAxisName[i] + "]");
     if (!std::isfinite(s.g_m_per_s2) || s.g_m_per_s2 <= 0)
       throw std::invalid_argument("g_m_per_s2 = " + num(s.g_m_per_s2) + " must be > 0 with a lever arm");
   }

@@ -4,22 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 #include <stdexcept>
 
 namespace vrelab::vibration {
 namespace {
 
-constexpr double kTwoPi = 2 * std::numbers::pi;
+using detail::check_g;
+using detail::kTwoPi;
 
-std::string num(double x) { return detail::num(x, 4); }
-
-double check_g(double g) {
-  if (!std::isfinite(g) || g <= 0)
-    throw std::invalid_argument("g_m_per_s2 = " + num(g) + " must be a finite number > 0");
-  return g;
-}
+// A number as the demand's messages and description print it: 4 significant digits.
+std::string num_4_digits(double x) { return detail::num(x, 4); }
 
 // Sine of peak amplitude amp_g (per axis) at f with harmonics (order, ratio); r_1 = 1.
 ShakerDemand tone_demand(const Vec3& amp_g, double f, const std::vector<Harmonic>& hs, double g) {
@@ -47,7 +42,7 @@ ShakerDemand tone_demand(const Vec3& amp_g, double f, const std::vector<Harmonic
 double sine_frequency(const SineVibration& v) {
   validate(v);
   if (v.frequency_Hz <= 0)
-    throw std::invalid_argument("frequency_Hz = " + num(v.frequency_Hz) +
+    throw std::invalid_argument("frequency_Hz = " + num_4_digits(v.frequency_Hz) +
                                 " (not given): velocity and displacement need the frequency");
   return v.frequency_Hz;
 }
@@ -107,26 +102,27 @@ std::string ShakerDemand::report() const {
   o << "acceleration rms " << v3(acceleration_rms_g, 1) << " g, peak " << v3(acceleration_peak_g, 1) << " g; "
     << "velocity rms " << v3(velocity_rms_m_per_s, 1) << " m/s, peak " << v3(velocity_peak_m_per_s, 1) << " m/s; "
     << "displacement rms " << v3(displacement_rms_m, 1e3) << " mm, peak " << v3(displacement_peak_m, 1e3)
-    << " mm; table: stroke " << num(table_stroke_peak_to_peak_m() * 1e3) << " mm peak-to-peak, velocity "
-    << num(table_velocity_peak_m_per_s()) << " m/s peak";
+    << " mm; table: stroke " << num_4_digits(table_stroke_peak_to_peak_m() * 1e3) << " mm peak-to-peak, velocity "
+    << num_4_digits(table_velocity_peak_m_per_s()) << " m/s peak";
   return o.str();
 }
 
 void check_feasible(const ShakerDemand& d, const ShakerLimits& lim) {
   if (std::isnan(lim.stroke_peak_to_peak_m) || lim.stroke_peak_to_peak_m <= 0)
-    throw std::invalid_argument("stroke_peak_to_peak_m = " + num(lim.stroke_peak_to_peak_m) + " must be > 0");
+    throw std::invalid_argument("stroke_peak_to_peak_m = " + num_4_digits(lim.stroke_peak_to_peak_m) + " must be > 0");
   if (std::isnan(lim.velocity_peak_m_per_s) || lim.velocity_peak_m_per_s <= 0)
-    throw std::invalid_argument("velocity_peak_m_per_s = " + num(lim.velocity_peak_m_per_s) + " must be > 0");
+    throw std::invalid_argument("velocity_peak_m_per_s = " + num_4_digits(lim.velocity_peak_m_per_s) + " must be > 0");
   const double stroke = d.table_stroke_peak_to_peak_m();
   if (!(stroke <= lim.stroke_peak_to_peak_m))
     throw std::invalid_argument(
-        "the profile needs a stroke of " + num(stroke * 1e3) +
-        " mm peak-to-peak, above the shaker's stroke_peak_to_peak_m = " + num(lim.stroke_peak_to_peak_m * 1e3) + " mm");
+        "the profile needs a stroke of " + num_4_digits(stroke * 1e3) +
+        " mm peak-to-peak, above the shaker's stroke_peak_to_peak_m = " +
+        num_4_digits(lim.stroke_peak_to_peak_m * 1e3) + " mm");
   const double vel = d.table_velocity_peak_m_per_s();
   if (!(vel <= lim.velocity_peak_m_per_s))
     throw std::invalid_argument(
-        "the profile needs a velocity of " + num(vel) +
-        " m/s peak, above the shaker's velocity_peak_m_per_s = " + num(lim.velocity_peak_m_per_s) + " m/s");
+        "the profile needs a velocity of " + num_4_digits(vel) +
+        " m/s peak, above the shaker's velocity_peak_m_per_s = " + num_4_digits(lim.velocity_peak_m_per_s) + " m/s");
 }
 
 }  // namespace vrelab::vibration

@@ -2,8 +2,11 @@
 // vibration/detail.hpp -- helpers internal to the vibration stage (not part of its API).
 #include <array>
 #include <cstddef>
+#include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -11,12 +14,25 @@
 
 namespace vrelab::vibration::detail {
 
+inline constexpr double kTwoPi = 2 * std::numbers::pi;
+
+// The sensor axes' names in messages, by index (IA, PA, OA: plant/model1.hpp).
+inline constexpr const char* kAxisName[3] = {"IA", "PA", "OA"};
+
 // A number as messages and descriptions print it.
 inline std::string num(double x, int precision = 6) {
   std::ostringstream s;
   s.precision(precision);
   s << x;
   return s.str();
+}
+
+// The site's gravity g_m_per_s2 of a shaker demand or a PSD's velocity and displacement, checked
+// (a finite number > 0) and returned.
+inline double check_g(double g_m_per_s2) {
+  if (!std::isfinite(g_m_per_s2) || g_m_per_s2 <= 0)
+    throw std::invalid_argument("g_m_per_s2 = " + num(g_m_per_s2) + " must be a finite number > 0");
+  return g_m_per_s2;
 }
 
 // The phases of a random block (random.hpp): phase[a][k] = 2 pi u for the bins k = 1 .. kmax

@@ -11,6 +11,7 @@
 namespace vrelab::vibration {
 namespace {
 
+using detail::check_g;
 using detail::num;
 
 [[noreturn]] void row_error(std::size_t i, const PsdRow& r, const std::string& what) {
@@ -84,14 +85,6 @@ double psd_moment(const ResolvedPsd& p, int m) {
   }
   return sum;
 }
-
-namespace {
-double check_g(double g_m_per_s2) {
-  if (!std::isfinite(g_m_per_s2) || g_m_per_s2 <= 0)
-    throw std::invalid_argument("g_m_per_s2 = " + num(g_m_per_s2) + " must be a finite number > 0");
-  return g_m_per_s2;
-}
-}  // namespace
 
 double rms_g(const PsdTable& t) { return std::sqrt(psd_moment(resolve(t), 0)); }
 

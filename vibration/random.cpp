@@ -24,8 +24,6 @@ std::mutex& fftw_planner_mutex() {
 }
 namespace {
 
-constexpr const char* kAxis[3] = {"IA", "PA", "OA"};
-
 // RAII owners for FFTW: buffers from fftw_malloc freed by fftw_free, plans destroyed by
 // fftw_destroy_plan under fftw_planner_mutex() (random.hpp).
 std::mutex& planner_mutex() { return fftw_planner_mutex(); }
@@ -70,6 +68,7 @@ Plan plan_r2c(int n, double* in, fftw_complex* out) {
   return Plan(p);
 }
 
+using detail::kAxisName;
 using detail::num;
 
 void check_rate(const RandomProfile& p, double fs) {
@@ -153,7 +152,7 @@ void validate(const RandomProfile& p) {
     try {
       validate(*p.psd[i]);
     } catch (const std::invalid_argument& e) {
-      throw std::invalid_argument(std::string("psd[") + kAxis[i] + "]: " + e.what());
+      throw std::invalid_argument(std::string("psd[") + kAxisName[i] + "]: " + e.what());
     }
   }
   if (!any) throw std::invalid_argument("psd: no axis has a PSD table");
@@ -172,7 +171,7 @@ std::string describe(const RandomProfile& p) {
   std::string s = p.measured ? "random (measured cross-spectra)"
                  : p.coupling == AxisCoupling::common ? "random (common phases)" : "random (independent axes)";
   for (int i = 0; i < 3; ++i)
-    if (p.psd[i]) s += std::string("; ") + kAxis[i] + ": " + describe(*p.psd[i]);
+    if (p.psd[i]) s += std::string("; ") + kAxisName[i] + ": " + describe(*p.psd[i]);
   return s;
 }
 

@@ -64,31 +64,6 @@ double check_time(double t, double fs) {
   return p;
 }
 
-// Small least-recently-used cache keyed by an index.
-template <class T>
-class Lru {
- public:
-  explicit Lru(std::size_t capacity) : capacity_(capacity) {}
-  template <class Make>
-  std::shared_ptr<const T> get(std::int64_t key, Make&& make) {
-    for (std::size_t i = 0; i < items_.size(); ++i)
-      if (items_[i].first == key) {
-        std::rotate(items_.begin(), items_.begin() + static_cast<std::ptrdiff_t>(i),
-                    items_.begin() + static_cast<std::ptrdiff_t>(i) + 1);
-        return items_.front().second;
-      }
-    auto value = std::make_shared<const T>(make());
-    items_.insert(items_.begin(), {key, value});
-    if (items_.size() > capacity_) items_.pop_back();
-    return value;
-  }
-  std::size_t capacity() const { return capacity_; }
-
- private:
-  std::size_t capacity_;
-  std::vector<std::pair<std::int64_t, std::shared_ptr<const T>>> items_;
-};
-
 using Coefficients3 = std::array<std::vector<double>, 3>;
 
 }  // namespace
@@ -163,7 +138,34 @@ std::string SampledExcitation::describe() const {
 
 // ---------------------------------------------------------------- RandomExcitation
 
-namespace {
+// Named rather than anonymous: RandomExcitation::Cache, a class with linkage, holds them (GCC's
+// -Wsubobject-linkage when this file is compiled inside a unity build).
+namespace sampled_internal {
+
+// Small least-recently-used cache keyed by an index.
+template <class T>
+class Lru {
+ public:
+  explicit Lru(std::size_t capacity) : capacity_(capacity) {}
+  template <class Make>
+  std::shared_ptr<const T> get(std::int64_t key, Make&& make) {
+    for (std::size_t i = 0; i < items_.size(); ++i)
+      if (items_[i].first == key) {
+        std::rotate(items_.begin(), items_.begin() + static_cast<std::ptrdiff_t>(i),
+                    items_.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+        return items_.front().second;
+      }
+    auto value = std::make_shared<const T>(make());
+    items_.insert(items_.begin(), {key, value});
+    if (items_.size() > capacity_) items_.pop_back();
+    return value;
+  }
+  std::size_t capacity() const { return capacity_; }
+
+ private:
+  std::size_t capacity_;
+  std::vector<std::pair<std::int64_t, std::shared_ptr<const T>>> items_;
+};
 
 // random_phase_block(profile, M, fs, seed, j) for a RandomExcitation's blocks, bit for bit,
 // with what does not depend on j made once: the amplitude of every bin (the PSD's log-log
@@ -254,14 +256,14 @@ class BlockSynthesiser {
   fftw_plan plan_ = nullptr;
 };
 
-}  // namespace
+}  // namespace sampled_internal
 
 struct RandomExcitation::Cache {
   std::mutex mutex;
-  Lru<SampledSignal> blocks{4};
-  Lru<Coefficients3> stretches{3};
+  sampled_internal::Lru<SampledSignal> blocks{4};
+  sampled_internal::Lru<Coefficients3> stretches{3};
   // Made on first use (a RandomExcitation that is only described costs nothing).
-  std::unique_ptr<BlockSynthesiser> synthesiser;
+  std::unique_ptr<sampled_internal::BlockSynthesiser> synthesiser;
   // The overlap-add weights cos(pi r / M), sin(pi r / M), r = 0 .. M/2 - 1.
   std::vector<double> w0, w1;
 };
@@ -305,7 +307,7 @@ void stream_samples(const RandomProfile& profile, double fs, std::uint64_t seed,
                     RandomExcitation::Cache& cache, std::int64_t first, std::size_t count, Coefficients3& out) {
   const auto h = static_cast<std::int64_t>(m / 2);
   if (!cache.synthesiser) {
-    cache.synthesiser = std::make_unique<BlockSynthesiser>(profile, fs, seed, m);
+    cache.synthesiser = std::make_unique<sampled_internal::BlockSynthesiser>(profile, fs, seed, m);
     cache.w0.resize(static_cast<std::size_t>(h));
     cache.w1.resize(static_cast<std::size_t>(h));
     for (std::int64_t r = 0; r < h; ++r) {
@@ -314,7 +316,7 @@ void stream_samples(const RandomProfile& profile, double fs, std::uint64_t seed,
       cache.w1[static_cast<std::size_t>(r)] = std::sin(theta);
     }
   }
-  BlockSynthesiser& synth = *cache.synthesiser;
+  sampled_internal::BlockSynthesiser& synth = *cache.synthesiser;
   // The axes with a PSD are written in full below; the others are +0.
   for (int a = 0; a < 3; ++a) {
     if (profile.psd[a])

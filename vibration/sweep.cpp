@@ -11,8 +11,7 @@
 namespace vrelab::vibration {
 namespace {
 
-constexpr double kTwoPi = 2 * std::numbers::pi;
-
+using detail::kTwoPi;
 using detail::num;
 
 void check_positive(double v, const char* field) {

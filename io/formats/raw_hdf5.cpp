@@ -19,8 +19,50 @@
 #include "io/formats/error.hpp"
 
 namespace vrelab::io {
+
+// Named rather than anonymous: Hdf5SeriesWriter::State, a class with linkage, holds them (GCC's
+// -Wsubobject-linkage when this file is compiled inside a unity build).
+namespace raw_hdf5_internal {
+
+// An HDF5 identifier closed when it leaves scope.
+class Id {
+ public:
+  Id() = default;
+  Id(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  Id(const Id&) = delete;
+  Id& operator=(const Id&) = delete;
+  Id(Id&& o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = -1; }
+  Id& operator=(Id&& o) noexcept {
+    if (this != &o) reset(), id_ = o.id_, close_ = o.close_, o.id_ = -1;
+    return *this;
+  }
+  ~Id() { reset(); }
+  void reset() {
+    if (id_ >= 0 && close_) close_(id_);
+    id_ = -1;
+  }
+  hid_t get() const { return id_; }
+  bool ok() const { return id_ >= 0; }
+
+ private:
+  hid_t id_ = -1;
+  herr_t (*close_)(hid_t) = nullptr;
+};
+
+// One channel of a record: a 1-D dataset of numbers (floating point or integer, read as double).
+struct Channel {
+  std::string name;
+  Id dataset, space;
+  hsize_t length = 0;
+  std::vector<double> block;
+};
+
+}  // namespace raw_hdf5_internal
+
 namespace {
 
+using raw_hdf5_internal::Channel;
+using raw_hdf5_internal::Id;
 namespace fs = std::filesystem;
 
 // HDF5 prints its error stack on stderr by default; vrelab reports errors itself. The
@@ -51,31 +93,6 @@ std::string with_reason(const std::string& message) {
   const std::string r = hdf5_reason();
   return r.empty() ? message : fmt::format("{} (HDF5: {})", message, r);
 }
-
-// An HDF5 identifier closed when it leaves scope.
-class Id {
- public:
-  Id() = default;
-  Id(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  Id(const Id&) = delete;
-  Id& operator=(const Id&) = delete;
-  Id(Id&& o) noexcept : id_(o.id_), close_(o.close_) { o.id_ = -1; }
-  Id& operator=(Id&& o) noexcept {
-    if (this != &o) reset(), id_ = o.id_, close_ = o.close_, o.id_ = -1;
-    return *this;
-  }
-  ~Id() { reset(); }
-  void reset() {
-    if (id_ >= 0 && close_) close_(id_);
-    id_ = -1;
-  }
-  hid_t get() const { return id_; }
-  bool ok() const { return id_ >= 0; }
-
- private:
-  hid_t id_ = -1;
-  herr_t (*close_)(hid_t) = nullptr;
-};
 
 // The names of the links in the file's root group, in name order.
 std::vector<std::string> root_names(hid_t file) {
@@ -124,14 +141,6 @@ std::optional<std::string> string_attribute(hid_t obj, const char* name) {
   while (!s.empty() && s.back() == ' ') s.pop_back();
   return s;
 }
-
-// One channel of a record: a 1-D dataset of numbers (floating point or integer, read as double).
-struct Channel {
-  std::string name;
-  Id dataset, space;
-  hsize_t length = 0;
-  std::vector<double> block;
-};
 
 // The place of a dataset (or one of its elements) in a file.
 FormatLocation dataset(const std::string& path, const std::string& name, long long element = -1) {

@@ -14,6 +14,7 @@
 #include "core/dispatch.hpp"
 #include "core/progress.hpp"
 #include "io/formats/output.hpp"
+#include "io/services/internal.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 #include "vrelab_version.hpp"
 
@@ -111,7 +112,6 @@ std::vector<std::string> campaign_folders(const std::vector<std::string>& dirs) 
 }
 
 BatchSummary diagnose_many(const BatchRequest& r, std::ostream& out) {
-  using Clock = std::chrono::steady_clock;
   BatchSummary s;
   s.campaigns = campaign_folders(r.dirs);
   s.ranks = core::process_count();
@@ -172,16 +172,15 @@ BatchSummary diagnose_many(const BatchRequest& r, std::ostream& out) {
   std::ofstream append;
   if (writer) append.open(r.summary_path, std::ios::app);
   core::Progress bar(std::cerr, "diagnose", todo.size(), r.progress && writer);
-  const auto start = Clock::now();
+  const auto start = std::chrono::steady_clock::now();
   // A campaign's result: "+" and its row, or "!" and why it failed.
   core::dispatch(
       todo, s.threads,
       [&](std::size_t i) {
-        const auto t0 = Clock::now();
+        const auto t0 = std::chrono::steady_clock::now();
         try {
           const std::string body = diagnose_row(s.campaigns[i], r.overrides);
-          return fmt::format("+{},{},{:.4g}\n", body, checksum(body),
-                             std::chrono::duration<double>(Clock::now() - t0).count());
+          return fmt::format("+{},{},{:.4g}\n", body, checksum(body), internal::seconds_since(t0));
         } catch (const std::exception& e) {
           return std::string("!") + e.what();
         }
@@ -198,7 +197,7 @@ BatchSummary diagnose_many(const BatchRequest& r, std::ostream& out) {
       });
   bar.finish();
   append.close();
-  s.wall_s = std::chrono::duration<double>(Clock::now() - start).count();
+  s.wall_s = internal::seconds_since(start);
   if (writer) write_atomic(r.summary_path, text_of());  // every row, in the campaigns' order
   s.written = rows.size();
   std::sort(s.failures.begin(), s.failures.end());

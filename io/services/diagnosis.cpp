@@ -9,18 +9,13 @@
 
 #include "io/formats/case_file.hpp"
 #include "io/services/diagnosis_json.hpp"
+#include "io/services/internal.hpp"
 #include "io/formats/output.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "core/progress.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 
 namespace vrelab::io {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-}  // namespace
 
 CampaignWritten write_virtual_campaign(const CampaignRequest& request) {
   Case c = read_case(request.case_path);
@@ -36,7 +31,7 @@ CampaignWritten write_virtual_campaign(const CampaignRequest& request) {
   w.request = request;
   w.request.seed = c.seed;
   if (w.request.key_path.empty()) w.request.key_path = request.out_dir + ".key.json";
-  const auto start = Clock::now();
+  const auto start = std::chrono::steady_clock::now();
   core::Progress progress(std::cerr, "campaign", spec.design.frequencies_Hz.size() * spec.design.amplitudes_g.size() *
                                                     spec.design.directions.size() * spec.design.orientations_g.size(),
                           request.progress);
@@ -54,7 +49,7 @@ CampaignWritten write_virtual_campaign(const CampaignRequest& request) {
   key["data"] = request.out_dir;
   write_atomic(w.request.key_path, json_text(key));
   w.statics = camp.statics.size(), w.runs = camp.runs.size(), w.raw_records = !camp.raw.empty();
-  w.wall_s = seconds_since(start);
+  w.wall_s = internal::seconds_since(start);
   return w;
 }
 
@@ -88,13 +83,13 @@ FolderDiagnosis read_folder(const std::string& dir, const DiagnoseOverrides& o) 
 
 FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& o) {
   FolderDiagnosis f = read_folder(dir, o);
-  const auto start = Clock::now();
+  const auto start = std::chrono::steady_clock::now();
   try {
     f.diagnosis = validation::diagnose(f.campaign, f.settings);
   } catch (const std::invalid_argument& e) {
     throw InputError(dir + ": " + e.what());
   }
-  f.wall_s = seconds_since(start);
+  f.wall_s = internal::seconds_since(start);
   f.diagnosed = true;
   return f;
 }

@@ -69,7 +69,7 @@ double run_input_rms_g(const validation::RunRecord& r) {
 }
 
 // Each run as read; with its diagnosis (prediction, gap, z, held-out gaps) when d has one per run.
-json runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
+json diagnosed_runs_json(const validation::Diagnosis& d, const validation::Campaign& c) {
   json runs = json::array();
   const bool diagnosed = d.runs.size() == c.runs.size();
   for (std::size_t k = 0; k < c.runs.size(); ++k) {
@@ -256,7 +256,7 @@ json to_json(const validation::Diagnosis& d, const validation::Campaign& c) {
                      "largest gaps"}}},
           {"identified", coefficients_json(d.identified)},
           {"skipped_runs", c.skipped},
-          {"runs", runs_json(d, c)}};
+          {"runs", diagnosed_runs_json(d, c)}};
 }
 
 json to_json(const rectification::MotionDeparture& m) {
@@ -369,7 +369,7 @@ json to_json(const FolderDiagnosis& f) {
   } else {  // read and checked only: the campaign as read, nothing judged
     j["diagnosed"] = false;
     j["skipped_runs"] = c.skipped;
-    j["runs"] = runs_json(f.diagnosis, c);
+    j["runs"] = diagnosed_runs_json(f.diagnosis, c);
   }
   j["units"] = {{"gap", "g"}, {"parameter", "see each effect's unit"}};
   return j;

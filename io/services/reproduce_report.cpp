@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <numbers>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include "io/formats/output.hpp"
+#include "io/services/internal.hpp"
 #include "io/services/results_json.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "vrelab_version.hpp"
@@ -20,7 +20,7 @@ using plant::kNumCoefficients;
 using validation::ReproduceResult;
 using validation::ReproduceSettings;
 using validation::RunResult;
-constexpr double kArcsec = std::numbers::pi / (180.0 * 3600.0);
+using internal::kArcsec;
 
 // A CSV field: quoted when it holds a comma, a quote or a line break (RFC 4180).
 std::string csv_field(const std::string& x) {

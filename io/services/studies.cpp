@@ -22,6 +22,7 @@
 #include "core/progress.hpp"
 #include "io/formats/csv.hpp"
 #include "io/formats/output.hpp"
+#include "io/services/internal.hpp"
 #include "io/services/results_json.hpp"
 #include "io/formats/series.hpp"
 #include "rectification/measurement/vrc.hpp"
@@ -38,7 +39,8 @@ FormatLocation table_of(const Case& c, const std::string& table) {
 }
 
 using plant::kNumCoefficients;
-constexpr double kArcsec = std::numbers::pi / (180.0 * 3600.0);
+using internal::kArcsec;
+using internal::seconds_since;
 
 std::string cell(double x) { return fmt::format(" {:>10.3e}", x); }
 std::string text_cell(const std::string& s) { return fmt::format(" {:>10}", s); }
@@ -48,10 +50,6 @@ double thread_cpu_s() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 std::uint64_t fnv1a(const std::string& s) {

@@ -16,7 +16,13 @@
 namespace vrelab::rectification {
 
 using plant::Accelerometer;
-using namespace plant;
+using plant::Coefficients;
+using plant::Dynamics;
+using plant::Effect;
+using plant::Location;
+using plant::PlantConfig;
+using plant::kNumCoefficients;
+using enum plant::Coef;
 
 LoopResponse loop_response(const PlantConfig& config, double frequency_Hz) {
   if (!(frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive");

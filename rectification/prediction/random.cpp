@@ -10,7 +10,12 @@
 
 namespace vrelab::rectification {
 
-using namespace plant;
+using plant::Coefficients;
+using plant::Dynamics;
+using plant::Location;
+using plant::PlantConfig;
+using plant::kNumCoefficients;
+using enum plant::Coef;
 
 namespace {
 

@@ -19,7 +19,6 @@
 
 namespace vrelab::rectification {
 namespace {
-constexpr double kPi = std::numbers::pi;
 using plant::Accelerometer;
 
 // The plant and, beside it, its own linearisation driven by the same input: z' = A z + B a.
@@ -255,7 +254,7 @@ SinePlan plan_sine(const plant::PlantConfig& config, const vibration::SineVibrat
   SinePlan p;
   p.s = &s;
   p.frequency_Hz = v.frequency_Hz;
-  p.w = 2 * kPi * v.frequency_Hz;
+  p.w = 2 * std::numbers::pi * v.frequency_Hz;
   p.period = 1 / v.frequency_Hz;
   const double period = p.period;
 
@@ -515,7 +514,7 @@ ShakeResult shake_sine(const plant::PlantConfig& config, const Vec3& a_static, c
   if (!s.IsValid(&why)) throw std::invalid_argument(why);
   vibration::validate(v);
   if (!(v.frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive for a shaker run");
-  const double w = 2 * kPi * v.frequency_Hz;
+  const double w = 2 * std::numbers::pi * v.frequency_Hz;
 
   const Accelerometer rest(config, a_static);
   ShakeResult r;

@@ -16,7 +16,9 @@
 namespace vrelab::validation {
 namespace {
 
-using namespace plant;
+using plant::Basis;
+using plant::kNumCoefficients;
+using enum plant::Coef;
 constexpr int N = kNumCoefficients;
 // Singular values below this fraction of the largest count as zero. The column-scaled
 // design of an exactly confounded set has its smallest singular value at ~1e-16; a
@@ -48,7 +50,7 @@ Design design(const std::vector<Position>& positions, const std::vector<int>& ro
   d.A.resize(static_cast<Eigen::Index>(rows.size()), static_cast<Eigen::Index>(d.params.size()));
   d.offset = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(rows.size()));
   for (std::size_t r = 0; r < rows.size(); ++r) {
-    const Basis f = basis(positions.at(rows[r]).nominal_g);
+    const Basis f = plant::basis(positions.at(rows[r]).nominal_g);
     double known = f[0];  // the part multiplied by K1: a_IA + sum of fixed k_i f_i
     for (int i = 1; i < N; ++i)
       if (fixed[i]) known += *fixed[i] * f[i];
@@ -90,7 +92,7 @@ std::string describe(const std::array<double, N>& v, const std::vector<Position>
   std::vector<int> idx;
   for (int i = 0; i < N; ++i)
     if (std::abs(v[i]) > 1e-9) idx.push_back(i);
-  auto label = [](int i) { return i == K1 ? std::string("K1 (relative)") : std::string(coefficient_name(i)); };
+  auto label = [](int i) { return i == K1 ? std::string("K1 (relative)") : std::string(plant::coefficient_name(i)); };
   std::ostringstream out;
   bool unit_pattern = idx.size() >= 2;
   for (std::size_t n = 1; n < idx.size(); ++n)
@@ -271,7 +273,7 @@ FitCheck check_fit(const std::vector<Position>& positions, const std::vector<Rea
   const double k1 = e.value[K1];
   for (int i = 0; i < N; ++i)
     if (!std::isfinite(e.value[i])) {
-      out.problem = std::string(coefficient_name(i)) + " is not a finite number";
+      out.problem = std::string(plant::coefficient_name(i)) + " is not a finite number";
       return out;
     }
   if (!(k1 > 0)) {
@@ -281,7 +283,7 @@ FitCheck check_fit(const std::vector<Position>& positions, const std::vector<Rea
   for (int i = 1; i < N; ++i)
     if (std::abs(e.value[i]) > kAbsurdCoefficient) {
       out.problem = fmt::format("{} = {:.3g} lies beyond any accelerometer's range (|{}| <= {:g} in its unit)",
-                                coefficient_name(i), e.value[i], coefficient_name(i), kAbsurdCoefficient);
+                                plant::coefficient_name(i), e.value[i], plant::coefficient_name(i), kAbsurdCoefficient);
       return out;
     }
   const double floor = std::pow(k1 * kFitFloor_g, 2);
@@ -328,12 +330,13 @@ std::optional<PaperTable> paper_table(const std::vector<Position>& positions,
 namespace {
 
 // U(s, j) with the paper's 1-based indices: U_sj.
-struct Table {
+struct OneBasedTable {
   const PaperTable& t;
   double operator()(int s, int j) const { return t[s - 1][j - 1]; }
 };
 
-Estimate paper_common(const Table& U, double k1_tilde, double K, bool corrected, double kpp = 0, double koo = 0) {
+Estimate paper_common(const OneBasedTable& U, double k1_tilde, double K, bool corrected, double kpp = 0,
+                      double koo = 0) {
   constexpr double r2 = std::numbers::sqrt2;
   Estimate e;
   e.value[K1] = K;
@@ -374,14 +377,14 @@ Estimate paper_common(const Table& U, double k1_tilde, double K, bool corrected,
 }  // namespace
 
 Estimate paper_printed(const PaperTable& t, double k1_tilde) {
-  const Table U{t};
+  const OneBasedTable U{t};
   constexpr double r2 = std::numbers::sqrt2;
   const double k1 = ((U(1, 5) - U(1, 1)) + r2 * (U(1, 4) + U(1, 6)) - r2 * (U(1, 2) + U(1, 8))) / 6;
   return paper_common(U, k1_tilde, k1, false);
 }
 
 Estimate paper_corrected(const PaperTable& t, double k1_tilde, double kpp, double koo) {
-  const Table U{t};
+  const OneBasedTable U{t};
   constexpr double r2 = std::numbers::sqrt2;
   const double d1 = (U(1, 5) - U(1, 1)) / 2;
   const double d2 = ((U(1, 4) + U(1, 6)) - (U(1, 2) + U(1, 8))) / 4;
