@@ -610,7 +610,7 @@ PYBIND11_MODULE(_core, m) {
       .def_readonly("wall_s", &io::FolderDiagnosis::wall_s, "The diagnosis alone, s.")
       .def_property_readonly("verdict", [](const io::FolderDiagnosis& f) { return validation::verdict_text(f.diagnosis); })
       .def_property_readonly("chosen", [](const io::FolderDiagnosis& f) { return validation::to_string(f.diagnosis.chosen); }, "The best effect (or \"A + B\").")
-      .def_property_readonly("explained", [](const io::FolderDiagnosis& f) { return f.diagnosis.explained; })
+      .def_property_readonly("explained", [](const io::FolderDiagnosis& f) { return f.diagnosis.explained(); })
       .def_property_readonly("gap_significant", [](const io::FolderDiagnosis& f) { return f.diagnosis.gap_significant; })
       .def_property_readonly("significant_runs", [](const io::FolderDiagnosis& f) { return f.diagnosis.significant_runs; }, "Runs whose gap exceeds significance_sigma.")
       .def_property_readonly("runs", [](const io::FolderDiagnosis& f) { return f.diagnosis.runs.size(); })

@@ -226,7 +226,7 @@ json to_json(const validation::Diagnosis& d, const validation::Campaign& c) {
           {"verdict", validation::verdict_text(d)},
           {"chosen", validation::to_string(d.chosen)},
           {"pairs", pairs_json(d)},
-          {"explained", d.explained},
+          {"explained", d.explained()},
           {"where", d.where},
           {"folds", d.folds},
           {"significant_runs", d.significant_runs},

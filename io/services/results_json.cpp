@@ -15,12 +15,9 @@ using nlohmann::json;
 using plant::kNumCoefficients;
 using validation::RunResult;
 
-// The described fields (the readout's noise and LSB in ug) and the solver used.
-json shake_settings_json(const rectification::ShakeSettings& s) {
-  json j = settings_json(s);
-  j["solver"] = "CVODE BDF, dense direct linear solver";
-  return j;
-}
+// The ODE solver every shaker run uses (recorded beside the settings, not among them: a settings
+// record holds only fields, so that settings_from_json reads it back).
+const char* const kSolverName = "CVODE BDF, dense direct linear solver";
 
 json sweep_grid_json(const rectification::SweepGrid& g) {
   json d = json::array(), o = json::array();
@@ -37,14 +34,6 @@ json series_windows_json(const rectification::SeriesWindows& w) {
           {"frequency_Hz", w.frequency_Hz > 0 ? json(w.frequency_Hz) : json(nullptr)},
           {"K1", w.K1},
           {"blocks", w.blocks}};
-}
-
-// ReproduceSettings as described (validation_json.hpp for its positions and named vectors), the
-// shaker runs' settings with their solver.
-json reproduce_settings_json(const validation::ReproduceSettings& s) {
-  json j = settings_json(s);
-  j["shake"] = shake_settings_json(s.shake);
-  return j;
 }
 
 double vibration_input_rms_g(const VibrationSpec& v) {
@@ -238,8 +227,9 @@ json shake_json(const Case& c, const ShakeStudy& s) {
                       {"periods", r.periods},
                       {"samples", r.samples},
                       {"sample_rate_Hz", r.sample_rate_Hz}};
-  j["settings"] = shake_settings_json(c.shake);
-  j["solver_stats"] = {{"steps", r.steps},
+  j["settings"] = settings_json(c.shake);
+  j["solver_stats"] = {{"solver", kSolverName},
+                       {"steps", r.steps},
                        {"rhs_evaluations", r.rhs_evaluations},
                        {"wall_s", s.wall_s},
                        {"cpu_s", s.cpu_s},
@@ -403,7 +393,8 @@ json reproduce_summary_json(const Case& c, const validation::ReproduceSettings& 
                             double wall_s) {
   const validation::AmplitudeAnalysis& a = res.amplitude;
   json summary = result_record("reproduce", c);
-  summary["settings"] = reproduce_settings_json(s);
+  summary["settings"] = settings_json(s);  // validation_json.hpp: its positions and named vectors
+  summary["solver"] = kSolverName;
   summary["plant"] = plant_json(c.plant, false);
   summary["wall_s"] = wall_s;
   summary["units"] = {{"errors", "g"}, {"frequency", "Hz"}, {"amplitude", "g peak"}, {"coefficients", "see docs/case-files.md"}};

@@ -18,11 +18,9 @@
 namespace vrelab::io {
 
 // ---- settings
-nlohmann::json shake_settings_json(const rectification::ShakeSettings& s);
 nlohmann::json sweep_grid_json(const rectification::SweepGrid& g);
 nlohmann::json frequency_study_settings_json(const rectification::FrequencyStudySettings& s);
 nlohmann::json series_windows_json(const rectification::SeriesWindows& w);
-nlohmann::json reproduce_settings_json(const validation::ReproduceSettings& s);
 
 // ---- the commands' results (each with its "settings")
 nlohmann::json identify_json(const Case& c, const IdentifyStudy& s);

@@ -147,7 +147,7 @@ TEST(BlindScoringCampaign, TheGapsHeldOutRmsWithoutTheNoiseIsTheNoiseFreeDiagnos
   const Campaign quiet = without_noise(noisy, noise_g);
   const Diagnosis dn = diagnose(noisy, s), dq = diagnose(quiet, s);
   ASSERT_EQ(to_string(dn.chosen), "pickoff_nonlinearity") << verdict_text(dn);
-  ASSERT_TRUE(dn.explained) << verdict_text(dn);
+  ASSERT_TRUE(dn.explained()) << verdict_text(dn);
   ASSERT_EQ(to_string(dq.chosen), "pickoff_nonlinearity") << verdict_text(dq);
   const std::vector<double> gap_g = heldout_nominal_gap_g(quiet, s);
   ASSERT_EQ(gap_g.size(), dq.runs.size());
@@ -226,7 +226,7 @@ TEST(BlindScoring, SinglesAreScoredByTheGapAsTheLabSeesItTheLargestRunSizeBeside
     if (i == 10 || i == 11) {
       k.called = k.hidden[0].name;
       k.diagnosis.chosen.names = {k.hidden[0].name};
-      k.diagnosis.explained = k.diagnosis.gap_significant = true;
+      k.diagnosis.gap_significant = true;
       k.diagnosis.verdict = Verdict::explained;
     }
     if (i == 10) k.effect_max_sigma = 4, k.effect_gap_sigma = 8;
@@ -283,7 +283,7 @@ TEST(BlindScoring, TwoEffectCampaignsAreScoredByTheChosenSetInEitherOrder) {
       k.diagnosis.chosen.names = two.size() == 1 ? std::vector<std::string>{b, a}
                                  : two.size() == 2 ? std::vector<std::string>{a}
                                                    : std::vector<std::string>{a, third};
-      k.diagnosis.explained = k.diagnosis.gap_significant = true;
+      k.diagnosis.gap_significant = true;
       k.diagnosis.verdict = Verdict::explained;
       k.called = to_string(k.diagnosis.chosen);
     }

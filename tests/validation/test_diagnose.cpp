@@ -248,7 +248,7 @@ TEST(DiagnoseCampaign, HiddenPickoffNonlinearityIsFoundFittedAndRemoved) {
   const Campaign c = simulate_campaign(truth(), {{"pickoff_nonlinearity", -12.0}}, small_design(), 32, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant);
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   EXPECT_EQ(d.effects.front().name, "pickoff_nonlinearity");
   // The parameter: within 2 % of the truth (its statistical sigma is ~0.013 /rad; the
   // first-order model's own error, ~0.1 %, dominates).
@@ -278,7 +278,7 @@ TEST(DiagnoseCampaign, HiddenK5IsFittedWithWhatTheStaticTestTookUpGivenBack) {
   const Campaign c = simulate_campaign(truth(), {{"higher_order_k5", 2e-7}}, small_design(), 34, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "higher_order_k5");
   // Tolerance: 3 fitted sigma plus the first-order simulation's 0.2 %.
   EXPECT_NEAR(d.effects.front().value, 2e-7, 3 * d.effects.front().sigma + 0.002 * 2e-7);
@@ -298,7 +298,7 @@ TEST(DiagnoseCampaign, ReadoutNonlinearityOfTheShakerRunsIsFound) {
   const Campaign c = simulate_campaign(truth(), {{"readout_nonlinearity", 2e-5}}, small_design(), 35, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "readout_nonlinearity");
   EXPECT_NEAR(d.effects.front().value, 2e-5, 3 * d.effects.front().sigma + 0.002 * 2e-5);
   // q2 |U|^2 / 2 does not depend on the sign of the static a_IA: the gap is even in it.
@@ -316,7 +316,7 @@ TEST(DiagnoseCampaign, TwoHiddenEffectsAreFittedTogether) {
   const Diagnosis d = diagnose(c, s);
   ASSERT_TRUE(d.gap_significant);
   ASSERT_FALSE(d.pairs.empty()) << verdict_text(d);  // tried: one effect did not explain it
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   const PairFit& p = d.pairs.front();
   ASSERT_EQ(to_string(d.chosen), p.a + " + " + p.b);
   const double p2 = p.a == "pickoff_nonlinearity" ? p.pa : p.pb, q2 = p.a == "readout_nonlinearity" ? p.pa : p.pb;
@@ -338,7 +338,7 @@ TEST(DiagnoseCampaign, ServoDynamicsAreTellApartFromAResonance) {
   EXPECT_NEAR(d.effects.front().value, 1.3, 0.02);
   // Told apart: explained, not ambiguous, and the resonance (mechanical_mode) judged and left
   // behind by the targeted test's 25 in held-out -2 ln L.
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   EXPECT_TRUE(d.ambiguous_with.empty()) << verdict_text(d);
   const auto mode = std::find_if(d.effects.begin(), d.effects.end(), [](const EffectFit& e) { return e.name == "mechanical_mode"; });
   ASSERT_NE(mode, d.effects.end()) << "mechanical_mode was not judged";
@@ -356,7 +356,7 @@ TEST(DiagnoseCampaign, HiddenHarmonicDistortionIsFoundAndFitted) {
   const Campaign c = simulate_campaign(truth(), {{"shaker_harmonic_distortion", 0.2}}, small_design(), 37, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "shaker_harmonic_distortion");
   EXPECT_NEAR(d.effects.front().value, 0.2, 3 * d.effects.front().sigma + 0.01 * 0.2);
 }
@@ -368,7 +368,7 @@ TEST(DiagnoseCampaign, HiddenFixtureRockingIsFoundAndFitted) {
   const Campaign c = simulate_campaign(truth(), {{"fixture_rocking", -6e-7}}, small_design(), 38, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "fixture_rocking");
   EXPECT_NEAR(d.effects.front().value, -6e-7, 3 * d.effects.front().sigma + 0.01 * 6e-7);
   // The held-out gap in sigma falls from 7.5 to 2.2 (seed 38; bound 0.4x). In ug it falls
@@ -385,7 +385,7 @@ TEST(DiagnoseCampaign, AnEffectOutsideTheLibraryIsNotExplained) {
   const Campaign c = simulate_campaign(truth(), {{"readout_clipping", 4.6}}, small_design(), 41, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_FALSE(d.explained) << verdict_text(d);
+  EXPECT_FALSE(d.explained()) << verdict_text(d);
 }
 
 TEST(LabDataCampaign, RoundTripAndTheHandWrittenExample) {

@@ -86,7 +86,7 @@ TEST(NaturalFormCampaign, AModeAlongPaWithLowDampingIsFoundWithItsParameters) {
                                        51, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "mechanical_mode") << verdict_text(d);
   const EffectFit& e = d.effects.front();
   EXPECT_EQ(parameter_named(e, "axis").status, ParameterStatus::chosen);
@@ -103,7 +103,7 @@ TEST(NaturalFormCampaign, ASecondHarmonicAtNinetyDegreesIsFoundWithItsPhase) {
                                        52, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "shaker_harmonic_distortion") << verdict_text(d);
   EXPECT_EQ(parameter_named(d.effects.front(), "second_harmonic_phase_rad").status, ParameterStatus::fitted);
   expect_within_3_sigma(d.effects.front(), v);
@@ -119,7 +119,7 @@ TEST(NaturalFormCampaign, AMisalignmentAboutPaAndOaIsFoundWithBothAngles) {
                                        53, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "mounting_misalignment") << verdict_text(d);
   EXPECT_EQ(parameter_named(d.effects.front(), "angle_about_PA_rad").status, ParameterStatus::fitted);
   expect_within_3_sigma(d.effects.front(), v);
@@ -135,7 +135,7 @@ TEST(NaturalFormCampaign, ACleanCampaignIsNotExplainedByTheRicherEffects) {
                                        54, 2);
   const Diagnosis d = diagnose(c);
   EXPECT_FALSE(d.gap_significant) << d.where << "; " << verdict_text(d);
-  EXPECT_FALSE(d.explained) << verdict_text(d);
+  EXPECT_FALSE(d.explained()) << verdict_text(d);
   // Every library effect is judged (none left out of the list, so none escapes the bound).
   ASSERT_EQ(d.effects.size(), effect_library().size()) << verdict_text(d);
   for (const EffectFit& e : d.effects) {
@@ -173,7 +173,7 @@ TEST(NaturalFormCampaign, TransverseMotionOutOfPhaseOnTheOtherAxisIsFoundWithIts
                                        design({10, 100, 400, 800, 1500}, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}), 6010, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "shaker_transverse_motion") << verdict_text(d);
   EXPECT_EQ(parameter_named(d.effects.front(), "axis_cycle").status, ParameterStatus::chosen);
   EXPECT_EQ(parameter_named(d.effects.front(), "frequency_power").status, ParameterStatus::fitted);
@@ -190,7 +190,7 @@ TEST(NaturalFormCampaign, RockingAboutPaIsFoundWithItsAxis) {
                                        design({10, 100, 400, 1000}, {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)}), 6011, 2);
   const Diagnosis d = diagnose(c);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "fixture_rocking") << verdict_text(d);
   EXPECT_EQ(parameter_named(d.effects.front(), "axis").status, ParameterStatus::chosen);
   expect_within_3_sigma(d.effects.front(), v);

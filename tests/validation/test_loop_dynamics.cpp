@@ -69,7 +69,7 @@ void print(const Diagnosis& d) {
 void expect_loop_found(const Diagnosis& d, const Departure& x) {
   print(d);
   ASSERT_TRUE(d.gap_significant) << d.where;
-  EXPECT_TRUE(d.explained) << verdict_text(d);
+  EXPECT_TRUE(d.explained()) << verdict_text(d);
   EXPECT_TRUE(d.ambiguous_with.empty()) << verdict_text(d);
   EXPECT_EQ(to_string(d.chosen), "servo_dynamics") << verdict_text(d);
   ASSERT_EQ(d.effects.front().name, "servo_dynamics") << verdict_text(d);
@@ -145,10 +145,11 @@ TEST(LoopDynamics, BlindScoresDynamicsOffByEveryFittedParameter) {
       k.called = "clean";
       if (i == kIndex) {
         Diagnosis& d = k.diagnosis;
-        d.gap_significant = true, d.explained = called != "unexplained";
-        if (d.explained) d.chosen.names = {called};
+        const bool explained = called != "unexplained";
+        d.gap_significant = true;
+        if (explained) d.chosen.names = {called};
         d.ambiguous_with = std::move(ambiguous);
-        d.verdict = !d.explained ? Verdict::not_explained : d.ambiguous_with.empty() ? Verdict::explained : Verdict::ambiguous;
+        d.verdict = !explained ? Verdict::not_explained : d.ambiguous_with.empty() ? Verdict::explained : Verdict::ambiguous;
         EffectFit e;
         e.name = called == "unexplained" ? "servo_dynamics" : called;
         e.value = ps.empty() ? 0 : ps.front().value;

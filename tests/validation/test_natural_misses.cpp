@@ -93,7 +93,7 @@ TEST(NaturalMissesCampaign, AThirdHarmonicsPhaseIsFoundInItsValleyAndExplainsThe
   ASSERT_EQ(k.hidden.at(0).name, "shaker_third_harmonic");
   const Diagnosis& d = k.diagnosis;
   std::printf("  %s; held-out chi2 %.1f\n", verdict_text(d).c_str(), d.effects.front().heldout_chi2);
-  EXPECT_TRUE(d.explained);
+  EXPECT_TRUE(d.explained());
   EXPECT_EQ(to_string(d.chosen), "shaker_third_harmonic");
   ASSERT_EQ(d.effects.front().name, "shaker_third_harmonic");
   const FittedParameter& phase = parameter_named(d.effects.front(), "third_harmonic_phase_rad");
@@ -165,7 +165,7 @@ TEST(NaturalMissesCampaign, AResonancesFrequencyAndDampingAreFoundInTheirNarrowV
   ASSERT_EQ(k.hidden.at(0).name, "mechanical_mode");
   const Diagnosis& d = k.diagnosis;
   std::printf("  %s\n", verdict_text(d).c_str());
-  EXPECT_TRUE(d.explained);
+  EXPECT_TRUE(d.explained());
   ASSERT_EQ(d.effects.front().name, "mechanical_mode");
   const FittedParameter& f = parameter_named(d.effects.front(), "frequency_Hz");
   const FittedParameter& z = parameter_named(d.effects.front(), "damping_ratio");

@@ -78,7 +78,7 @@ TEST(NuisancesCampaign, ADriftIsEstimatedFromTheRestReadingsRemovedAndNotCalledA
   for (const auto& r : c.runs) stt += (r.time_h - tm) * (r.time_h - tm);
   EXPECT_NEAR(x->sigma, 0.3 / std::sqrt(stt), 0.3 * 0.3 / std::sqrt(stt));
   EXPECT_NEAR(x->value, 2.0, 3 * x->sigma);
-  EXPECT_FALSE(d.explained) << verdict_text(d);
+  EXPECT_FALSE(d.explained()) << verdict_text(d);
   EXPECT_FALSE(d.gap_significant) << verdict_text(d);
   EXPECT_NE(verdict_text(d).find("bias drift"), std::string::npos) << verdict_text(d);
   // The same drift without the rest readings is a gap the diagnosis sees (the test can fail).
@@ -99,7 +99,7 @@ TEST(NuisancesCampaign, AStatedSigmaTooSmallIsFlaggedAndTheGapJudgedWithTheCorre
   EXPECT_TRUE(x->applied) << verdict_text(d) << "; " << x->note;
   // k from 36 gaps: sigma ~ k / sqrt(72) = 0.3; allow 3 of it.
   EXPECT_NEAR(x->value, 2.5, 3 * x->sigma) << x->note;
-  EXPECT_FALSE(d.explained) << verdict_text(d);
+  EXPECT_FALSE(d.explained()) << verdict_text(d);
   EXPECT_NE(verdict_text(d).find("sigma understated"), std::string::npos) << verdict_text(d);
   // Unscaled, the clean campaign is not flagged.
   const Diagnosis clean = diagnose(clean_campaign());

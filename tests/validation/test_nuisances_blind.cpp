@@ -73,7 +73,7 @@ TEST(NuisancesBlindCampaign, ADriftAtBlindsLowerEndIsReportedWhateverTheGapsVerd
     ASSERT_NE(x, nullptr);
     EXPECT_TRUE(x->significant) << x->value << " +- " << x->sigma << "; " << verdict_text(d);
     EXPECT_NEAR(x->value, drift_ug_per_h, 3 * x->sigma);
-    EXPECT_FALSE(d.explained) << verdict_text(d);
+    EXPECT_FALSE(d.explained()) << verdict_text(d);
     EXPECT_NE(verdict_text(d).find("bias drift"), std::string::npos) << verdict_text(d);
     // Not a nuisance it is not.
     EXPECT_FALSE(d.nuisance("sigma_scale")->significant) << d.nuisance("sigma_scale")->note;
@@ -92,7 +92,7 @@ TEST(NuisancesBlindCampaign, AnUnderstatedSigmaIsFlaggedWhateverTheGapsVerdict) 
     ASSERT_NE(x, nullptr);
     EXPECT_TRUE(x->significant && x->applied) << k << ": " << x->value << "; " << x->note << "; " << verdict_text(d);
     EXPECT_NEAR(x->value, k, 3 * x->sigma) << x->note;
-    EXPECT_FALSE(d.explained) << verdict_text(d);
+    EXPECT_FALSE(d.explained()) << verdict_text(d);
     EXPECT_NE(verdict_text(d).find("sigma understated"), std::string::npos) << verdict_text(d);
     EXPECT_FALSE(d.nuisance("bias_drift")->significant);
   }

@@ -21,6 +21,8 @@
 #include "io/formats/case_file.hpp"
 #include "app/commands.hpp"
 #include "io/formats/report.hpp"
+#include "io/formats/settings_json.hpp"
+#include "io/formats/validation_json.hpp"
 #include "rectification/prediction/eq3.hpp"
 #include "rectification/prediction/gradient.hpp"
 #include "support/constants.hpp"
@@ -221,6 +223,13 @@ TEST(ReproduceCampaign, SmallCaseAgreesAtLowFrequencyFlagsFrequencyAndRecoversTh
   EXPECT_EQ(s["seed"], 11);
   EXPECT_TRUE(s["program"].contains("version"));
   EXPECT_TRUE(s["case"]["content"].contains("reproduce"));
+  // The settings record holds only settings: read back, it writes the same record, and the
+  // case's [shake] blocks (10 in kSmallCase) came through it.
+  ReproduceSettings back;
+  ASSERT_NO_THROW(io::settings_from_json(s["settings"], back)) << s["settings"].dump();
+  EXPECT_EQ(io::settings_json(back), s["settings"]);
+  EXPECT_EQ(back.shake.blocks, 10);
+  EXPECT_EQ(s["solver"], "CVODE BDF, dense direct linear solver");
 
   // Where the paper's assumptions hold (20 Hz, in range, k_PP = k_OO = 0), measured and
   // predicted agree within the combined uncertainty. z is a residual over its standard

@@ -169,7 +169,7 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
   k.called = !k.error.empty()           ? "error"
              : !d.ambiguous_with.empty() ? "ambiguous"
              : !d.gap_significant        ? "clean"
-             : d.explained               ? to_string(d.chosen)
+             : d.explained()             ? to_string(d.chosen)
                                          : "unexplained";
   k.top = k.error.empty() && d.effects.front().not_ranked.empty() ? d.effects.front().name : "";
 }
@@ -285,17 +285,17 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
     return;
   }
   // What was called: the effects of an "explained" verdict.
-  const std::vector<std::string> called = d.explained ? d.chosen.names : std::vector<std::string>{};
+  const std::vector<std::string> called = d.explained() ? d.chosen.names : std::vector<std::string>{};
   const Nuisance* scale = d.nuisance("sigma_scale");
   const Nuisance* drift = d.nuisance("bias_drift");
   bool right = false, family = false;
   // A nuisance reported where there is none is a false alarm as much as a gap is.
   const bool scale_flagged = scale && scale->significant, drift_flagged = drift && drift->significant;
   if (k.category == "clean") right = !d.gap_significant && !scale_flagged && !drift_flagged;
-  else if (k.category == "out_of_library") right = d.gap_significant && !d.explained;
-  else if (k.category == "sigma_understated") right = !d.explained && scale_flagged;
+  else if (k.category == "out_of_library") right = d.gap_significant && !d.explained();
+  else if (k.category == "sigma_understated") right = !d.explained() && scale_flagged;
   else if (k.category == "drift")
-    right = !d.explained && drift_flagged &&
+    right = !d.explained() && drift_flagged &&
             std::abs(drift->value - k.drift_g_per_h * 1e6) < 3 * drift->sigma + 0.1 * std::abs(k.drift_g_per_h * 1e6);
   else if (k.category == "dynamics_off") {
     // The loop's dynamics found off the manifest: explained by servo_dynamics alone, every
@@ -333,7 +333,7 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
   }
   if (family) {
     ++f.family;
-  } else if (d.explained) {
+  } else if (d.explained()) {
     ++f.wrong;  // explained by an effect of another physics (or of none hidden)
   } else if (d.gap_significant) {
     ++f.unexplained;
@@ -412,7 +412,7 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
     ++s.two;
     // The effects of an unambiguous "explained" verdict (what `called` names).
     std::vector<std::string> chosen;
-    if (k.error.empty() && d.ambiguous_with.empty() && d.gap_significant && d.explained) chosen = d.chosen.names;
+    if (k.error.empty() && d.ambiguous_with.empty() && d.gap_significant && d.explained()) chosen = d.chosen.names;
     std::sort(chosen.begin(), chosen.end());
     const std::string& a = k.hidden[0].name;
     const std::string& b = k.hidden[1].name;
@@ -501,7 +501,7 @@ std::string campaign_result_text(const BlindCampaign& k) {
   const Diagnosis& d = k.diagnosis;
   const bool has_top = !d.effects.empty();
   std::string t = fmt::format("{:.17g}\t{:.17g}\t{:.17g}\t{:d}\t{:d}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}",
-                              k.simulate_s, k.wall_s, k.effect_max_sigma, d.gap_significant ? 1 : 0, d.explained ? 1 : 0,
+                              k.simulate_s, k.wall_s, k.effect_max_sigma, d.gap_significant ? 1 : 0, d.explained() ? 1 : 0,
                               d.rms_before_g, d.rms_after_g, d.rms_before_sigma, d.rms_after_sigma,
                               has_top ? d.effects.front().value : 0.0);
   for (const std::string& x : {k.error, k.called, k.top, to_string(d.chosen), d.where}) t.append("\t").append(escaped(x));
@@ -555,7 +555,8 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
   if (f.size() < kFixedResultFields + 3) throw bad(fmt::format("at least {} expected", kFixedResultFields + 3));
   Diagnosis& d = k.diagnosis;
   k.simulate_s = num(0), k.wall_s = num(1), k.effect_max_sigma = num(2);
-  d.gap_significant = f[3] == "1", d.explained = f[4] == "1";
+  d.gap_significant = f[3] == "1";
+  const bool explained = f[4] == "1";
   d.rms_before_g = num(5), d.rms_after_g = num(6), d.rms_before_sigma = num(7), d.rms_after_sigma = num(8);
   k.error = unescaped(f[10]), k.called = unescaped(f[11]), k.top = unescaped(f[12]);
   try {
@@ -581,7 +582,7 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
   d.verdict = !diagnosed                   ? Verdict::none
               : !d.gap_significant         ? Verdict::no_significant_gap
               : !d.ambiguous_with.empty()  ? Verdict::ambiguous
-              : d.explained                ? Verdict::explained
+              : explained                  ? Verdict::explained
                                            : Verdict::not_explained;
   const std::size_t n_nuisances = count(at++);
   if (f.size() < at + kNuisanceFields * n_nuisances + 1) throw bad(fmt::format("{} nuisances of {} fields expected", n_nuisances, kNuisanceFields));

@@ -208,8 +208,9 @@ struct Diagnosis {
   double pair_evidence_margin = 0;  // a pair is chosen only when its evidence beats the best single effect's by this
   ChosenEffects chosen;            // the best effect, or the pair that explains the gap
   std::string folds;               // the cross-validation used
-  bool explained = false;
   Verdict verdict = Verdict::none;  // in words (with the nuisances applied): verdict_text
+  // An effect (or pair) explains the gap, alone or tied with others.
+  bool explained() const { return verdict == Verdict::explained || verdict == Verdict::ambiguous; }
   std::vector<Nuisance> nuisances;        // bias_drift, sigma_scale
   std::vector<std::string> ambiguous_with;  // the effects that explain the gap equally well (empty: not ambiguous)
   std::vector<NextRun> next_runs;         // best first; for an ambiguous or unexplained gap

@@ -17,7 +17,7 @@ using plant::PlantConfig;
 // coefficients corrected by all runs (under the chosen effect) and the effect added, and
 // without it.
 void confirm_on_ode(const CampaignModel& m, const Chosen& chosen, const Eigen::VectorXd& r, int max_runs, Diagnosis& d) {
-  if (!(max_runs > 0 && d.explained)) return;
+  if (!(max_runs > 0 && d.explained())) return;
   const Campaign& c = m.campaign;
   const PlantConfig& plant = m.plant;
   const Data& data = m.data;

@@ -16,7 +16,7 @@ namespace vrelab::validation::internal {
 // the identified coefficients (what the static test took up of an effect acting at rest is
 // not given back here: a small part of such an effect's prediction).
 void suggest_next_runs(const plant::PlantConfig& plant, const Campaign& c, double simulation_rel_accuracy, Diagnosis& d) {
-  if (!(d.gap_significant && (!d.ambiguous_with.empty() || !d.explained))) return;
+  if (!(d.gap_significant && (!d.ambiguous_with.empty() || !d.explained()))) return;
   std::vector<std::pair<const Effect*, std::vector<double>>> cand;
   if (!d.ambiguous_with.empty()) {
     for (const auto& name : d.ambiguous_with)

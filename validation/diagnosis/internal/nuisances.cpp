@@ -118,7 +118,7 @@ Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d
   for (int k = 0; k < n; ++k) {
     const RunDiagnosis& rd = d.runs[static_cast<std::size_t>(k)];
     const double sig = std::hypot(c.runs[static_cast<std::size_t>(k)].sigma_g, o.simulation_rel_accuracy * rd.predicted_g);  // as rd.z's
-    z[static_cast<std::size_t>(k)] = d.explained ? rd.heldout_after_g / sig : rd.z;
+    z[static_cast<std::size_t>(k)] = d.explained() ? rd.heldout_after_g / sig : rd.z;
     z2 += z[static_cast<std::size_t>(k)] * z[static_cast<std::size_t>(k)];
   }
   const auto [rep_chi2, rep_dof] = repeat_scatter(c);
@@ -135,7 +135,7 @@ Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d
   scale.sigma = scale.value / std::sqrt(2.0 * kdof);
   {
     const std::string from = from_repeats ? std::string("from ").append(std::to_string(rep_dof)).append(" degrees of freedom of repeated runs")
-                             : d.explained ? std::string("from the gaps the chosen effect leaves (held out)")
+                             : d.explained() ? std::string("from the gaps the chosen effect leaves (held out)")
                                            : std::string("from the gaps no effect explains");
     char buf[240];
     std::snprintf(buf, sizeof buf, "%s; neighbouring runs' gaps correlate by %.2f (%.1f sigma over %d pairs)", from.c_str(), rho,
@@ -153,7 +153,7 @@ Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d
   // It is scatter when measured by repeats, or when no effect explains the gaps and their
   // neighbours are not alike (structure is physics). Whatever the gap's verdict: an
   // overdispersion below the gap's own 5-sigma test is still reported.
-  const bool scatter = from_repeats || (!d.explained && rho_sigma < o.structure_threshold_sigma);
+  const bool scatter = from_repeats || (!d.explained() && rho_sigma < o.structure_threshold_sigma);
   // A physical gap is not scatter: scaled from the gaps alone (no repeats), the scaling is not
   // applied when, judged with the corrected sigma, one library effect's held-out evidence still
   // exceeds the targeted test's level (significance^2 = 25). With the right sigma, 30 clean
@@ -177,7 +177,7 @@ Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d
       scale.applied = true, scale.significant = true;  // (said after the verdict: verdict_text)
     }
   } else if (excess) {
-    scale.note += d.explained ? "; not applied: the chosen effect explains the gap (only repeated runs would tell scatter apart)"
+    scale.note += d.explained() ? "; not applied: the chosen effect explains the gap (only repeated runs would tell scatter apart)"
                               : "; not applied: the gaps are alike between neighbouring runs (structure, not scatter)";
   }
   return scale;

@@ -150,14 +150,13 @@ Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, c
   if (!d.gap_significant) {
     d.verdict = Verdict::no_significant_gap;
   } else if (explains_gap(*best, d.rms_after_g)) {
-    d.explained = true;
     d.verdict = Verdict::explained;
   } else {
     d.verdict = Verdict::not_explained;
   }
   // Ambiguity: another single effect that also explains the gap with held-out evidence within
   // tie_evidence of the chosen one's (2 ln of their Bayes factor on the held-out runs).
-  if (d.explained && chosen.size() == 1) {
+  if (d.explained() && chosen.size() == 1) {
     std::vector<std::string> tied = {best->fit.name};
     for (const Scored& sc : scored)
       if (&sc != best && best->fit.evidence - sc.fit.evidence < o.tie_evidence && explains_gap(sc, rms(sc.heldout)))
