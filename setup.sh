@@ -8,7 +8,7 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 
-packages=(build-essential cmake git pkg-config
+packages=(build-essential cmake ninja-build git pkg-config
           libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libfftw3-dev libsundials-dev libhdf5-dev
           libgtest-dev libbenchmark-dev python3-matplotlib
           python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest
@@ -33,8 +33,14 @@ mpi_arg=""
 if command -v mpicxx >/dev/null 2>&1 && command -v mpirun >/dev/null 2>&1 && [[ "${VRELAB_CMAKE_ARGS:-}" != *VRELAB_MPI* ]]; then
   mpi_arg="-DVRELAB_MPI=ON"
 fi
+# Ninja for a new build folder (it keeps both cores busy where Make waits for each library to
+# link; docs/performance.md, "Build time"); an existing folder keeps the generator it has.
+gen_arg=""
+if [ ! -f build/CMakeCache.txt ] && command -v ninja >/dev/null 2>&1; then
+  gen_arg="-G Ninja"
+fi
 # shellcheck disable=SC2086
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release $mpi_arg ${VRELAB_CMAKE_ARGS:-}
+cmake -S . -B build $gen_arg -DCMAKE_BUILD_TYPE=Release $mpi_arg ${VRELAB_CMAKE_ARGS:-}
 cmake --build build -j"$(nproc)"
 
 # `import vrelab` for Debian's /usr/bin/python3: a .pth file in its site directory for local
