@@ -192,7 +192,7 @@ void write_dataset(hid_t file, Bytes& b) {
   const hid_t space = type == 5 ? H5Screate_simple(2, dims2, nullptr) : H5Screate_simple(1, dims1, nullptr);
   const hid_t dcpl = H5Pcreate(H5P_DATASET_CREATE);
   if (storage > 0 && length > 0) {
-    const hsize_t chunk1[1] = {std::min<hsize_t>(length, 1 + param * 64)}, chunk2[2] = {std::max<hsize_t>(1, length / 2), 2};
+    const hsize_t chunk1[1] = {std::min<hsize_t>(length, 64 * (1 + param))}, chunk2[2] = {std::max<hsize_t>(1, length / 2), 2};
     H5Pset_chunk(dcpl, type == 5 ? 2 : 1, type == 5 ? chunk2 : chunk1);
     if (storage == 2) H5Pset_deflate(dcpl, 1);
   }
