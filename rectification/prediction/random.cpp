@@ -6,6 +6,7 @@
 #include <complex>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace vrelab::rectification {
@@ -63,22 +64,33 @@ vibration::RandomVibration gaussian_of(const Eigen::Matrix3d& c) {
 namespace {
 
 // The profile's tables as the quadrature reads them: a table of levels only (a lab's PSD file,
-// a measured PSD of 10^6 rows) in place, checked in one pass without copying it; a table with
-// slope rows (a case file's, a few rows) resolved. Each frequency then costs a bisection in a
-// table, not a pass over it: the diagnosis evaluates a random run's PSD thousands of times.
+// a measured PSD of 10^6 rows) in place, a table with slope rows (a case file's, a few rows)
+// resolved. Each frequency then costs a bisection in a table, not a pass over it: the
+// diagnosis evaluates a random run's PSD thousands of times.
 struct PreparedTables {
   std::array<const vibration::PsdTable*, 3> levels{};
   std::array<std::optional<vibration::ResolvedPsd>, 3> resolved;
 };
 
-// True when every row of `t` is a level and the table is what vibration::validate accepts.
+// Up to this many rows a table of levels is checked whole at every call (one pass, no copy);
+// a longer one (read and validated whole by its reader: io::read_psd_file) at its ends here and
+// at each bracket the bisection lands on (level_at), so that a call costs O(log rows).
+constexpr std::size_t kWholeCheckRows = 65536;
+
+bool valid_level_row(const vibration::PsdRow& r) {
+  return r.psd_g2_per_Hz && !r.slope_dB_per_octave && std::isfinite(r.frequency_Hz) && r.frequency_Hz > 0 &&
+         std::isfinite(*r.psd_g2_per_Hz) && *r.psd_g2_per_Hz > 0;
+}
+
+// True when `t` is a table of levels that vibration::validate accepts (a long one: at its ends).
 bool valid_levels(const vibration::PsdTable& t) {
-  if (t.rows.size() < 2) return false;
+  const auto& rows = t.rows;
+  if (rows.size() < 2) return false;
+  if (rows.size() > kWholeCheckRows)
+    return valid_level_row(rows.front()) && valid_level_row(rows.back()) && rows.front().frequency_Hz < rows.back().frequency_Hz;
   double previous = 0;
-  for (const vibration::PsdRow& r : t.rows) {
-    if (!r.psd_g2_per_Hz || r.slope_dB_per_octave) return false;
-    if (!std::isfinite(r.frequency_Hz) || !(r.frequency_Hz > previous)) return false;
-    if (!std::isfinite(*r.psd_g2_per_Hz) || !(*r.psd_g2_per_Hz > 0)) return false;
+  for (const vibration::PsdRow& r : rows) {
+    if (!valid_level_row(r) || !(r.frequency_Hz > previous)) return false;
     previous = r.frequency_Hz;
   }
   return true;
@@ -106,12 +118,19 @@ PreparedTables prepared_tables(const vibration::RandomProfile& p) {
 }
 
 // The table's PSD at f, g^2/Hz: vibration::psd_g2_per_Hz's interpolation, on the rows in place.
+// A bracket that is not two level rows in increasing frequency (a long table's flaw the ends
+// did not show) is the table's validation error.
 double level_at(const vibration::PsdTable& t, double f) {
   const auto& rows = t.rows;
   if (!(f >= rows.front().frequency_Hz && f <= rows.back().frequency_Hz)) return 0.0;
   const auto above = std::upper_bound(rows.begin(), rows.end(), f,
                                       [](double x, const vibration::PsdRow& row) { return x < row.frequency_Hz; });
   const std::size_t k = std::min(static_cast<std::size_t>(above - rows.begin()), rows.size() - 1) - 1;
+  if (!valid_level_row(rows[k]) || !valid_level_row(rows[k + 1]) || !(rows[k].frequency_Hz < rows[k + 1].frequency_Hz) ||
+      !(rows[k].frequency_Hz <= f && f <= rows[k + 1].frequency_Hz)) {
+    vibration::validate(t);  // throws, naming the row
+    throw std::invalid_argument("PSD table: rows " + std::to_string(k + 1) + " and " + std::to_string(k + 2) + " are not in order");
+  }
   const double f0 = rows[k].frequency_Hz, p0 = *rows[k].psd_g2_per_Hz, p1 = *rows[k + 1].psd_g2_per_Hz;
   const double b = std::log(p1 / p0) / std::log(rows[k + 1].frequency_Hz / f0);
   return p0 * std::pow(f / f0, b);
