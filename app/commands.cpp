@@ -14,23 +14,9 @@
 namespace vrelab::app {
 namespace {
 
-// The first number of a result that is not finite ("" if none), as a JSON path.
-std::string first_non_finite(const nlohmann::json& j, const std::string& at) {
-  if (j.is_number_float() && !std::isfinite(j.get<double>())) return at.empty() ? "/" : at;
-  if (j.is_object())
-    for (auto it = j.begin(); it != j.end(); ++it)
-      if (std::string p = first_non_finite(it.value(), at + "/" + it.key()); !p.empty()) return p;
-  if (j.is_array())
-    for (std::size_t i = 0; i < j.size(); ++i)
-      if (std::string p = first_non_finite(j[i], at + "/" + std::to_string(i)); !p.empty()) return p;
-  return "";
-}
-
 // A result with inf or NaN is not written (nor printed as if it were one): exit 2, naming it.
 void check_finite(const io::Case& c, const nlohmann::json& j) {
-  if (const std::string p = first_non_finite(j, ""); !p.empty())
-    throw io::InputError(c.path + ": the result " + p +
-                     " is not a finite number: a value of the case drives the computation out of range");
+  io::require_finite(j, c.path, "a value of the case drives the computation out of range");
 }
 
 void write_json(const std::string& path, const nlohmann::json& j) {

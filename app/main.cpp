@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <functional>
 #include <iostream>
 #include <memory>
@@ -24,6 +25,7 @@
 #include "core/mpi.hpp"
 #endif
 #include "io/formats/case_file.hpp"
+#include "io/formats/paths.hpp"
 #include "plant/ode_solver.hpp"
 #include "vrelab_version.hpp"
 
@@ -31,6 +33,15 @@ namespace {
 
 using namespace vrelab::app;
 using namespace vrelab::io;
+
+// An option naming an output file: a regular file or a new name (io/formats/paths.hpp), refused
+// with exit code 2 before the command starts (a folder, a FIFO, a path too long).
+const CLI::Validator kOutputFile(
+    [](std::string& p) {
+      const std::string why = writable_file_problem(p);
+      return why.empty() ? std::string() : "cannot write " + path_for_message(p) + ": " + why;
+    },
+    "FILE");
 
 // A subcommand and what running it does (its exit code); each add_* registers
 // one command's options on the CLI. `distributed`: the command hands its items to every rank
@@ -48,12 +59,13 @@ Command add_identify(CLI::App& app) {
                                      "Virtual static test on a dividing head; "
                                      "identify the coefficients of model (1)");
   cmd->add_option("case", o.case_path, "Case file (TOML)")->required();
-  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
+  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file")->check(kOutputFile);
   cmd->add_option("--monte-carlo", o.monte_carlo, "Also run N simulated tests for Monte Carlo uncertainty")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--checkpoint", o.checkpoint_path,
                   "With --monte-carlo: keep each block of trials in this file as it ends; a rerun with the "
-                  "same file runs only the missing blocks (docs/mpi.md)");
+                  "same file runs only the missing blocks (docs/mpi.md)")
+      ->check(kOutputFile);
   cmd->add_option("--seed", o.seed, "Override the case's [run] seed");
   cmd->add_flag_callback(
       "--no-work-limit", [&o] { o.work_limit = false; },
@@ -71,7 +83,7 @@ Command add_predict(CLI::App& app) {
   PredictOptions& o = *owned;
   CLI::App* cmd = app.add_subcommand("predict", "Vibration error implied by model (1): eq. (3), corrected");
   cmd->add_option("case", o.case_path, "Case file (TOML)")->required();
-  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
+  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file")->check(kOutputFile);
   cmd->add_flag("--frequency-dependent", o.frequency_dependent,
                 "Also eq. (3) at [vibration] frequency_Hz through the plant's "
                 "dynamics ([plant]; sine only)");
@@ -86,8 +98,8 @@ Command add_shake(CLI::App& app) {
   ShakeOptions& o = *owned;
   CLI::App* cmd = app.add_subcommand("shake", "One run on the virtual shaker: measured vibration error vs eq. (3)");
   cmd->add_option("case", o.case_path, "Case file (TOML)")->required();
-  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
-  cmd->add_option("--series", o.series_path, "Write the sampled record as CSV to this file");
+  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file")->check(kOutputFile);
+  cmd->add_option("--series", o.series_path, "Write the sampled record as CSV to this file")->check(kOutputFile);
   cmd->add_option("--seed", o.seed, "Override the case's [run] seed");
   cmd->add_flag_callback(
       "--no-work-limit", [&o] { o.work_limit = false; },
@@ -117,7 +129,7 @@ Command add_measure(CLI::App& app) {
   cmd->add_option("--blocks", o.blocks, "Blocks for the batch-means uncertainty (default 4)");
   cmd->add_option("--input-rms-g", o.input_rms_g,
                   "The input's rms in g (magnitude over the axes): the VRC, error / rms^2 in ug/g^2, is reported too");
-  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file");
+  cmd->add_option("--json", o.json_path, "Write the result as JSON to this file")->check(kOutputFile);
   return {cmd, [owned] {
             run_measure(*owned, std::cout);
             return 0;
@@ -129,7 +141,7 @@ Command add_sweep(CLI::App& app) {
   SweepOptions& o = *owned;
   CLI::App* cmd = app.add_subcommand("sweep", "A grid of shaker runs on all cores; resumable");
   cmd->add_option("case", o.case_path, "Case file (TOML) with a [sweep] table")->required();
-  cmd->add_option("--out", o.out_path, "Results CSV (resumed if it exists)")->required();
+  cmd->add_option("--out", o.out_path, "Results CSV (resumed if it exists)")->required()->check(kOutputFile);
   cmd->add_flag("--restart", o.restart, "Discard an existing results file");
   cmd->add_option("--threads", o.threads, "Threads (default: the case's, 0 = all cores; under mpirun per rank, 0 = 1)");
   cmd->add_flag_callback(
@@ -189,7 +201,7 @@ Command add_campaign(CLI::App& app) {
                                      "in the lab data format, and its answer key");
   cmd->add_option("case", o.case_path, "Case file (TOML) with [coefficients], [plant] and [campaign]")->required();
   cmd->add_option("--out", o.out_dir, "Campaign folder (docs/data-format.md)")->required();
-  cmd->add_option("--key", o.key_path, "Answer key (JSON; default <out>.key.json); diagnose never reads it");
+  cmd->add_option("--key", o.key_path, "Answer key (JSON; default <out>.key.json); diagnose never reads it")->check(kOutputFile);
   cmd->add_option("--seed", o.seed, "Seed (default: the case's [run] seed)");
   cmd->add_option("--raw-format", o.raw_format,
                   "Raw records (a case with [campaign] raw_series = true) as records/<id>.csv or records/<id>.h5 "
@@ -217,10 +229,11 @@ Command add_diagnose(CLI::App& app) {
       ->required();
   cmd->add_option("--summary", o.summary_path,
                   "Diagnose every campaign given and write one row per campaign to this CSV (resumed if it exists; "
-                  "docs/mpi.md)");
+                  "docs/mpi.md)")
+      ->check(kOutputFile);
   cmd->add_option("--threads", o.threads, "With --summary: threads (0: all cores; under mpirun 1 per rank)");
   cmd->add_flag_callback("--no-progress", [&o] { o.progress = false; }, "With --summary: no progress bar");
-  cmd->add_option("--json", o.json_path, "Write the diagnosis as JSON");
+  cmd->add_option("--json", o.json_path, "Write the diagnosis as JSON")->check(kOutputFile);
   cmd->add_option("--report", o.report_dir, "Write report.md, report.html and diagnosis.json to this folder");
   cmd->add_flag("--check", o.check,
                 "Read and check the folder only (every file, run and setting; exit 2 naming what is bad); no diagnosis");
@@ -318,6 +331,10 @@ int run_command(const std::vector<Command>& commands, bool root, bool* raised) {
     // The library rejects parameters it cannot work with (e.g. an unstable loop
     // design): input that passed the case reader's checks but not the physics.
     report("error: ", e.what());
+    return 2;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A path the system refuses (a reader's or writer's check above it missed it): the user's.
+    report("error: ", (path_for_message(e.path1().string()) + ": " + e.code().message()).c_str());
     return 2;
   } catch (const std::exception& e) {
     report("internal error: ", e.what());

@@ -4,7 +4,8 @@
 # Prints each target's executions per second and total executions; exits 1 on a finding (its
 # input is in BUILD/fuzz-findings/: keep it in fuzz/regressions/<target>/ with the fix).
 # The targets run side by side, as many at a time as there are cores (FUZZ_JOBS to change it),
-# each for SECONDS of wall time on a core of its own.
+# each for SECONDS of wall time on a core of its own: the stage's wall time is about
+# SECONDS x ceil(6 / FUZZ_JOBS) (CI: 13 s x 3 rounds on 2 cores, ~40 s).
 # Usage: fuzz/run.sh BUILD_DIR [SECONDS]   (BUILD_DIR configured with -DVRELAB_FUZZ=ON)
 set -u
 build=$1
@@ -14,7 +15,7 @@ if ! [[ "$jobs" =~ ^[1-9][0-9]*$ ]]; then echo "fuzz/run.sh: FUZZ_JOBS must be a
 src=$(cd "$(dirname "$0")/.." && pwd)
 findings="$build/fuzz-findings"
 mkdir -p "$findings"
-targets=(case_file lab_data series)
+targets=(case_file lab_data series psd_table raw_csv raw_hdf5)
 fuzz_one() {  # target: runs it, its exit code into $build/fuzz-$t.rc
   local t=$1 work="$build/fuzz-corpus/$1"  # grows as the fuzzer finds new coverage; kept between runs
   mkdir -p "$work"

@@ -12,6 +12,7 @@
 // be stopped with Ctrl-C (interruptible below: the library's cancel flag, core/cancel.hpp).
 #include <Python.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -38,6 +39,8 @@
 #include "io/services/diagnosis.hpp"
 #include "io/services/diagnosis_json.hpp"
 #include "io/formats/output.hpp"
+#include "io/formats/paths.hpp"
+#include "io/formats/ranges.hpp"
 #include "io/services/reproduce_report.hpp"
 #include "io/services/reproduce_run.hpp"
 #include "io/services/results_json.hpp"
@@ -83,58 +86,92 @@ py::object to_py(const nlohmann::json& j) {
 
 // ---------------------------------------------------------------- dict -> TOML -> Case
 
-toml::array to_toml_array(const py::handle& seq, const std::string& where);
+// A case dict's conversion to TOML: iterative in spirit, bounded in fact. A case is tables of
+// values two or three levels deep; the conversion recurses once per level and stops at
+// kMaxCaseDepth, and a dict or list that holds itself (on the way from the top) is named, so
+// neither a self-containing dict nor one nested 100 000 deep can exhaust the C++ stack.
+constexpr int kMaxCaseDepth = 32;
+
+struct Nesting {
+  std::string argument;              // the argument converted, for messages ("Case.from_dict(d)")
+  std::vector<const PyObject*> open;  // the containers on the way from the top
+};
+
+std::string place(const std::string& where) { return where.empty() ? "the top level" : where; }
+
+// Enters container `v` at `where`: refuses a container already on the way (it holds itself)
+// and a depth beyond kMaxCaseDepth.
+void enter(Nesting& n, const py::handle& v, const std::string& where) {
+  if (std::find(n.open.begin(), n.open.end(), v.ptr()) != n.open.end())
+    throw io::InputError(n.argument + ": " + place(where) + " holds a dict or list that contains itself; a case is a tree of tables");
+  if (static_cast<int>(n.open.size()) >= kMaxCaseDepth)
+    throw io::InputError(n.argument + ": " + place(where) + " nests deeper than " + std::to_string(kMaxCaseDepth) +
+                         " levels; a case is tables of values, two or three levels deep");
+  n.open.push_back(v.ptr());
+}
+
+toml::array to_toml_array(const py::handle& seq, const std::string& where, Nesting& n);
 
 // One value of a case dict as TOML (bool, int, float, str, list/tuple/array, dict).
 template <class Insert>
-void put_toml(const py::handle& v, const std::string& where, Insert&& insert);
+void put_toml(const py::handle& v, const std::string& where, Nesting& n, Insert&& insert);
 
-toml::table to_toml_table(const py::dict& d, const std::string& where) {
+toml::table to_toml_table(const py::dict& d, const std::string& where, Nesting& n) {
+  enter(n, d, where);
   toml::table t;
   for (const auto& [k, v] : d) {
-    if (!py::isinstance<py::str>(k)) throw io::InputError(where + ": keys must be strings");
+    if (!py::isinstance<py::str>(k)) throw io::InputError(n.argument + ": " + place(where) + ": keys must be strings");
     const std::string key = k.cast<std::string>();
     const std::string at = where.empty() ? key : where + "." + key;
-    put_toml(v, at, [&](auto&& node) { t.insert_or_assign(key, std::forward<decltype(node)>(node)); });
+    put_toml(v, at, n, [&](auto&& node) { t.insert_or_assign(key, std::forward<decltype(node)>(node)); });
   }
+  n.open.pop_back();
   return t;
 }
 
 template <class Insert>
-void put_toml(const py::handle& v, const std::string& where, Insert&& insert) {
+void put_toml(const py::handle& v, const std::string& where, Nesting& n, Insert&& insert) {
   if (py::isinstance<py::bool_>(v)) return insert(v.cast<bool>());
   if (py::isinstance<py::int_>(v)) {
     int overflow = 0;
     const long long i = PyLong_AsLongLongAndOverflow(v.ptr(), &overflow);
-    if (overflow != 0) throw io::InputError(where + ": the integer does not fit in 64 bits (TOML's range)");
+    if (overflow != 0) throw io::InputError(n.argument + ": " + place(where) + ": the integer does not fit in 64 bits (TOML's range)");
     return insert(static_cast<std::int64_t>(i));
   }
   if (py::isinstance<py::float_>(v)) return insert(v.cast<double>());
   if (py::isinstance<py::str>(v)) return insert(v.cast<std::string>());
-  if (py::isinstance<py::dict>(v)) return insert(to_toml_table(v.cast<py::dict>(), where));
-  if (py::hasattr(v, "tolist")) {  // NumPy arrays and scalars
+  if (py::isinstance<py::dict>(v)) return insert(to_toml_table(v.cast<py::dict>(), where, n));
+  if (py::hasattr(v, "tolist")) {  // NumPy arrays and scalars (a level of its own: tolist() may return anything)
+    enter(n, v, where);
     const py::object plain = v.attr("tolist")();
-    return put_toml(plain, where, std::forward<Insert>(insert));
+    put_toml(plain, where, n, std::forward<Insert>(insert));
+    n.open.pop_back();
+    return;
   }
-  if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) return insert(to_toml_array(v, where));
-  throw io::InputError(where + ": cannot be written as TOML (a " + std::string(py::str(v.get_type().attr("__name__"))) + ")");
+  if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) return insert(to_toml_array(v, where, n));
+  throw io::InputError(n.argument + ": " + place(where) + ": cannot be written as TOML (a " +
+                       std::string(py::str(v.get_type().attr("__name__"))) + ")");
 }
 
-toml::array to_toml_array(const py::handle& seq, const std::string& where) {
+toml::array to_toml_array(const py::handle& seq, const std::string& where, Nesting& n) {
+  enter(n, seq, where);
   toml::array a;
   for (const auto& e : seq) {
     if (py::isinstance<py::dict>(e)) {
-      a.push_back(to_toml_table(e.cast<py::dict>(), where));  // an array of tables
+      a.push_back(to_toml_table(e.cast<py::dict>(), where, n));  // an array of tables
       continue;
     }
-    put_toml(e, where, [&](auto&& node) { a.push_back(std::forward<decltype(node)>(node)); });
+    put_toml(e, where, n, [&](auto&& node) { a.push_back(std::forward<decltype(node)>(node)); });
   }
+  n.open.pop_back();
   return a;
 }
 
-std::string case_toml(const py::dict& d) {
+// `argument`: how messages name the dict ("Case.from_dict(d)").
+std::string case_toml(const py::dict& d, const std::string& argument) {
+  Nesting n{argument, {}};
   std::ostringstream s;
-  s << to_toml_table(d, "") << "\n";
+  s << to_toml_table(d, "", n) << "\n";
   return s.str();
 }
 
@@ -375,8 +412,17 @@ PYBIND11_MODULE(_core, m) {
       PyErr_SetObject(solver_error.ptr(), err.ptr());
     } catch (const std::invalid_argument& e) {  // parameters the physics rejects: exit code 2 in the CLI too
       PyErr_SetString(input_error.ptr(), e.what());
+    } catch (const std::filesystem::filesystem_error& e) {  // a path the system refuses: the caller's, as in the CLI
+      PyErr_SetString(input_error.ptr(), (io::path_for_message(e.path1().string()) + ": " + e.code().message()).c_str());
     }
   });
+  // The size limits of lab data (io/formats/ranges.hpp): diagnose_data checks its columns against them before
+  // writing them out.
+  py::dict limits;
+  limits["static_readings"] = io::kMaxStaticReadings;
+  limits["runs"] = io::kMaxRuns;
+  limits["psd_rows"] = io::kMaxPsdRows;
+  m.attr("limits") = limits;
 
   // ------------------------------------------------------------ Case
   py::class_<io::Case>(m, "Case",
@@ -385,7 +431,7 @@ PYBIND11_MODULE(_core, m) {
       .def_static("from_file", &io::read_case, py::arg("path"),
                   "Reads a case file (TOML). Bad input raises vrelab.InputError naming the file, the line and the key.")
       .def_static(
-          "from_dict", [](const py::dict& d, const std::string& name) { return case_from_toml(case_toml(d), name); },
+          "from_dict", [](const py::dict& d, const std::string& name) { return case_from_toml(case_toml(d, "Case.from_dict(d)"), name); },
           py::arg("d"), py::arg("name") = "<dict>",
           "Builds a case from a dict of tables ({'coefficients': {'K1': 1.25, ...}, 'vibration': {...}}): the dict is "
           "written as TOML (vrelab.case_toml(d)) and read by the same reader as a file, so the checks and messages are "
@@ -403,7 +449,10 @@ PYBIND11_MODULE(_core, m) {
                              "The case as read (the parsed TOML as a dict), as recorded in every result.")
       .def("__repr__", [](const io::Case& c) { return "<vrelab.Case " + c.path + ">"; });
 
-  m.def("case_toml", &case_toml, py::arg("d"), "The TOML text a case dict is read from (Case.from_dict).");
+  m.def(
+      "case_toml", [](const py::dict& d) { return case_toml(d, "case_toml(d)"); }, py::arg("d"),
+      "The TOML text a case dict is read from (Case.from_dict). A dict that contains itself or nests deeper than 32 "
+      "levels raises vrelab.InputError naming where.");
 
   // ------------------------------------------------------------ identify
   py::class_<IdentifyResult>(m, "IdentifyResult", "The static test on the dividing head and the three identifications.")

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
-#include <filesystem>
 #include <numbers>
 #include <set>
 #include <span>
@@ -15,6 +14,7 @@
 #include <toml++/toml.h>
 
 #include "io/formats/case_file_internal.hpp"
+#include "io/formats/paths.hpp"
 #include "plant/physical.hpp"
 
 namespace vrelab::io::internal {
@@ -345,10 +345,7 @@ namespace vrelab::io {
 
 Case read_case(const std::string& path) {
   using namespace internal;  // Table and the tables' readers (case_file_internal.hpp)
-  if (std::filesystem::is_directory(path))
-    throw FormatError({.file = path}, "cannot open the case file: is a directory (give the .toml file)");
-  if (!std::filesystem::exists(path)) throw FormatError({.file = path}, "cannot open the case file (no such file)");
-  if (!std::filesystem::is_regular_file(path)) throw FormatError({.file = path}, "cannot open the case file: not a regular file");
+  require_readable_file(path, "the case file");
   toml::table root;
   try {
     root = toml::parse_file(path);

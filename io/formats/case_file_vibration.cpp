@@ -7,6 +7,8 @@
 #include <toml++/toml.h>
 
 #include "io/formats/case_file_internal.hpp"
+#include "io/formats/ranges.hpp"
+#include "vibration/psd.hpp"
 
 // The [vibration] and [shaker] tables of a case file (docs/case-files.md).
 namespace vrelab::io::internal {
@@ -55,6 +57,15 @@ vibration::PsdTable read_psd(Table& t, std::string_view key, const toml::node* n
   } catch (const std::invalid_argument& e) {
     t.fail(n, key, e.what());
   }
+  // The lab data's physical ranges (io/formats/ranges.hpp), on the levels as resolved from slopes.
+  const vibration::ResolvedPsd r = vibration::resolve(table);
+  for (std::size_t k = 0; k < r.frequency_Hz.size(); ++k) {
+    std::string out = range_problem(kFrequencyRange, r.frequency_Hz[k]);
+    if (out.empty()) out = range_problem(kPsdLevelRange, r.psd_g2_per_Hz[k]);
+    if (!out.empty()) t.fail(a->get(k), std::string(key) + " row " + std::to_string(k + 1), out);
+  }
+  if (const double rms = vibration::rms_g(table); !(rms <= kPsdMaxRms_g))
+    t.fail(n, key, fmt::format("the table's rms is {:g} g, over the {:g} g a shaker's motion stays within", rms, kPsdMaxRms_g));
   return table;
 }
 

@@ -5,11 +5,14 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <map>
 #include <stdexcept>
 
 #include <fmt/format.h>
 
 #include "io/formats/error.hpp"
+#include "io/formats/paths.hpp"
+#include "io/formats/ranges.hpp"
 
 namespace vrelab::io {
 
@@ -137,6 +140,14 @@ void check_separator(const std::string& header_line, long line_no, const std::st
                                     name));
 }
 
+void check_header_names(const std::vector<std::string>& header, const std::string& path, long line_no) {
+  std::map<std::string_view, std::size_t> seen;  // name -> its first column (0-based)
+  for (std::size_t i = 0; i < header.size(); ++i)
+    if (const auto [it, fresh] = seen.emplace(header[i], i); !fresh)
+      throw FormatError({.file = path, .line = line_no, .column = static_cast<long>(i + 1), .key = header[i]},
+                        fmt::format("column '{}' appears twice in the header (columns {} and {})", header[i], it->second + 1, i + 1));
+}
+
 std::string closest_name(const std::string& name, const std::vector<std::string>& names) {
   const auto lower = [](std::string x) {
     for (char& ch : x) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
@@ -206,8 +217,9 @@ std::string read_series_csv(const std::string& path, const std::string& column_n
 
 std::string read_series_csv(const std::string& path, const std::string& column_name,
                             const std::function<void(double, double)>& sample, const ReferenceSink& reference) {
+  require_readable_file(path, "the series");
   std::ifstream in(path);
-  if (!in) throw FormatError({.file = path}, "cannot open the series (no such file?)");
+  if (!in) throw FormatError({.file = path}, "cannot open the series");
   return read_series_csv(in, path, column_name, sample, reference);
 }
 
@@ -230,6 +242,7 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
     const std::vector<std::string> f = split_csv_line(line, path, line_no);
     if (header.empty()) {
       check_separator(line, line_no, path);
+      check_header_names(f, path, line_no);
       header = f;
       column = static_cast<std::size_t>(series_column(header, column_name, where));
       name = header[column];
@@ -258,6 +271,10 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
         throw FormatError(where, fmt::format("not a number in '{}' (column {}, '{}': {})", line, col + 1, f[col], why));
       }
       value[k] = *x;
+      if (const std::string out = range_problem(k == 0 ? kTimeRange : kOutputRange, *x); !out.empty())
+        throw FormatError({.file = path, .line = line_no, .column = static_cast<long>(col + 1), .key = header[col],
+                           .kind = KeyKind::csv_column},
+                          out);
     }
     // The reader's own check (read_series_hdf5 makes the same): time strictly increasing.
     if (!(value[0] > last_t))
@@ -281,6 +298,10 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
                                         f[ref_col[i]].empty() ? std::string("missing value")
                                                               : "'" + f[ref_col[i]] + "' is " + why_not_decimal(f[ref_col[i]])));
         ref[i] = *x;
+        if (const std::string out = range_problem(kReferenceRange, *x); !out.empty())
+          throw FormatError({.file = path, .line = line_no, .column = static_cast<long>(ref_col[i] + 1), .key = header[ref_col[i]],
+                             .kind = KeyKind::csv_column},
+                            out);
       }
       try {
         reference(value[0], ref, ref_present);

@@ -42,6 +42,10 @@ void check_text_line(std::string& line, long line_no, const std::string& path);
 // naming the separator: vrelab reads ',' only (a ';' file usually has decimal commas too).
 void check_separator(const std::string& header_line, long line_no, const std::string& path);
 
+// A header naming a column twice (or an empty name twice) is FormatError at
+// "<path>:<line>:<column>" naming the column: which of the two a reader took would be a guess.
+void check_header_names(const std::vector<std::string>& header, const std::string& path, long line_no);
+
 // The name in `names` closest to `name` (case-insensitive equality first, then edit
 // distance at most 3), or "" when none is close.
 std::string closest_name(const std::string& name, const std::vector<std::string>& names);
@@ -49,7 +53,8 @@ std::string closest_name(const std::string& name, const std::vector<std::string>
 // A recorded output series: a header naming the columns, time (s) in the column time_s, else
 // the first column. Streams (t, value of `column`) to `sample` row by row (`column` empty:
 // the one column named output_<unit>, else the last column) and returns the column's name. Anything wrong (no file, no header, a
-// field count, not a number, time not strictly increasing, `sample` rejecting a row with
+// column named twice, a field count, not a number, a sample outside its range (io/formats/ranges.hpp:
+// time, output, reference), time not strictly increasing, `sample` rejecting a row with
 // std::invalid_argument) is FormatError (io/formats/error.hpp) at the file and the line. read_series
 // (io/formats/series.hpp) chooses this reader or the HDF5 one by the file's extension.
 std::string read_series_csv(const std::string& path, const std::string& column,

@@ -17,6 +17,8 @@
 #include "io/formats/case_file.hpp"
 #include "io/formats/csv.hpp"
 #include "io/formats/output.hpp"
+#include "io/formats/paths.hpp"
+#include "io/formats/ranges.hpp"
 #include "io/formats/raw_hdf5.hpp"
 #include "io/formats/series.hpp"
 #include "io/formats/settings_toml.hpp"
@@ -41,10 +43,16 @@ struct Csv {
   bool has(const std::string& c) const { return column.count(c) > 0; }
 };
 
-Csv read_csv(const std::string& path) {
-  if (fs::is_directory(path)) throw FormatError({.file = path}, "is a folder, not a CSV file");
+// `what` names the file in messages ("the runs table"); more than `max_rows` rows is refused
+// at the first row past it (`rows_what`, `rows_why`: what the rows are and why they are bounded).
+struct CsvLimit {
+  std::size_t max_rows;
+  std::string rows_what, rows_why;
+};
+Csv read_csv(const std::string& path, const std::string& what, const CsvLimit& limit) {
+  require_readable_file(path, what);
   std::ifstream in(path);
-  if (!in) throw FormatError({.file = path}, "cannot open (no such file)");
+  if (!in) throw FormatError({.file = path}, fmt::format("cannot open {}", what));
   Csv csv;
   csv.path = path;
   std::string line;
@@ -57,12 +65,8 @@ Csv read_csv(const std::string& path) {
     std::vector<std::string> cells = split_csv_line(line, path, n);
     if (!header) {
       check_separator(line, n, path);
-      for (std::size_t i = 0; i < cells.size(); ++i) {
-        if (csv.column.count(cells[i]))
-          throw FormatError({.file = path, .line = n, .column = static_cast<long>(i + 1), .key = cells[i]},
-                            fmt::format("column '{}' appears twice in the header", cells[i]));
-        csv.column[cells[i]] = i;
-      }
+      check_header_names(cells, path, n);
+      for (std::size_t i = 0; i < cells.size(); ++i) csv.column[cells[i]] = i;
       csv.names = cells;
       header = true;
       continue;
@@ -71,6 +75,8 @@ Csv read_csv(const std::string& path) {
       throw FormatError({.file = path, .line = n, .column = static_cast<long>(csv.names.size() + 1)},
                         fmt::format("{} cells, the header has {} (a ',' inside a cell? quote the cell)", cells.size(),
                                     csv.names.size()));
+    if (csv.rows.size() == limit.max_rows)
+      throw FormatError({.file = path, .line = n}, rows_problem(limit.max_rows, limit.rows_what, limit.rows_why));
     csv.rows.emplace_back(n, std::move(cells));
   }
   if (!header) throw FormatError({.file = path}, "no header line");
@@ -123,9 +129,11 @@ void require_columns(const Csv& csv, const std::vector<std::string>& cols, const
 
 // A random run's PSD file (docs/data-format.md): frequency_Hz and psd_<axis>_g2_per_Hz for
 // the axes that move (a missing column: that axis at rest); breakpoints, straight lines on
-// log-log axes between them. Bad content throws FormatError at the file, line and column.
-vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling) {
-  const Csv csv = read_csv(path);
+// log-log axes between them, each frequency and level within its physical range and each
+// table's rms at most kPsdMaxRms_g. Bad content throws FormatError at the file, line and column.
+vibration::RandomProfile psd_file(const std::string& path, const std::string& coupling) {
+  const Csv csv = read_csv(path, "the PSD file",
+                           {kMaxPsdRows, "rows of a PSD table", "the breakpoints of a PSD table are read in full"});
   require_columns(csv, {"frequency_Hz"});
   static const std::array<std::string, 3> cols{"psd_IA_g2_per_Hz", "psd_PA_g2_per_Hz", "psd_OA_g2_per_Hz"};
   vibration::RandomProfile p;
@@ -144,8 +152,10 @@ vibration::RandomProfile read_psd_file(const std::string& path, const std::strin
       };
       if (!(*f > 0) || (!t.rows.empty() && !(*f > t.rows.back().frequency_Hz)))
         throw FormatError(cell("frequency_Hz"), fmt::format("{:g} must be positive and above the previous row's", *f));
+      if (const std::string out = range_problem(kFrequencyRange, *f); !out.empty()) throw FormatError(cell("frequency_Hz"), out);
       if (!(*g > 0))
         throw FormatError(cell(cols[i]), fmt::format("{:g} must be positive (an axis at rest: leave its column out)", *g));
+      if (const std::string out = range_problem(kPsdLevelRange, *g); !out.empty()) throw FormatError(cell(cols[i]), out);
       t.rows.push_back(vibration::PsdRow::level(*f, *g));
     }
     try {
@@ -153,13 +163,17 @@ vibration::RandomProfile read_psd_file(const std::string& path, const std::strin
     } catch (const std::invalid_argument& e) {
       throw FormatError({.file = path, .key = cols[i], .kind = KeyKind::csv_column}, e.what());
     }
+    if (const double rms = vibration::rms_g(t); !(rms <= kPsdMaxRms_g))
+      throw FormatError({.file = path, .key = cols[i], .kind = KeyKind::csv_column},
+                        fmt::format("the table's rms is {:g} g, over the {:g} g a shaker's motion stays within "
+                                    "(docs/data-format.md, Ranges and limits)",
+                                    rms, kPsdMaxRms_g));
     p.psd[i] = t;
   }
   if (!any)
     throw FormatError({.file = path}, "the header needs at least one of psd_IA_g2_per_Hz, psd_PA_g2_per_Hz, psd_OA_g2_per_Hz");
   return p;
 }
-
 
 // The output column of a file must carry the manifest's unit: output_<unit>, sigma_<unit>.
 void require_unit(const Csv& csv, const std::string& prefix, const std::string& unit) {
@@ -292,7 +306,7 @@ rectification::MeasuredMotion measured_motion(const validation::RunRecord& r, co
 
 // The manifest parsed, its top-level tables checked and the keys every campaign states there.
 toml::table parse_manifest(const std::string& mpath) {
-  if (!fs::is_regular_file(mpath)) throw FormatError({.file = mpath}, "cannot open the manifest (no such file)");
+  require_readable_file(mpath, "the manifest");
   toml::table root;
   try {
     root = toml::parse_file(mpath);
@@ -399,7 +413,9 @@ ManifestFiles read_manifest_files(const toml::table& root, const std::string& mp
 
 // The static readings: every row must be usable (the identification needs them all).
 void read_static_readings(const std::string& path, const std::string& unit, validation::Campaign& c) {
-  const Csv st = read_csv(path);
+  const Csv st = read_csv(path, "the static readings",
+                           {kMaxStaticReadings, "static readings",
+                            "the identification's work grows with them; average repeated readings of a position (count)"});
   require_unit(st, "output_", unit);
   require_unit(st, "sigma_", unit);
   const bool by_vector = st.has("a_IA_g");
@@ -436,6 +452,8 @@ void read_static_readings(const std::string& path, const std::string& unit, vali
                         fmt::format("{} is not a whole number of readings", row.second[st.column.at("count")]));
     if (!(sigma > 0)) throw FormatError(cell("sigma_" + unit), "must be positive");
     if (!(count >= 1)) throw FormatError(cell("count"), "must be at least 1");
+    if (const std::string out = range_problem(kOutputRange, r.output); !out.empty()) throw FormatError(cell("output_" + unit), out);
+    if (const std::string out = range_problem(kOutputSigmaRange, sigma); !out.empty()) throw FormatError(cell("sigma_" + unit), out);
     r.sigma_output = sigma / std::sqrt(count);
     r.where = fmt::format("{}:{}", st.path, row.first);
     c.statics.push_back(r);
@@ -465,7 +483,8 @@ struct RunsTable {
 };
 RunsTable read_runs_table(const std::string& path, const validation::Campaign& c) {
   RunsTable t;
-  t.csv = read_csv(path);
+  t.csv = read_csv(path, "the runs table",
+                   {kMaxRuns, "shaker runs", "the diagnosis' work grows as the cube of the runs (a runs x runs covariance)"});
   const Csv& rn = t.csv;
   require_columns(rn, {"id", "frequency_Hz", "amplitude_g", "d_IA", "d_PA", "d_OA", "a_IA_g", "a_PA_g", "a_OA_g"});
   t.summaries = rn.has("measured_ug"), t.series = rn.has("series");
@@ -512,7 +531,7 @@ std::optional<std::string> read_run_kind(const RunRow& rr, const std::string& di
       return fmt::format("{}:{}: column psd: a {} run needs its PSD file", rr.csv.path, rr.row.first,
                          rectification::to_string(*kind));
     try {
-      r.random = read_psd_file((fs::path(dir) / rr.cell("psd")).string(), coupling);
+      r.random = psd_file((fs::path(dir) / rr.cell("psd")).string(), coupling);
     } catch (const FormatError& e) {
       return rr.label + ": " + e.what();
     }
@@ -545,6 +564,8 @@ std::optional<std::string> read_run_motion(RunRow& rr, VibrationKind kind, valid
     const Vec3 d(*d0, *d1, *d2);
     if (!(*f > 0) || !(*a > 0) || !(d.norm() > 0))
       return rr.label + ": frequency, amplitude and direction must be positive / non-zero";
+    if (const std::string out = range_problem(kFrequencyRange, *f); !out.empty()) return rr.label + ": column frequency_Hz: " + out;
+    if (const std::string out = range_problem(kAmplitudeRange, *a); !out.empty()) return rr.label + ": column amplitude_g: " + out;
     r.frequency_Hz = *f, r.amplitude_g = *a, r.direction = d.normalized(), r.orientation_g = Vec3(*o0, *o1, *o2);
   }
   return std::nullopt;
@@ -651,6 +672,8 @@ std::optional<std::string> read_run_summary(RunRow& rr, const RunsTable& runs, v
   const auto mu = rr.get("measured_ug"), su = rr.get("sigma_ug");
   if (!mu || !su) return rr.missing();
   if (!(*su > 0)) return rr.label + ": sigma_ug must be positive";
+  if (const std::string out = range_problem(kErrorRange, *mu); !out.empty()) return rr.label + ": column measured_ug: " + out;
+  if (const std::string out = range_problem(kSigmaUgRange, *su); !out.empty()) return rr.label + ": column sigma_ug: " + out;
   r.measured_g = *mu * 1e-6, r.sigma_g = *su * 1e-6;
   return std::nullopt;
 }
@@ -708,6 +731,8 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
   if (manifest_out) *manifest_out = m;
   return c;
 }
+
+vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling) { return psd_file(path, coupling); }
 
 void write_campaign(const std::string& dir, const validation::Campaign& c, const LabManifest& m,
                     const std::vector<RawSeriesRef>& raw_series, RawFormat raw_format) {

@@ -22,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "validation/diagnosis/diagnose.hpp"
+#include "vibration/random.hpp"
 
 namespace vrelab::io {
 
@@ -36,6 +37,11 @@ struct LabManifest {
 };
 
 validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest = nullptr);
+
+// A random run's PSD file as read_campaign reads the file a run's `psd` cell names
+// (docs/data-format.md, "Random runs"); `coupling`: "common" or "independent". Bad content
+// (a frequency or level outside its range among it) throws FormatError at the file, line and column.
+vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling = "common");
 
 // Writes manifest.toml, static.csv and runs.csv (summaries). `raw_series`, when non-empty,
 // gives per run a recorded series already written under DIR (file name, rest and on

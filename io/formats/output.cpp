@@ -1,5 +1,6 @@
 #include "io/formats/output.hpp"
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <numbers>
@@ -12,6 +13,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include "io/formats/paths.hpp"
 #include "vrelab_version.hpp"
 
 namespace vrelab::io {
@@ -30,6 +32,7 @@ bool sync_fd(int fd) { return ::fsync(fd) == 0 || errno == EINVAL; }
 // new name itself survives a crash).
 void write_atomic(const std::string& path, const std::string& text) {
   namespace fs = std::filesystem;
+  require_writable_file(path, "the result");
   const fs::path target(path);
   std::error_code dir_error;
   if (target.has_parent_path()) fs::create_directories(target.parent_path(), dir_error);
@@ -50,7 +53,7 @@ void write_atomic(const std::string& path, const std::string& text) {
   ok = (::close(fd) == 0) && ok;
   if (!ok) {
     fs::remove(tmp, dir_error);
-    throw std::runtime_error("writing " + tmp.string() + " failed" + (why.empty() ? "" : ": " + why));
+    throw FormatError("cannot write " + tmp.string() + (why.empty() ? "" : ": " + why));
   }
   std::error_code ec;
   fs::rename(tmp, target, ec);
@@ -68,6 +71,34 @@ void write_atomic(const std::string& path, const std::string& text) {
 
 std::string json_text(const nlohmann::json& j) {
   return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
+
+namespace {
+std::string non_finite_at(const nlohmann::json& j, const std::string& at, double* value) {
+  if (j.is_number_float() && !std::isfinite(j.get<double>())) {
+    *value = j.get<double>();
+    return at.empty() ? "/" : at;
+  }
+  if (j.is_object())
+    for (auto it = j.begin(); it != j.end(); ++it)
+      if (std::string p = non_finite_at(it.value(), at + "/" + it.key(), value); !p.empty()) return p;
+  if (j.is_array())
+    for (std::size_t i = 0; i < j.size(); ++i)
+      if (std::string p = non_finite_at(j[i], at + "/" + std::to_string(i), value); !p.empty()) return p;
+  return "";
+}
+}  // namespace
+
+std::string first_non_finite(const nlohmann::json& j) {
+  double value = 0;
+  return non_finite_at(j, "", &value);
+}
+
+void require_finite(const nlohmann::json& j, const std::string& source, const std::string& why) {
+  double value = 0;
+  if (const std::string p = non_finite_at(j, "", &value); !p.empty())
+    throw FormatError({.file = path_for_message(source)},
+                      "the result " + p + " is not a finite number (" + (std::isnan(value) ? "nan" : "inf") + "): " + why);
 }
 
 nlohmann::json program_record() {

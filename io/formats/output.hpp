@@ -20,6 +20,13 @@ void write_atomic(const std::string& path, const std::string& text);
 // after the computation (nlohmann's error_handler_t::replace).
 std::string json_text(const nlohmann::json& j);
 
+// The JSON path of the first number of `j` that is not finite ("/runs/3/z"), or "" when all
+// are: a result's numbers are checked before it is printed or written.
+std::string first_non_finite(const nlohmann::json& j);
+// FormatError "<source>: the result <path> is not a finite number (nan): <why>" when `j` holds
+// one (exit code 2: a value of the input drove the computation out of range).
+void require_finite(const nlohmann::json& j, const std::string& source, const std::string& why);
+
 // {"name", "version", "git"}: the program that made a result.
 nlohmann::json program_record();
 // {"file", "content"}: the case a result was made from.

@@ -17,6 +17,8 @@
 #include <hdf5.h>
 
 #include "io/formats/error.hpp"
+#include "io/formats/paths.hpp"
+#include "io/formats/ranges.hpp"
 
 namespace vrelab::io {
 
@@ -196,8 +198,7 @@ bool is_hdf5_path(const std::string& path) {
 std::string read_series_hdf5(const std::string& path, const std::string& column,
                              const std::function<void(double, double)>& sample, const ReferenceSink& reference) {
   silence_hdf5();
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) throw FormatError({.file = path}, "cannot open the series (no such file?)");
+  require_readable_file(path, "the series");
   if (H5Fis_hdf5(path.c_str()) <= 0)
     throw FormatError({.file = path},
                       "not an HDF5 file (a name ending in .h5 or .hdf5 is read as HDF5; a CSV record must end in .csv)");
@@ -256,10 +257,13 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
     for (hsize_t j = 0; j < m; ++j) {
       const hsize_t at = from + j;
       const double t = ch[0].block[j], u = ch[1].block[j];
-      for (std::size_t k = 0; k < 2; ++k)
+      for (std::size_t k = 0; k < 2; ++k) {
         if (!std::isfinite(ch[k].block[j]))
           throw FormatError(dataset(path, ch[k].name, static_cast<long long>(at)),
                             fmt::format("a sample is not a finite number ({})", ch[k].block[j]));
+        if (const std::string out = range_problem(k == 0 ? kTimeRange : kOutputRange, ch[k].block[j]); !out.empty())
+          throw FormatError(dataset(path, ch[k].name, static_cast<long long>(at)), out);
+      }
       if (!(t > last_t))
         throw FormatError(dataset(path, "time_s", static_cast<long long>(at)),
                           fmt::format("time does not increase ({} s after {} s)", t, last_t));
@@ -278,6 +282,8 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
           if (!std::isfinite(c.block[j]))
             throw FormatError(dataset(path, c.name, static_cast<long long>(at)),
                               fmt::format("a sample is not a finite number ({})", c.block[j]));
+          if (const std::string out = range_problem(kReferenceRange, c.block[j]); !out.empty())
+            throw FormatError(dataset(path, c.name, static_cast<long long>(at)), out);
           g[i] = c.block[j];
         }
         try {
@@ -321,6 +327,7 @@ Hdf5SeriesWriter::Hdf5SeriesWriter(const std::string& path, const std::string& o
                                    const std::string& run_id, const std::string& comment)
     : s_(std::make_unique<State>()) {
   silence_hdf5();
+  require_writable_file(path, "the record");
   s_->path = path, s_->tmp = path + ".tmp." + std::to_string(::getpid()), s_->reference = reference;
   const fs::path target(path);
   std::error_code ec;

@@ -14,6 +14,7 @@
 #include "core/dispatch.hpp"
 #include "core/progress.hpp"
 #include "io/formats/output.hpp"
+#include "io/formats/paths.hpp"
 #include "io/services/internal.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 #include "vrelab_version.hpp"
@@ -126,6 +127,7 @@ BatchSummary diagnose_many(const BatchRequest& r, std::ostream& out) {
       kProgramVersion, kGitDescribe, fp, s.ranks, s.threads, kColumns);
   // campaign -> its line; kept from an earlier run of the same program and settings.
   std::map<std::string, std::string> rows;
+  if (writer) require_writable_file(r.summary_path, "the summary (--summary)");
   if (writer && fs::exists(r.summary_path) && !r.restart) {
     std::ifstream in(r.summary_path);
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());

@@ -91,6 +91,8 @@ FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides&
   }
   f.wall_s = internal::seconds_since(start);
   f.diagnosed = true;
+  // Every number the diagnosis prints or writes is finite, or the diagnosis fails naming it.
+  require_finite(to_json(f), dir, "a value of the campaign drives the diagnosis out of range");
   return f;
 }
 

@@ -1,6 +1,7 @@
 #include "io/services/studies.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <ctime>
 #include <cmath>
@@ -22,6 +23,7 @@
 #include "core/progress.hpp"
 #include "io/formats/csv.hpp"
 #include "io/formats/output.hpp"
+#include "io/formats/paths.hpp"
 #include "io/services/internal.hpp"
 #include "io/services/results_json.hpp"
 #include "io/formats/series.hpp"
@@ -340,8 +342,11 @@ class SeriesFile {
  public:
   SeriesFile(const Case& c, const std::string& path) : path_(path) {
     if (path.empty()) return;
+    require_writable_file(path, "the series (--series)");
     const std::filesystem::path target(path);
-    if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
+    std::error_code ec;
+    if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path(), ec);
+    if (ec) throw InputError(fmt::format("{}: cannot create its folder: {}", path_for_message(path), ec.message()));
     tmp_ = path + ".tmp." + std::to_string(::getpid());
     out_.open(tmp_);
     if (!out_) throw InputError("cannot write " + tmp_);
@@ -368,7 +373,9 @@ class SeriesFile {
     if (!out_.is_open()) return;
     out_.close();
     if (!out_) throw InputError("writing " + tmp_ + " failed");
-    std::filesystem::rename(tmp_, path_);
+    std::error_code ec;
+    std::filesystem::rename(tmp_, path_, ec);
+    if (ec) throw InputError(fmt::format("cannot write {}: {}", path_for_message(path_), ec.message()));
   }
 
  private:
@@ -456,6 +463,32 @@ std::string shake_report(const Case& c, const ShakeStudy& s) {
 
 // ---------------------------------------------------------------- measure
 
+namespace {
+
+// The VRC's input rms from reference channels is the motion's magnitude over the axes with a
+// channel: without the input axis IA's the reference does not measure the motion the VRC is of
+// (a record with ref_PA_g alone of a run along IA would give the VRC of the transverse motion).
+void require_input_axis_reference(const MeasureStudy& s) {
+  if (!s.reference || s.windows.input_rms_g > 0 || s.reference_axes[0]) return;
+  static const std::array<const char*, 3> axis{"IA", "PA", "OA"};
+  std::string have, lack;
+  for (std::size_t i = 0; i < 3; ++i) {
+    std::string& list = s.reference_axes[i] ? have : lack;
+    list += (list.empty() ? "" : ", ") + std::string(axis[i]);
+  }
+  throw FormatError({.file = path_for_message(s.path)},
+                    fmt::format("the reference channels cover {} only (none for {}): without the input axis IA's channel "
+                                "they do not measure the motion the VRC is of; give ref_IA_g (or all three channels) or "
+                                "--input-rms-g",
+                                have, lack));
+}
+
+// A number of the motion's departure, "-" where it is not defined (NaN: an axis without a
+// reference channel, a ratio to a fundamental of zero).
+std::string ratio(double x, int digits = 4) { return std::isfinite(x) ? fmt::format("{:.{}g}", x, digits) : std::string("-"); }
+
+}  // namespace
+
 MeasureStudy measure(const std::string& series_path, const std::string& column, const rectification::SeriesWindows& w) {
   if (std::string why; !w.IsValid(&why)) throw InputError("measure: " + why);
   MeasureStudy s;
@@ -513,6 +546,8 @@ MeasureStudy measure(const std::string& series_path, const std::string& column, 
   } catch (const std::invalid_argument& e) {
     throw FormatError({.file = series_path}, e.what());
   }
+  require_input_axis_reference(s);
+  require_finite(measure_json(s), series_path, "the record's samples or the options drive the measurement out of range");
   return s;
 }
 
@@ -537,14 +572,15 @@ std::string measure_report(const MeasureStudy& s) {
     int dom = 0;
     m.measured_rms_axis_g.maxCoeff(&dom);
     if (m.kind == VibrationKind::sine)
-      out += fmt::format("  motion: transverse to {} {:.5g} +/- {:.2g} (per axis [{:.4g}, {:.4g}, {:.4g}]), 2nd harmonic {:.5g} +/- "
-                         "{:.2g}, 3rd harmonic {:.5g} +/- {:.2g} (of the fundamental)\n",
-                         axis[dom], m.transverse_ratio, m.transverse_sigma, m.transverse_axis_ratio[0], m.transverse_axis_ratio[1],
-                         m.transverse_axis_ratio[2], m.harmonic2_ratio, m.harmonic2_sigma, m.harmonic3_ratio, m.harmonic3_sigma);
+      out += fmt::format("  motion: transverse to {} {} +/- {} (per axis [{}, {}, {}]; -: no channel), 2nd harmonic {} +/- "
+                         "{}, 3rd harmonic {} +/- {} (of the fundamental)\n",
+                         axis[dom], ratio(m.transverse_ratio, 5), ratio(m.transverse_sigma, 2), ratio(m.transverse_axis_ratio[0]),
+                         ratio(m.transverse_axis_ratio[1]), ratio(m.transverse_axis_ratio[2]), ratio(m.harmonic2_ratio, 5),
+                         ratio(m.harmonic2_sigma, 2), ratio(m.harmonic3_ratio, 5), ratio(m.harmonic3_sigma, 2));
     else
-      out += fmt::format("  motion: transverse to {} {:.5g} +/- {:.2g} (rms across / along; Welch {:.4g} Hz bins, {} segments, "
+      out += fmt::format("  motion: transverse to {} {} +/- {} (rms across / along; Welch {:.4g} Hz bins, {} segments, "
                          "{:.3g} dof per bin)\n",
-                         axis[dom], m.transverse_ratio, m.transverse_sigma, m.resolution_Hz, m.segments, m.dof);
+                         axis[dom], ratio(m.transverse_ratio, 5), ratio(m.transverse_sigma, 2), m.resolution_Hz, m.segments, m.dof);
   } else if (!s.motion_note.empty()) {
     out += "  motion: not analysed: " + s.motion_note + "\n";
   }
@@ -664,7 +700,10 @@ SweepStudy sweep(const Case& c, const std::string& out_path, bool restart, int t
   // Under mpirun only rank 0 reads and writes the file; the others compute the conditions it
   // hands out (core/dispatch.hpp).
   const bool writer = core::is_root_process();
-  if (writer && path.has_parent_path()) fs::create_directories(path.parent_path());
+  if (writer) require_writable_file(out_path, "the sweep's results (--out)");
+  std::error_code ec;
+  if (writer && path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
+  if (ec) throw InputError(fmt::format("{}: cannot create its folder: {}", path_for_message(out_path), ec.message()));
   std::map<std::size_t, std::string> rows;
   SweepStudy s;
   if (writer && fs::exists(path) && !restart) rows = resumed_rows(out_path, fingerprint, grid.size(), &s.recomputed);

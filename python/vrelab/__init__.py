@@ -35,6 +35,7 @@ from ._core import (  # noqa: F401
     frequency,
     git_describe,
     identify,
+    limits,
     predict,
     predict_total_g,
     reproduce,
@@ -63,7 +64,7 @@ _find_plot_scripts()
 __all__ = [
     "Case", "InputError", "SolverError", "load_case", "case_toml", "identify", "predict", "shake",
     "sweep", "frequency", "campaign", "diagnose", "diagnose_data", "check_campaign", "diagnose_settings",
-    "reproduce", "__version__",
+    "reproduce", "limits", "__version__",
 ]
 
 
@@ -227,6 +228,31 @@ def _write_columns(path, columns):
             f.write(",".join(text(v) for v in row) + "\n")
 
 
+def _rows(argument, columns, limit, what):
+    """The rows of a dict of columns (or a pandas DataFrame) given as `argument`; TypeError for
+    anything else, InputError for columns of different lengths or more rows than `limit` (the
+    reader's size limit, checked before anything is written: docs/data-format.md, "Ranges and
+    limits")."""
+    if not isinstance(columns, dict) and not (hasattr(columns, "columns") and hasattr(columns, "keys")):
+        raise TypeError("diagnose_data(): %s must be a dict of columns (lists or NumPy arrays) or a pandas "
+                        "DataFrame, not %s" % (argument, type(columns).__name__))
+    lengths = {}
+    for k in columns.keys():
+        try:
+            lengths[k] = len(columns[k])
+        except TypeError:
+            raise TypeError("diagnose_data(): %s[%r] must be a column (a list or a NumPy array), not %s"
+                            % (argument, k, type(columns[k]).__name__)) from None
+    if len(set(lengths.values())) > 1:
+        raise InputError("diagnose_data(): %s: the columns differ in length (%s)"
+                         % (argument, ", ".join("%s %d" % (k, n) for k, n in lengths.items())))
+    rows = next(iter(lengths.values()), 0)
+    if rows > limit:
+        raise InputError("diagnose_data(): %s has %d rows, more than the %d %s the diagnosis takes "
+                         "(docs/data-format.md, Ranges and limits)" % (argument, rows, limit, what))
+    return rows
+
+
 def diagnose_data(static, runs, manifest=None, name="<memory>", **settings):
     """diagnose_data(static, runs, manifest=None, name="<memory>", **settings) -> Diagnosis
 
@@ -238,7 +264,17 @@ def diagnose_data(static, runs, manifest=None, name="<memory>", **settings):
     dynamics). They are written in the lab data format to a private temporary folder and read
     by the same reader as a folder, so the checks and messages are the folder's (naming
     `name` for the folder). Settings as for diagnose().
+
+    Raises TypeError when static or runs is not a dict of columns or a DataFrame (or manifest
+    not a dict), vrelab.InputError when their columns differ in length, hold more rows than
+    vrelab.limits allows (checked before anything is written), or the folder's reader refuses them.
     """
+    _rows("static", static, _core.limits["static_readings"], "static readings")
+    _rows("runs", runs, _core.limits["runs"], "shaker runs")
+    if manifest is not None and not isinstance(manifest, dict):
+        raise TypeError("diagnose_data(): manifest must be a dict of tables or None, not %s" % type(manifest).__name__)
+    if not isinstance(name, str):
+        raise TypeError("diagnose_data(): name must be a str, not %s" % type(name).__name__)
     man = manifest if manifest is not None else {"campaign": {"name": name, "format_version": 1},
                                                  "instrument": {"output_unit": "mA"}}
     with tempfile.TemporaryDirectory(prefix="vrelab-campaign-") as d:

@@ -6,6 +6,7 @@
 #include <complex>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace vrelab::rectification {
@@ -60,12 +61,107 @@ vibration::RandomVibration gaussian_of(const Eigen::Matrix3d& c) {
   return v;
 }
 
-Eigen::Matrix3cd cross_spectral_matrix_g2_per_Hz(const vibration::RandomProfile& p, double f) {
+namespace {
+
+// The profile's tables as the quadrature reads them: a table of levels only (a lab's PSD file,
+// a measured PSD of 10^6 rows) in place, a table with slope rows (a case file's, a few rows)
+// resolved. Each frequency then costs a bisection in a table, not a pass over it: the
+// diagnosis evaluates a random run's PSD thousands of times.
+struct PreparedTables {
+  std::array<const vibration::PsdTable*, 3> levels{};
+  std::array<std::optional<vibration::ResolvedPsd>, 3> resolved;
+};
+
+// Up to this many rows a table of levels is checked whole at every call (one pass, no copy);
+// a longer one (read and validated whole by its reader: io::read_psd_file) at its ends here and
+// at each bracket the bisection lands on (level_at), so that a call costs O(log rows).
+constexpr std::size_t kWholeCheckRows = 65536;
+
+bool valid_level_row(const vibration::PsdRow& r) {
+  return r.psd_g2_per_Hz && !r.slope_dB_per_octave && std::isfinite(r.frequency_Hz) && r.frequency_Hz > 0 &&
+         std::isfinite(*r.psd_g2_per_Hz) && *r.psd_g2_per_Hz > 0;
+}
+
+// True when `t` is a table of levels that vibration::validate accepts (a long one: at its ends).
+bool valid_levels(const vibration::PsdTable& t) {
+  const auto& rows = t.rows;
+  if (rows.size() < 2) return false;
+  if (rows.size() > kWholeCheckRows)
+    return valid_level_row(rows.front()) && valid_level_row(rows.back()) && rows.front().frequency_Hz < rows.back().frequency_Hz;
+  double previous = 0;
+  for (const vibration::PsdRow& r : rows) {
+    if (!valid_level_row(r) || !(r.frequency_Hz > previous)) return false;
+    previous = r.frequency_Hz;
+  }
+  return true;
+}
+
+// Validates the profile (vibration::validate's checks and messages) and prepares its tables.
+PreparedTables prepared_tables(const vibration::RandomProfile& p) {
+  PreparedTables r;
+  bool any = false, valid = true;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (!p.psd[i]) continue;
+    any = true;
+    if (valid_levels(*p.psd[i])) {
+      r.levels[i] = &*p.psd[i];
+      continue;
+    }
+    try {
+      r.resolved[i] = vibration::resolve(*p.psd[i]);
+    } catch (const std::invalid_argument&) {
+      valid = false;
+    }
+  }
+  if (!any || !valid || p.measured) vibration::validate(p);  // throws its message (or checks the measured matrix)
+  return r;
+}
+
+// The table's PSD at f, g^2/Hz: vibration::psd_g2_per_Hz's interpolation, on the rows in place.
+// A bracket that is not two level rows in increasing frequency (a long table's flaw the ends
+// did not show) is the table's validation error.
+double level_at(const vibration::PsdTable& t, double f) {
+  const auto& rows = t.rows;
+  if (!(f >= rows.front().frequency_Hz && f <= rows.back().frequency_Hz)) return 0.0;
+  const auto above = std::upper_bound(rows.begin(), rows.end(), f,
+                                      [](double x, const vibration::PsdRow& row) { return x < row.frequency_Hz; });
+  const std::size_t k = std::min(static_cast<std::size_t>(above - rows.begin()), rows.size() - 1) - 1;
+  if (!valid_level_row(rows[k]) || !valid_level_row(rows[k + 1]) || !(rows[k].frequency_Hz < rows[k + 1].frequency_Hz) ||
+      !(rows[k].frequency_Hz <= f && f <= rows[k + 1].frequency_Hz)) {
+    vibration::validate(t);  // throws, naming the row
+    throw std::invalid_argument("PSD table: rows " + std::to_string(k + 1) + " and " + std::to_string(k + 2) + " are not in order");
+  }
+  const double f0 = rows[k].frequency_Hz, p0 = *rows[k].psd_g2_per_Hz, p1 = *rows[k + 1].psd_g2_per_Hz;
+  const double b = std::log(p1 / p0) / std::log(rows[k + 1].frequency_Hz / f0);
+  return p0 * std::pow(f / f0, b);
+}
+
+// The lowest and highest frequency of the tables, and every breakpoint when `all` (else only those two).
+std::vector<double> table_frequencies(const PreparedTables& r, bool all) {
+  std::vector<double> knots;
+  for (std::size_t i = 0; i < 3; ++i) {
+    if (r.levels[i]) {
+      const auto& rows = r.levels[i]->rows;
+      if (all)
+        for (const auto& row : rows) knots.push_back(row.frequency_Hz);
+      else
+        knots.insert(knots.end(), {rows.front().frequency_Hz, rows.back().frequency_Hz});
+    } else if (r.resolved[i]) {
+      const auto& fs = r.resolved[i]->frequency_Hz;
+      if (all) knots.insert(knots.end(), fs.begin(), fs.end());
+      else knots.insert(knots.end(), {fs.front(), fs.back()});
+    }
+  }
+  return knots;
+}
+
+Eigen::Matrix3cd cross_spectral_matrix(const vibration::RandomProfile& p, const PreparedTables& r, double f) {
   if (p.measured) return p.measured->at(f);
   Eigen::Matrix3cd s = Eigen::Matrix3cd::Zero();
   std::array<double, 3> g{};
-  for (int i = 0; i < 3; ++i)
-    if (const auto& t = p.psd[static_cast<std::size_t>(i)]) g[static_cast<std::size_t>(i)] = vibration::psd_g2_per_Hz(*t, f);
+  for (std::size_t i = 0; i < 3; ++i)
+    if (r.levels[i]) g[i] = level_at(*r.levels[i], f);
+    else if (r.resolved[i]) g[i] = vibration::psd_g2_per_Hz(*r.resolved[i], f);
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
       if (i == j) s(i, i) = g[static_cast<std::size_t>(i)];
@@ -74,21 +170,22 @@ Eigen::Matrix3cd cross_spectral_matrix_g2_per_Hz(const vibration::RandomProfile&
   return s;
 }
 
+}  // namespace
+
+Eigen::Matrix3cd cross_spectral_matrix_g2_per_Hz(const vibration::RandomProfile& p, double f) {
+  return cross_spectral_matrix(p, p.measured ? PreparedTables{} : prepared_tables(p), f);
+}
+
 Eigen::Matrix3d cross_spectrum_g2_per_Hz(const vibration::RandomProfile& p, double f) {
   return cross_spectral_matrix_g2_per_Hz(p, f).real();
 }
 
 RandomResponse random_response(const vibration::RandomProfile& p, const ResponseAt& response, const RandomQuadrature& q) {
-  vibration::validate(p);
+  const PreparedTables tables = prepared_tables(p);
   if (!(q.max_log_step > 0)) throw std::invalid_argument("random_response: max_log_step must be positive");
   // Every table's breakpoints: the PSD is a power law between them (smooth in ln f), and
-  // it jumps to 0 outside a table's band.
-  std::vector<double> knots;
-  for (const auto& t : p.psd)
-    if (t) {
-      const vibration::ResolvedPsd r = vibration::resolve(*t);
-      knots.insert(knots.end(), r.frequency_Hz.begin(), r.frequency_Hz.end());
-    }
+  // it jumps to 0 outside a table's band. (The common grid needs only the band's ends.)
+  std::vector<double> knots = table_frequencies(tables, !q.common_grid || p.measured);
   // A measured matrix: its bins' edges (each bin a step; the tables' rows 0.1 % of a bin
   // inside them are left out, so that no piece straddles a step). Not on the common grid: a
   // piece of it would sample several steps at a few points.
@@ -128,7 +225,7 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
       for (std::size_t n = 0; n < points; ++n) {
         const double f = std::exp(mid + 0.5 * h * (two ? kGl2X[n] : kGlX[n]));
         const double weight = 0.5 * h * (two ? kGl2W[n] : kGlW[n]) * f;  // df = f d(ln f)
-        const Eigen::Matrix3cd s = cross_spectral_matrix_g2_per_Hz(p, f);
+        const Eigen::Matrix3cd s = cross_spectral_matrix(p, tables, f);
         if (s.isZero(0.0)) continue;
         const LoopResponse r = response(f);
         ++out.frequencies;

@@ -1,0 +1,7 @@
+// libFuzzer entry point of the raw_csv reader (fuzz/readers.hpp).
+#include "fuzz/readers.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  vrelab::fuzz::raw_csv(data, size);
+  return 0;
+}
