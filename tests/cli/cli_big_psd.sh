@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# A valid PSD table of 10^6 rows is diagnosed right and in under a minute: cases/lab-random's
+# A valid PSD table of 10^6 rows is diagnosed right: cases/lab-random's
 # GEVS table (four breakpoints) refined to 10^6 rows on its own straight lines in log-log axes
 # is the same PSD, so `vrelab diagnose` must give the same verdict and the same chi^2 and gap
 # rms (to 1e-6: the refined rows are the lines' values to 1e-12, and the PSD integral's grid
-# is the same); in under a minute, or within twice the four rows' time where other tests load
-# the machine. Usage: cli_big_psd.sh <vrelab binary> <cases dir>
+# is the same). Its time is printed, not judged (speed is a benchmark's: docs/performance.md);
+# the 300 s limit only stops a hang (it took 18 s in Release).
+# Usage: cli_big_psd.sh <vrelab binary> <cases dir>
 set -u
 bin=$1
 cases=$2
@@ -37,10 +38,9 @@ timeout -k 5 300 "$bin" diagnose "$tmp/million" --json "$tmp/million.json" >"$tm
   { echo "FAIL: 10^6 rows: $(tail -5 "$tmp/million.out")"; exit 1; }
 wall=$(since "$start")
 echo "10^6-row PSD ($rows rows): diagnosed in $wall s, the four rows in $four_s s"
-python3 - "$tmp/four.json" "$tmp/million.json" "$wall" "$four_s" <<'EOF'
+python3 - "$tmp/four.json" "$tmp/million.json" <<'EOF'
 import json, sys
 a, b = (json.load(open(p)) for p in sys.argv[1:3])
-wall, four = float(sys.argv[3]), float(sys.argv[4])
 bad = []
 for key in ("verdict", "chosen"):
     if a[key] != b[key]:
@@ -50,9 +50,6 @@ for name, x, y in (("chi2_nominal", a["chi2_nominal"], b["chi2_nominal"]),
                    ("rms_after_g", a["shrinkage"]["rms_after_g"], b["shrinkage"]["rms_after_g"])):
     if abs(x - y) > 1e-6 * abs(x):
         bad.append("%s: %.10g against %.10g" % (name, y, x))
-# Under a minute, or (on a machine other tests load: ctest -j) within twice the four rows' time.
-if wall > 60 and wall > 2 * four:
-    bad.append("took %.1f s (at most 60, or twice the four rows' %.1f s)" % (wall, four))
 print("verdict %r, chi2 %.10g (four rows %.10g)" % (b["verdict"], b["chi2_nominal"], a["chi2_nominal"]))
 for m in bad:
     print("FAIL: " + m)
