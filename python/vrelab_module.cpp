@@ -666,6 +666,10 @@ PYBIND11_MODULE(_core, m) {
       .def_property_readonly("max_abs_z", [](const io::FolderDiagnosis& f) { return f.diagnosis.max_abs_z; }, "Largest |z| over the runs: the gap the static test's coefficient errors cannot take up, over the run's sigma (1).")
       .def_property_readonly("rms_before_g", [](const io::FolderDiagnosis& f) { return f.diagnosis.rms_before_g; }, "Held-out rms gap, g.")
       .def_property_readonly("rms_after_g", [](const io::FolderDiagnosis& f) { return f.diagnosis.rms_after_g; }, "With the chosen effect, g.")
+      .def_property_readonly("rms_floor_g", [](const io::FolderDiagnosis& f) { return f.diagnosis.rms_floor_g; },
+                             "The held-out rms with no gap at all (noise, simulation accuracy, the coefficients' extrapolation), g: no effect removes it.")
+      .def_property_readonly("shrinkage_above_floor", [](const io::FolderDiagnosis& f) { return f.diagnosis.shrinkage_above_floor(); },
+                             "1 - (after above the floor) / (before above the floor), in quadrature (1); NaN when the gap before is within the floor.")
       .def_property_readonly("identified", [](const io::FolderDiagnosis& f) { return coefficient_dict(f.diagnosis.identified); }, "Model (1)'s coefficients from the static readings (K1 output units/g, k0 g, k2 1/g, ...).")
       .def("report", &io::FolderDiagnosis::FullReport, "The text `vrelab diagnose` prints (without the program's name).")
       .def("brief_report", &io::FolderDiagnosis::BriefReport)

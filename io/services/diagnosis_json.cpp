@@ -94,8 +94,10 @@ json diagnosed_runs_json(const validation::Diagnosis& d, const validation::Campa
                           {"gap_g", x.gap_g},
                           {"adjusted_gap_g", x.adjusted_gap_g},
                           {"z", x.z},
+                          {"sigma_simulation_g", x.sigma_simulation_g},
                           {"heldout_before_g", x.heldout_before_g},
-                          {"heldout_after_g", x.heldout_after_g}});
+                          {"heldout_after_g", x.heldout_after_g},
+                          {"heldout_floor_g", x.heldout_floor_g}});
     }
     if (r.motion) {
       runs.back()["motion"] = to_json(r.motion->departure);
@@ -246,6 +248,9 @@ json to_json(const validation::Diagnosis& d, const validation::Campaign& c) {
             {"rms_before_sigma", d.rms_before_sigma},
             {"rms_after_sigma", d.rms_after_sigma},
             {"fraction_removed", d.rms_before_g > 0 ? 1 - d.rms_after_g / d.rms_before_g : 0.0},
+            {"rms_floor_g", d.rms_floor_g},
+            {"rms_floor_sigma", d.rms_floor_sigma},
+            {"fraction_above_floor_removed", finite_or_null(d.shrinkage_above_floor())},
             {"on", "held-out runs (leave one amplitude out), gap the static test's coefficient errors cannot take up"}}},
           {"resimulated",
            {{"runs", d.resimulated_runs},
@@ -406,6 +411,8 @@ json to_json(const validation::BlindResult& r) {
           {"gap_shrinkage_campaigns", s.gap_shrinkage_campaigns},
           {"median_shrinkage", s.median_shrinkage},
           {"median_shrinkage_in_sigma", s.median_shrinkage_in_sigma},
+          {"median_shrinkage_above_floor", s.median_shrinkage_above_floor},
+          {"above_floor_campaigns", s.above_floor_campaigns},
           {"families", families_json(s.families)},
           {"criteria", criteria_json(r.Criteria())},
           {"family_size_max_run_sigma",

@@ -44,6 +44,13 @@ void how_far(Report& rep, const validation::Diagnosis& d) {
       "added: {:.0f} % removed.",
       d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, validation::to_string(d.chosen),
       d.rms_before_g > 0 ? 100 * (1 - d.rms_after_g / d.rms_before_g) : 0.0));
+  const double above = d.shrinkage_above_floor();
+  rep.paragraph(fmt::format(
+      "No effect can remove the floor: with no gap at all the held-out gap would have rms {:.4g} ug ({:.3g} sigma), the "
+      "runs' noise and the simulation's accuracy with the coefficients' error the training runs leave, extrapolated. {}",
+      d.rms_floor_g * 1e6, d.rms_floor_sigma,
+      std::isfinite(above) ? fmt::format("Of the gap above it, {:.0f} % is removed.", 100 * above)
+                           : std::string("The gap before is within it: nothing to shrink.")));
   if (d.resimulated_runs > 0)
     rep.paragraph(fmt::format(
         "Confirmed on the ODE plant: the {} runs with the largest gaps re-simulated with the coefficients corrected by "

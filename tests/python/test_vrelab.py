@@ -97,6 +97,17 @@ def test_diagnose_equals_cli(tmp_path):
     r = vrelab.diagnose(folder)
     assert strip_times(r.to_dict()) == strip_times(cli_json(tmp_path, "diagnose", folder))
     assert r.verdict and r.runs > 0
+    # The held-out floor: the runs' floors' rms, and the shrinkage above it in quadrature,
+    # from the JSON's numbers by hand.
+    d = r.to_dict()
+    s = d["shrinkage"]
+    before, after, floor = s["rms_before_g"], s["rms_after_g"], s["rms_floor_g"]
+    assert r.rms_floor_g == floor > 0
+    runs = d["runs"]
+    assert floor == pytest.approx(math.sqrt(sum(x["heldout_floor_g"] ** 2 for x in runs) / len(runs)), rel=1e-12)
+    above = 1 - math.sqrt(max(0.0, after**2 - floor**2)) / math.sqrt(before**2 - floor**2)
+    assert r.shrinkage_above_floor == pytest.approx(above, rel=1e-12)
+    assert s["fraction_above_floor_removed"] == pytest.approx(above, rel=1e-12)
 
 
 def test_frequency_equals_cli_summary(tmp_path):

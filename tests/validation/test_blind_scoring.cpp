@@ -172,13 +172,14 @@ TEST(BlindScoringCampaign, TheGapsHeldOutRmsWithoutTheNoiseIsTheNoiseFreeDiagnos
   EXPECT_THROW(gap_rms_without_lab_noise(dn, std::vector<double>(3, 0.0)), std::invalid_argument);
 }
 
-// The result line carries the gap's size and noise-free rms, read back exactly; a line without
-// them is refused as outdated (run_blind diagnoses it again), a garbled one
-// as unreadable.
+// The result line carries the gap's size and noise-free rms and the held-out floor, read back
+// exactly; a line without them, or without the floor, is refused as outdated (run_blind
+// diagnoses it again), a garbled one as unreadable.
 TEST(BlindScoring, TheResultLineCarriesTheGapsSizeAndNoiseFreeRms) {
   BlindCampaign k;
   k.called = "clean";
   k.effect_max_sigma = 55.25, k.effect_gap_sigma = 3.125, k.gap_rms_before_g = 1.0625e-6, k.gap_rms_after_g = 0.0625e-6;
+  k.diagnosis.rms_floor_g = 0.4375e-6, k.diagnosis.rms_floor_sigma = 1.125;
   const std::string text = campaign_result_text(k);
   BlindCampaign back;
   read_campaign_result(text, back);
@@ -186,9 +187,16 @@ TEST(BlindScoring, TheResultLineCarriesTheGapsSizeAndNoiseFreeRms) {
   EXPECT_EQ(back.effect_gap_sigma, 3.125);
   EXPECT_EQ(back.gap_rms_before_g, 1.0625e-6);
   EXPECT_EQ(back.gap_rms_after_g, 0.0625e-6);
+  EXPECT_EQ(back.diagnosis.rms_floor_g, 0.4375e-6);
+  EXPECT_EQ(back.diagnosis.rms_floor_sigma, 1.125);
   std::string old = text;
-  for (int i = 0; i < 4; ++i) old = old.substr(0, old.rfind('\t'));
+  for (int i = 0; i < 2; ++i) old = old.substr(0, old.rfind('\t'));  // before the floor
   EXPECT_THROW(read_campaign_result(old, back), OutdatedCampaignResult);
+  for (int i = 0; i < 4; ++i) old = old.substr(0, old.rfind('\t'));  // before the gap
+  EXPECT_THROW(read_campaign_result(old, back), OutdatedCampaignResult);
+  std::string cut = text;
+  cut = cut.substr(0, cut.rfind('\t'));  // one number of the floor missing
+  test::expect_refused_not_outdated(cut, "a line without its last number");
   std::string garbled = text;
   garbled.replace(garbled.rfind("gap\t"), 3, "gup");
   test::expect_refused_not_outdated(garbled, "a garbled line");

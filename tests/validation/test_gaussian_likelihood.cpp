@@ -139,6 +139,11 @@ TEST(GaussianLikelihood, MatchesADenseCovarianceInLongDouble) {
     EXPECT_LE((v.solve(c.r) - xd).norm(), 1e-10 * xd.norm()) << variant;
     const Eigen::VectorXd dc = (to_long(c.Sigma) * to_long(c.G).transpose() * x).cast<double>();
     EXPECT_LE((v.conditional_mean(c.r) - dc).norm(), 1e-10 * dc.norm()) << variant;
+    // Sigma - Sigma G^T V^-1 G Sigma (the held-out floor's coefficient part) against the dense
+    // solve: the same rounding argument, relative to Sigma's size.
+    const MatrixL SG = to_long(c.Sigma) * to_long(c.G).transpose();
+    const Eigen::MatrixXd P = (to_long(c.Sigma) - SG * V.llt().solve(SG.transpose())).cast<double>();
+    EXPECT_LE((v.conditional_covariance() - P).norm(), 1e-10 * c.Sigma.norm()) << variant;
     // E^T E = r^T V^-1 r for the whitened residual.
     EXPECT_NEAR(v.whitened(c.r).squaredNorm(), static_cast<double>(chi2_ref), 1e-10 * static_cast<double>(chi2_ref));
   }

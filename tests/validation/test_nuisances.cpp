@@ -158,6 +158,30 @@ TEST(NuisancesCampaign, ASqueezeFilmWithTheStatedSigmaRightIsNotCalledSigmaUnder
   EXPECT_TRUE(d.gap_significant) << verdict_text(d);  // the film is seen (the test can fail)
 }
 
+// A stray magnetic field's bias is not scatter (issue 30): it grows with the table's
+// displacement squared, 0.14 ug (A / 1 g)^2 (10 Hz / f)^4, added to a clean default-design
+// campaign's measured values (the ODE without it: the truth comes from outside the diagnosis).
+// Only the 10 Hz runs see it (0.14 to 2.2 ug; 40 Hz already 256 x less), so neighbouring runs,
+// 10 against 40 Hz, are not alike (a neighbour correlation of 2.4 sigma on the CLI's default
+// case, below its 3) and the overdispersion alone said "sigma understated x1.49" (no gap once
+// judged with it). The gaps' spread over frequency says it is structure: not applied, and the
+// gap stays unexplained (here: neighbours 2.0 sigma, k 1.70, the spreads over frequency 8.5
+// sigma). Seed 163 was not used to develop the structure tests.
+TEST(NuisancesCampaign, AStrayFieldsLowFrequencyBiasIsNotCalledSigmaUnderstated) {
+  const std::uint64_t seed = 163;
+  Campaign c = simulate_campaign(blind_like_truth(seed), {}, default_design(), seed, 2);
+  for (RunRecord& r : c.runs) r.measured_g += 0.14e-6 * r.amplitude_g * r.amplitude_g * std::pow(10 / r.frequency_Hz, 4);
+  const Diagnosis d = diagnose(c);
+  const Nuisance* x = d.nuisance("sigma_scale");
+  ASSERT_NE(x, nullptr);
+  std::printf("verdict: %s\nsigma_scale: %.3f +- %.3f, applied %d; %s\n", verdict_text(d).c_str(), x->value, x->sigma,
+              x->applied ? 1 : 0, x->note.c_str());
+  EXPECT_FALSE(x->applied) << x->note;
+  EXPECT_NE(x->note.find("over frequency"), std::string::npos) << x->note;
+  EXPECT_TRUE(d.gap_significant) << verdict_text(d);
+  EXPECT_FALSE(d.explained()) << verdict_text(d);
+}
+
 // The drift test's false-alarm rate, by Monte Carlo: rest readings that are independent normal
 // draws (blind's lab log: 3 min a run, sigma 0.3 ug) with no drift are flagged at the
 // nuisances' level, 2 (1 - Phi(3)) = 0.270 % two-sided, at any number of readings. 40 000 logs

@@ -345,11 +345,12 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
 
 // Scores one campaign against its key into r (counts, confusion, the wrong ones).
 // The held-out shrinkages 1 - after / before of the single campaigns: of the residuals' rms
-// (with the runs' noise) in g and in each run's sigma, and of the gap's rms (noise removed), over
-// the scored single family; the first two over the single family by the largest run's size
-// too.
+// (with the runs' noise) in g and in each run's sigma, of the gap's rms (noise removed), and of
+// the residuals above their floor (Diagnosis::shrinkage_above_floor, where the gap before
+// exceeds it), over the scored single family; the first two over the single family by the
+// largest run's size too.
 struct Shrinkages {
-  std::vector<double> residual_g, residual_sigma, gap, largest_run_residual_g, largest_run_residual_sigma;
+  std::vector<double> residual_g, residual_sigma, gap, above_floor, largest_run_residual_g, largest_run_residual_sigma;
 };
 
 void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
@@ -398,6 +399,7 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
     if (k.error.empty() && k.gap_rms_before_g > 0) sh.gap.push_back(1 - k.gap_rms_after_g / k.gap_rms_before_g);
     if (k.error.empty() && d.rms_before_g > 0) sh.residual_g.push_back(1 - d.rms_after_g / d.rms_before_g);
     if (k.error.empty() && d.rms_before_sigma > 0) sh.residual_sigma.push_back(1 - d.rms_after_sigma / d.rms_before_sigma);
+    if (k.error.empty() && std::isfinite(d.shrinkage_above_floor())) sh.above_floor.push_back(d.shrinkage_above_floor());
 
   } else if (k.category == "clean") {
     ++s.clean;
@@ -493,9 +495,10 @@ std::string unescaped(const std::string& s) {
 // would score "no gap" whatever its diagnosis says.)
 // Then the top effect's parameters (their count, then 6 fields each: name, unit, value,
 // sigma, status, at_bound). Last, "gap" and the effect's gap significance, the gap's held-out
-// rms before and after with the lab's noise removed (a line without them is outdated:
-// OutdatedCampaignResult, and the campaign is diagnosed again).
-constexpr std::size_t kFixedResultFields = 17, kNuisanceFields = 8, kParameterFields = 6, kGapFields = 4;
+// rms before and after with the lab's noise removed, and the diagnosis' held-out floor in g and
+// in sigma (a line without them, or without the floor, is outdated: OutdatedCampaignResult,
+// and the campaign is diagnosed again).
+constexpr std::size_t kFixedResultFields = 17, kNuisanceFields = 8, kParameterFields = 6, kGapFields = 6;
 
 std::string campaign_result_text(const BlindCampaign& k) {
   const Diagnosis& d = k.diagnosis;
@@ -520,7 +523,8 @@ std::string campaign_result_text(const BlindCampaign& k) {
   for (const FittedParameter& q : ps)
     t.append(fmt::format("\t{}\t{}\t{:.17g}\t{:.17g}\t{}\t{:d}", escaped(q.name), escaped(q.unit), q.value, q.sigma, to_string(q.status),
                          q.at_bound ? 1 : 0));
-  t.append(fmt::format("\tgap\t{:.17g}\t{:.17g}\t{:.17g}", k.effect_gap_sigma, k.gap_rms_before_g, k.gap_rms_after_g));
+  t.append(fmt::format("\tgap\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}\t{:.17g}", k.effect_gap_sigma, k.gap_rms_before_g,
+                       k.gap_rms_after_g, d.rms_floor_g, d.rms_floor_sigma));
   return t;
 }
 
@@ -600,14 +604,15 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
   // The top effect's parameters (the natural forms' scoring reads them).
   const std::size_t n_parameters = count(at++);
   const std::size_t gap_at = at + kParameterFields * n_parameters;
-  if (f.size() == gap_at)
+  if (f.size() == gap_at || (f.size() == gap_at + 4 && f[gap_at] == "gap"))
     throw OutdatedCampaignResult(fmt::format(
-        "blind: a campaign's result ({} fields) written before blind kept the effect's gap significance and the gap's "
-        "noise-free held-out rms: diagnose it again",
+        "blind: a campaign's result ({} fields) written before blind kept the effect's gap significance, the gap's "
+        "noise-free held-out rms and the held-out floor: diagnose it again",
         f.size()));
   if (f.size() != gap_at + kGapFields || f[gap_at] != "gap")
-    throw bad(fmt::format("{} parameters of {} fields, then \"gap\" and 3 numbers expected", n_parameters, kParameterFields));
+    throw bad(fmt::format("{} parameters of {} fields, then \"gap\" and 5 numbers expected", n_parameters, kParameterFields));
   k.effect_gap_sigma = num(gap_at + 1), k.gap_rms_before_g = num(gap_at + 2), k.gap_rms_after_g = num(gap_at + 3);
+  d.rms_floor_g = num(gap_at + 4), d.rms_floor_sigma = num(gap_at + 5);
   if (n_parameters > 0 && d.effects.empty()) throw bad("parameters without a top effect");
   for (std::size_t i = 0; i < n_parameters; ++i) {
     FittedParameter q;
@@ -677,6 +682,8 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
   r.scores.gap_shrinkage_campaigns = static_cast<int>(sh.gap.size());
   r.scores.median_shrinkage = median(sh.residual_g);
   r.scores.median_shrinkage_in_sigma = median(sh.residual_sigma);
+  r.scores.median_shrinkage_above_floor = median(sh.above_floor);
+  r.scores.above_floor_campaigns = static_cast<int>(sh.above_floor.size());
   r.scores.by_max_run_sigma.median_shrinkage = median(sh.largest_run_residual_g);
   r.scores.by_max_run_sigma.median_shrinkage_in_sigma = median(sh.largest_run_residual_sigma);
   return r;
@@ -754,6 +761,9 @@ std::string BlindResult::BriefReport() const {
                    "{:.0f} % (on the single family sized by the largest run: {:.0f} %, {:.0f} %)\n",
                    100 * s.median_shrinkage, 100 * s.median_shrinkage_in_sigma, 100 * o.median_shrinkage,
                    100 * o.median_shrinkage_in_sigma);
+  t += fmt::format("  median held-out shrinkage above the floor (the residuals' rms beyond what no effect removes; {} single "
+                   "campaigns): {:.0f} %\n",
+                   s.above_floor_campaigns, 100 * s.median_shrinkage_above_floor);
   t += "Issue 15's rates (the 95 % interval is Clopper-Pearson's: what a run of this size can tell):\n";
   for (const BlindCriterion& c : Criteria())
     t += fmt::format("  {:<72} {:>4}/{:<4} {:>5.1f} %  [{:5.1f}, {:5.1f}] %  target {} {:.0f} %: {}\n", c.name, c.k, c.n,

@@ -131,6 +131,10 @@ struct BlindScores {
   double median_gap_shrinkage = 0;
   int gap_shrinkage_campaigns = 0;  // single campaigns it is the median of
   double median_shrinkage = 0, median_shrinkage_in_sigma = 0;
+  // ... and of the residuals above their floor (Diagnosis::shrinkage_above_floor), over the
+  // single campaigns whose gap before exceeds it.
+  double median_shrinkage_above_floor = 0;
+  int above_floor_campaigns = 0;
   LargestRunSizeScores by_max_run_sigma;  // the families by the largest run's size, beside
   std::map<std::string, FamilyScore> families;  // per family (category)
   static double rate(int k, int of) { return of ? static_cast<double>(k) / of : 0.0; }

@@ -3,6 +3,8 @@
 // saying what it takes and gives.
 #include "validation/diagnosis/diagnose.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -33,6 +35,13 @@ const Nuisance* Diagnosis::nuisance(const std::string& name) const {
   return nullptr;
 }
 
+double Diagnosis::shrinkage_above_floor() const {
+  // What lies above the floor, in quadrature (noise and a gap add as variances).
+  const auto above = [&](double rms) { return std::sqrt(std::max(0.0, rms * rms - rms_floor_g * rms_floor_g)); };
+  const double before = above(rms_before_g);
+  return before > 0 ? 1 - above(rms_after_g) / before : NAN;
+}
+
 internal::StageOptions internal::stage_options(const DiagnoseSettings& s) {
   StageOptions o;
   o.simulation_rel_accuracy = s.model_accuracy;
@@ -41,8 +50,7 @@ internal::StageOptions internal::stage_options(const DiagnoseSettings& s) {
                .min_rms_removed = s.explained_shrinkage,
                .try_two_effects = s.try_pairs,
                .tie_evidence = s.ambiguity_evidence};
-  o.scatter = {.simulation_rel_accuracy = s.model_accuracy,
-               .structure_threshold_sigma = s.structure_sigma,
+  o.scatter = {.structure_threshold_sigma = s.structure_sigma,
                .threshold_sigma = s.significance_sigma};
   o.next_runs = s.advise_next_runs;
   o.max_resimulated_runs = s.resimulate_runs;

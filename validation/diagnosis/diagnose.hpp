@@ -181,8 +181,11 @@ struct RunDiagnosis {
   double gap_g = 0, sigma_g = 0;                  // measured - predicted; sigma from V's diagonal
   double adjusted_gap_g = 0;  // the gap the static test's coefficient errors cannot take up (all runs)
   double z = 0;               // adjusted_gap_g over the run's own sigma (measurement, simulation accuracy)
+  double sigma_simulation_g = 0;  // the simulation's accuracy: model_accuracy x the nominal prediction
+  double sigma_adjusted_g = 0;    // adjusted_gap_g's own sd with no gap (less than sigma: the coefficients take up a share)
   double heldout_before_g = 0;                    // the gap the coefficient errors cannot take up (nominal), held out
   double heldout_after_g = 0;                     // the same with the chosen effect, fitted without this run's fold
+  double heldout_floor_g = 0;  // the rms heldout_before_g has with no gap: noise, simulation accuracy, coefficients' extrapolation
 };
 
 struct Diagnosis {
@@ -217,6 +220,11 @@ struct Diagnosis {
   const Nuisance* nuisance(const std::string& name) const;
   double rms_before_g = 0, rms_after_g = 0;          // held-out, over all runs
   double rms_before_sigma = 0, rms_after_sigma = 0;  // the same in units of each run's sigma
+  // The floor no effect removes: the held-out rms with no gap (RunDiagnosis::heldout_floor_g).
+  double rms_floor_g = 0, rms_floor_sigma = 0;
+  // 1 - (after above the floor) / (before above the floor), in quadrature; NaN when the gap
+  // before is within its floor (nothing to shrink).
+  double shrinkage_above_floor() const;
   // The confirmation on the ODE plant (the runs with the largest gaps; coefficients corrected
   // by all runs under the chosen effect): rms of measured - ODE without and with the effect.
   // Only when the gap is explained; runs whose simulation failed are listed (id: why) and left out.

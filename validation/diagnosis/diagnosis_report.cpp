@@ -11,8 +11,13 @@ namespace vrelab::validation {
 namespace {
 
 std::string heldout_line(const Diagnosis& d, double wall_s) {
-  return fmt::format("Held-out gap rms: {:.4g} ug ({:.3g} sigma) before, {:.4g} ug ({:.3g} sigma) after {}{}\n",
+  const double above = d.shrinkage_above_floor();
+  return fmt::format("Held-out gap rms: {:.4g} ug ({:.3g} sigma) before, {:.4g} ug ({:.3g} sigma) after {}; floor {:.4g} ug "
+                     "({:.3g} sigma){}{}\n",
                      d.rms_before_g * 1e6, d.rms_before_sigma, d.rms_after_g * 1e6, d.rms_after_sigma, to_string(d.chosen),
+                     d.rms_floor_g * 1e6, d.rms_floor_sigma,
+                     std::isfinite(above) ? fmt::format(", {:.0f} % of the gap above it removed", 100 * above)
+                                          : std::string(", the gap within it"),
                      wall_s >= 0 ? fmt::format(" ({:.1f} s wall)", wall_s) : "");
 }
 

@@ -27,9 +27,12 @@ std::string to_string(const ChosenEffects& c) {
 
 std::string verdict_text(const Diagnosis& d) {
   std::string t;
+  const Nuisance* scale = d.nuisance("sigma_scale");
+  // An overstated covariance (sigma_scale below 1, flagged, not applied) may hide a gap.
+  const bool overstated = scale && scale->significant && !scale->applied && scale->value < 1;
   switch (d.verdict) {
     case Verdict::none: break;
-    case Verdict::no_significant_gap: t = "no significant gap"; break;
+    case Verdict::no_significant_gap: t = overstated ? "no gap can be judged" : "no significant gap"; break;
     case Verdict::explained: t = "explained by " + to_string(d.chosen); break;
     case Verdict::not_explained: t = "not explained by any known effect"; break;
     case Verdict::ambiguous:
@@ -39,8 +42,12 @@ std::string verdict_text(const Diagnosis& d) {
       break;
   }
   char buf[120];
-  if (const Nuisance* scale = d.nuisance("sigma_scale"); scale && scale->applied) {
+  if (scale && scale->applied) {
     std::snprintf(buf, sizeof buf, " (sigma understated x%.2f; judged with the corrected sigma)", scale->value);
+    t += buf;
+  }
+  if (overstated) {
+    std::snprintf(buf, sizeof buf, " (covariance overstated: the gaps scatter x%.2f of their sigma; a gap may be hidden)", scale->value);
     t += buf;
   }
   if (const Nuisance* drift = d.nuisance("bias_drift"); drift && drift->significant) {

@@ -140,6 +140,15 @@ Eigen::VectorXd FactoredCovariance::conditional_mean(const Eigen::VectorXd& y) c
   return -(B_ * whitened(y).bottomRows(p).col(0));
 }
 
+Eigen::MatrixXd FactoredCovariance::conditional_covariance() const {
+  if (!ok_) return Eigen::MatrixXd::Constant(m_, m_, std::numeric_limits<double>::quiet_NaN());
+  const Eigen::Index p = B_.cols();
+  if (p == 0) return Eigen::MatrixXd::Zero(m_, m_);
+  const Eigen::MatrixXd X =
+      qr_.matrixQR().topLeftCorner(p, p).triangularView<Eigen::Upper>().transpose().solve(B_.transpose());
+  return X.transpose() * X;
+}
+
 GaussianLikelihood gaussian_likelihood(const Eigen::VectorXd& y, const Eigen::VectorXd& s2, const Eigen::MatrixXd& G,
                                        const Eigen::MatrixXd& Sigma) {
   const FactoredCovariance v(s2, G, Sigma);

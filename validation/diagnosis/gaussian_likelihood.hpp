@@ -40,6 +40,9 @@ class FactoredCovariance {
   // The coefficients' conditional mean given y: Sigma G^T V^-1 y (= B z*, z* the least-squares
   // solution above), m entries.
   Eigen::VectorXd conditional_mean(const Eigen::VectorXd& y) const;
+  // The coefficients' conditional covariance given the runs: Sigma - Sigma G^T V^-1 G Sigma
+  // = B (I + W^T W)^-1 B^T = (R^-T B^T)^T (R^-T B^T), m x m (no difference of large numbers).
+  Eigen::MatrixXd conditional_covariance() const;
 
  private:
   // [S^-1/2 y; 0] and its Q^T, the first p rows zeroed (what R's columns cannot reach).

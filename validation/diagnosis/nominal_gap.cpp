@@ -41,8 +41,7 @@ Nominal nominal_of(const Campaign& c0, const DiagnoseSettings& s, double sigma_s
   internal::Identified id = internal::identify(c);
   internal::ResponseCache cache;
   Nominal nm{std::move(id.data), internal::tabulate(id.plant, c.runs, nullptr, 0, cache, internal::Absorbed{})};
-  const double accuracy = internal::stage_options(s).simulation_rel_accuracy;
-  for (Eigen::Index k = 0; k < nm.t.pred.size(); ++k) nm.data.sigma2(k) += std::pow(accuracy * nm.t.pred(k), 2);
+  internal::add_simulation_accuracy(nm.data, nm.t, internal::stage_options(s).simulation_rel_accuracy);
   return nm;
 }
 

@@ -42,13 +42,15 @@ struct DiagnoseSettings {
             "Runs (largest gaps first) re-simulated on the ODE plant; 0: none"));
     v(field("try_pairs", &S::try_pairs, "", core::any_value(),
             "Try two effects at once when no one effect explains the gap", "no-pairs"));
-    // Stated sigma too small: a significant gap that no effect explains and whose runs' gaps
-    // are not alike between neighbouring runs (the correlation of the gaps of runs one
-    // frequency or one amplitude step apart, as a normal deviate, below this) is scatter,
-    // not physics: the sigma is scaled by what the gaps say and the gap judged again.
+    // Stated sigma too small: gaps that no effect explains, not alike between neighbouring
+    // runs (the correlation of the gaps of runs one frequency or one amplitude step apart, as
+    // a normal deviate, below this) and whose means and spreads depend on no frequency,
+    // amplitude, direction, orientation or time order (the structure tests' deviate below
+    // this) are scatter, not physics: the sigma is scaled by what the gaps say and the gap
+    // judged again.
     v(field("structure_sigma", &S::structure_sigma, "sigma", core::above(0),
-            "An unexplained gap whose neighbouring runs' gaps correlate below this (normal deviate) is "
-            "scatter: the stated sigma is scaled"));
+            "Unexplained gaps whose neighbours' correlation and structure tests stay below this (normal deviate) "
+            "are scatter: the stated sigma is scaled"));
     // 6: "strong" on Kass and Raftery's scale.
     v(field("ambiguity_evidence", &S::ambiguity_evidence, "", core::at_least(0),
             "Two effects that both explain the gap with held-out evidence (2 ln Bayes factor) closer than "

@@ -128,9 +128,18 @@ void heldout_nominal(const CampaignModel& m, Evidence& ev, Diagnosis& d) {
   const Table& nominal = m.nominal;
   Eigen::VectorXd& heldout_nominal = ev.heldout_nominal;
   heldout_nominal = Eigen::VectorXd::Zero(n);
+  ev.heldout_floor2 = Eigen::VectorXd::Zero(n);
   for (const auto& [key, test] : ev.folds.test) {
-    const Eigen::VectorXd a = adjusted_residual(data, nominal.pred, nominal.G, ev.folds.train(key), test);
-    for (std::size_t i = 0; i < test.size(); ++i) heldout_nominal(test[i]) = a(static_cast<Eigen::Index>(i));
+    const std::vector<int> train = ev.folds.train(key);
+    const Eigen::VectorXd a = adjusted_residual(data, nominal.pred, nominal.G, train, test);
+    // r_test - G_test dc* is r_test less its conditional mean given the training runs, so with
+    // no gap its covariance is the conditional one: S_test + G_test P G_test^T.
+    const Eigen::MatrixXd P = factored(data, nominal.G, train).conditional_covariance();
+    for (std::size_t i = 0; i < test.size(); ++i) {
+      const int k = test[i];
+      heldout_nominal(k) = a(static_cast<Eigen::Index>(i));
+      ev.heldout_floor2(k) = data.sigma2(k) + (nominal.G.row(k) * P * nominal.G.row(k).transpose())(0, 0);
+    }
   }
 }
 

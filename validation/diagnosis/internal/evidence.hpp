@@ -89,6 +89,10 @@ class Scorer {
 struct Evidence {
   Folds folds;
   Eigen::VectorXd heldout_nominal;  // the nominal's held-out adjusted gap per run, g
+  // Its expected square with no gap (g^2): the run's variance and the coefficients' error
+  // left after its fold's training runs, sigma2 + G P G^T (P their conditional covariance):
+  // the floor no effect can remove.
+  Eigen::VectorXd heldout_floor2;
   std::vector<Scored> scored;       // ranked: best evidence first, the not ranked last
   std::map<std::string, std::unique_ptr<EffectFitter>> fitters;
 };

@@ -37,7 +37,8 @@ struct Span {
 };
 
 // Each run's prediction, gap and z; the peak, the significant runs and their span.
-Span per_run(const CampaignModel& m, double threshold_sigma, const Eigen::VectorXd& r, const Eigen::VectorXd& adj, Diagnosis& d) {
+Span per_run(const CampaignModel& m, double threshold_sigma, const Eigen::VectorXd& r, const Eigen::VectorXd& adj,
+             const Eigen::VectorXd& vinv_diag, Diagnosis& d) {
   const Campaign& c = m.campaign;
   const Data& data = m.data;
   const Table& nominal = m.nominal;
@@ -56,6 +57,8 @@ Span per_run(const CampaignModel& m, double threshold_sigma, const Eigen::Vector
     rd.sigma_g = std::sqrt(data.sigma2(k) + rd.sigma_predicted_g * rd.sigma_predicted_g);  // V's diagonal
     rd.adjusted_gap_g = adj(k);
     rd.z = adj(k) / std::sqrt(data.sigma2(k));
+    rd.sigma_simulation_g = std::sqrt(std::max(0.0, data.sigma2(k) - std::pow(run.sigma_g, 2)));
+    rd.sigma_adjusted_g = data.sigma2(k) * std::sqrt(std::max(0.0, vinv_diag(k)));
     const std::string dir = vec_name(run.direction), orient = vec_name(run.orientation_g);
     z2_by_direction[dir].first += rd.z * rd.z, ++z2_by_direction[dir].second;
     if (std::abs(rd.z) > d.max_abs_z) {
@@ -137,7 +140,11 @@ Eigen::VectorXd locate_gap(const CampaignModel& m, const GapOptions& o, Diagnosi
   const std::vector<int>& all = m.all;
   const int n = m.n;
   const Eigen::VectorXd r = data.measured - nominal.pred;
-  d.chi2_nominal = factored(data, nominal.G, all).chi2(r);
+  const FactoredCovariance v = factored(data, nominal.G, all);
+  d.chi2_nominal = v.chi2(r);
+  // The adjusted gap r - G dc* = S V^-1 r has covariance S V^-1 S: each run's own sd with no
+  // gap is s2_k sqrt((V^-1)_kk) (what the nuisances' structure tests divide by).
+  const Eigen::VectorXd vinv_diag = v.solve(Eigen::MatrixXd(Eigen::MatrixXd::Identity(n, n))).diagonal();
   const double chi2_sigma = chi2_as_sigma(d.chi2_nominal, n);
   d.runs.resize(static_cast<std::size_t>(n));
   // Where: each run's gap that the static test's coefficient errors cannot take up (r - G dc*,
@@ -145,7 +152,7 @@ Eigen::VectorXd locate_gap(const CampaignModel& m, const GapOptions& o, Diagnosi
   // simulation accuracy). The raw gap is dominated by the coefficient errors at several g
   // and would point everywhere.
   const Eigen::VectorXd adj = adjusted_residual(data, nominal.pred, nominal.G, all, all);
-  const Span sp = per_run(m, o.threshold_sigma, r, adj, d);
+  const Span sp = per_run(m, o.threshold_sigma, r, adj, vinv_diag, d);
   // Odd or even in the static a_IA.
   d.odd_in_a_IA_fraction = odd_in_a_IA_fraction(m.campaign, d, o.threshold_sigma);
   d.gap_significant = d.significant_runs > 0 || chi2_sigma >= o.threshold_sigma;

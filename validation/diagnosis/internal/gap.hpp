@@ -6,7 +6,8 @@
 //        significance level (GapOptions, sigma).
 // Gives: in the Diagnosis, per run the nominal prediction and its sigma from the coefficients
 //        (g), the gap measured - predicted and its sigma (V's diagonal, g), the gap the
-//        coefficient errors cannot take up (g) and its z in the run's own sigma; the nominal
+//        coefficient errors cannot take up (g), its own sd with no gap (g) and its z in the
+//        run's own sigma, the simulation's accuracy term (g); the nominal
 //        chi^2, the significant runs, the largest |z| and where it is, the gap's power laws in
 //        amplitude and frequency (pooled within groups), the rms z per direction, the share odd
 //        in the static a_IA, the `where` summary and gap_significant (a run beyond the level,

@@ -128,8 +128,7 @@ void nominal_model(const Identified& id, CampaignModel& m) {
 
   // The nominal simulation; the simulation's own accuracy at its prediction joins each run's variance.
   m.nominal = tabulate(plant, c.runs, nullptr, 0, cache, absorbed);
-  const Table& nominal = m.nominal;
-  for (int k = 0; k < n; ++k) data.sigma2(k) += std::pow(m.simulation_rel_accuracy * nominal.pred(k), 2);
+  add_simulation_accuracy(data, m.nominal, m.simulation_rel_accuracy);
   m.all.resize(static_cast<std::size_t>(n));
   for (int k = 0; k < n; ++k) m.all[static_cast<std::size_t>(k)] = k;
 }

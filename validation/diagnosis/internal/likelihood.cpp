@@ -15,8 +15,6 @@ Eigen::MatrixXd rows(const Eigen::MatrixXd& m, const std::vector<int>& idx) {
   return s;
 }
 
-// The model-accuracy part is fixed at the nominal prediction: were it taken at each effect's
-// prediction, an effect could lower chi^2 by inflating its predictions.
 // (Only the lower triangle is a product, the upper its mirror: every use factorises V, which
 // reads the lower triangle, or takes its diagonal. Each entry is the same sum in the same
 // order as the full product's, so the factorisations equal the full product's bit for bit, at
@@ -50,6 +48,10 @@ Eigen::VectorXd adjusted_residual(const Data& d, const Eigen::VectorXd& pred, co
   const Eigen::VectorXd rf = sub(d.measured, from) - sub(pred, from);
   const Eigen::VectorXd dc = factored(d, G, from).conditional_mean(rf);
   return sub(d.measured, at) - sub(pred, at) - rows(G, at) * dc;
+}
+
+void add_simulation_accuracy(Data& d, const Table& nominal, double f) {
+  d.sigma2 = d.sigma2.array() + (f * nominal.pred.array()).square();
 }
 
 // chi^2 with n degrees of freedom as a normal deviate (Wilson-Hilferty).

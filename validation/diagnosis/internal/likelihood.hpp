@@ -48,6 +48,11 @@ Likelihood likelihood(const Data& d, const Eigen::VectorXd& pred, const Eigen::M
 // the runs `at`.
 Eigen::VectorXd adjusted_residual(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G,
                                   const std::vector<int>& from, const std::vector<int>& at);
+// The simulation's own accuracy joins each run's variance: sigma2 += (f pred_nominal)^2, fixed
+// at the nominal prediction for every effect, so that no effect can lower chi^2 by inflating
+// its predictions (docs/diagnose.md, "Covariance": what that costs at several g). d.sigma2
+// holds the runs' own variances on entry.
+void add_simulation_accuracy(Data& d, const Table& nominal, double f);
 // chi^2 with n degrees of freedom as a normal deviate (Wilson-Hilferty).
 double chi2_as_sigma(double chi2, int n);
 

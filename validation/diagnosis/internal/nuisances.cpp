@@ -7,6 +7,7 @@
 #include <string>
 
 #include <boost/math/distributions/chi_squared.hpp>
+#include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
 namespace vrelab::validation {
@@ -84,6 +85,70 @@ std::pair<double, int> neighbour_correlation(const Campaign& c, const std::vecto
   return {sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0, pairs};
 }
 
+ScatterStructure scatter_structure(const Campaign& c, const std::vector<double>& w) {
+  const std::size_t n = c.runs.size();
+  const auto vec = [](const Vec3& v) {
+    char b[64];
+    std::snprintf(b, sizeof b, "[%.2g, %.2g, %.2g]", v[0], v[1], v[2]);
+    return std::string(b);
+  };
+  // The runs in time order: by time_h when every run has one, else as listed.
+  std::vector<std::size_t> order(n);
+  for (std::size_t k = 0; k < n; ++k) order[k] = k;
+  if (std::all_of(c.runs.begin(), c.runs.end(), [](const RunRecord& r) { return std::isfinite(r.time_h); }))
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return c.runs[a].time_h < c.runs[b].time_h; });
+  std::vector<std::size_t> quarter(n);
+  for (std::size_t i = 0; i < n; ++i) quarter[order[i]] = 4 * i / std::max<std::size_t>(n, 1);
+  using Groups = std::map<std::string, std::vector<double>>;
+  std::vector<std::pair<std::string, Groups>> factors = {{"frequency", {}}, {"amplitude", {}}, {"direction", {}},
+                                                         {"orientation", {}}, {"time order", {}}};
+  for (std::size_t k = 0; k < n; ++k) {
+    const RunRecord& r = c.runs[k];
+    const std::string kind = r.random ? "random " : "";
+    factors[0].second[kind + std::to_string(r.frequency_Hz)].push_back(w[k]);
+    factors[1].second[kind + std::to_string(r.amplitude_g)].push_back(w[k]);
+    factors[2].second[vec(r.direction)].push_back(w[k]);
+    factors[3].second[vec(r.orientation_g)].push_back(w[k]);
+    factors[4].second[std::to_string(quarter[k])].push_back(w[k]);
+  }
+  // Each testable factor's two p values.
+  struct P {
+    std::string factor, test;
+    double p;
+  };
+  std::vector<P> ps;
+  for (auto& [name, groups] : factors) {
+    std::erase_if(groups, [](const auto& g) { return g.second.size() < 2; });
+    if (groups.size() < 2) continue;
+    double N = 0, ss = 0;
+    for (const auto& [key, v] : groups)
+      for (double x : v) N += 1, ss += x * x;
+    const double s2 = ss / N;
+    if (!(s2 > 0)) continue;
+    const double G = static_cast<double>(groups.size());
+    double t_means = 0, b = N * std::log(s2), inv = 0;
+    for (const auto& [key, v] : groups) {
+      const double ng = static_cast<double>(v.size());
+      double sum = 0, sq = 0;
+      for (double x : v) sum += x, sq += x * x;
+      t_means += sum * sum / ng / s2;
+      b -= ng * std::log(std::max(sq / ng, 1e-300 * s2));
+      inv += 1 / ng;
+    }
+    const double bartlett = b / (1 + (inv - 1 / N) / (3 * (G - 1)));
+    ps.push_back({name, "means", boost::math::cdf(boost::math::complement(boost::math::chi_squared(G), t_means))});
+    ps.push_back({name, "spreads", boost::math::cdf(boost::math::complement(boost::math::chi_squared(G - 1), std::max(bartlett, 0.0)))});
+  }
+  ScatterStructure st;
+  st.tests = static_cast<int>(ps.size());
+  if (ps.empty()) return st;
+  const P& worst = *std::min_element(ps.begin(), ps.end(), [](const P& a, const P& b) { return a.p < b.p; });
+  const double family = std::min(1.0, worst.p * static_cast<double>(ps.size()));
+  st.factor = worst.factor, st.test = worst.test;
+  st.sigma = family >= 1 ? 0.0 : std::max(0.0, boost::math::quantile(boost::math::complement(boost::math::normal(), std::max(family, 1e-300))));
+  return st;
+}
+
 std::pair<double, int> repeat_scatter(const Campaign& c) {
   std::map<std::string, std::vector<const RunRecord*>> groups;
   for (const RunRecord& r : c.runs) {
@@ -105,6 +170,37 @@ std::pair<double, int> repeat_scatter(const Campaign& c) {
   return {chi2, dof};
 }
 
+namespace {
+// Each run's adjusted gap over its own sd with the stated sigma, rescaled to what it would be
+// if the runs' own sigma fell short by one common k and the simulation's accuracy did not:
+// var(u_k) = (k^2 s_k^2 + m_k^2) / (s_k^2 + m_k^2) (s the run's sigma, m the simulation's
+// term), k solving mean(u^2 / var) = 1 (by bisection: the mean falls as k grows). Scatter of an
+// understated sigma then leaves no dependence on amplitude, where the simulation's term grows.
+std::vector<double> scatter_deviates(const Campaign& c, const Diagnosis& d) {
+  const std::size_t n = c.runs.size();
+  std::vector<double> u(n), s2(n), m2(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const RunDiagnosis& rd = d.runs[k];
+    u[k] = rd.sigma_adjusted_g > 0 ? rd.adjusted_gap_g / rd.sigma_adjusted_g : 0.0;
+    s2[k] = c.runs[k].sigma_g * c.runs[k].sigma_g, m2[k] = rd.sigma_simulation_g * rd.sigma_simulation_g;
+  }
+  const auto var = [&](std::size_t k, double scale) { return (scale * scale * s2[k] + m2[k]) / (s2[k] + m2[k]); };
+  const auto mean_ratio = [&](double scale) {
+    double t = 0;
+    for (std::size_t k = 0; k < n; ++k) t += u[k] * u[k] / var(k, scale);
+    return t / static_cast<double>(n);
+  };
+  double lo = 1e-3, hi = 1e3;
+  for (int i = 0; i < 100 && hi / lo > 1 + 1e-9; ++i) {
+    const double mid = std::sqrt(lo * hi);
+    (mean_ratio(mid) > 1 ? lo : hi) = mid;
+  }
+  std::vector<double> w(n);
+  for (std::size_t k = 0; k < n; ++k) w[k] = u[k] / std::sqrt(var(k, std::sqrt(lo * hi)));
+  return w;
+}
+}  // namespace
+
 Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d,
                      const std::function<Diagnosis(const Campaign&)>& rediagnose) {
   // The stated sigma: from repeated runs when there are enough (their scatter is the
@@ -117,13 +213,14 @@ Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d
   double z2 = 0;
   for (int k = 0; k < n; ++k) {
     const RunDiagnosis& rd = d.runs[static_cast<std::size_t>(k)];
-    const double sig = std::hypot(c.runs[static_cast<std::size_t>(k)].sigma_g, o.simulation_rel_accuracy * rd.predicted_g);  // as rd.z's
+    const double sig = std::hypot(c.runs[static_cast<std::size_t>(k)].sigma_g, rd.sigma_simulation_g);  // as rd.z's
     z[static_cast<std::size_t>(k)] = d.explained() ? rd.heldout_after_g / sig : rd.z;
     z2 += z[static_cast<std::size_t>(k)] * z[static_cast<std::size_t>(k)];
   }
   const auto [rep_chi2, rep_dof] = repeat_scatter(c);
   const auto [rho, pairs] = neighbour_correlation(c, z);
   const double rho_sigma = rho * std::sqrt(std::max(pairs, 1));
+  const ScatterStructure structure = scatter_structure(c, scatter_deviates(c, d));
   // (The adjusted gaps have the coefficients' errors taken out under the static test's prior,
   // not fitted freely: n degrees of freedom, a little fewer in truth, so k a little low.)
   const int dof = n;
@@ -141,6 +238,11 @@ Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d
     std::snprintf(buf, sizeof buf, "%s; neighbouring runs' gaps correlate by %.2f (%.1f sigma over %d pairs)", from.c_str(), rho,
                   rho_sigma, pairs);
     scale.note = buf;
+    if (structure.tests > 0) {
+      std::snprintf(buf, sizeof buf, "; strongest structure: the gaps' %s over %s, %.1f sigma (of %d tests)", structure.test.c_str(),
+                    structure.factor.c_str(), structure.sigma, structure.tests);
+      scale.note += buf;
+    }
   }
   // Overdispersion beyond chance: with the stated sigma right, the repeats' pooled chi^2 is
   // chi^2 with rep_dof degrees of freedom exactly (Gaussian noise); the gaps' sum of z^2 is at
@@ -150,10 +252,13 @@ Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d
   const double chi2 = from_repeats ? rep_chi2 : z2;
   const double chi2_crit = boost::math::quantile(boost::math::chi_squared(kdof), 1 - kNuisanceTail);
   const bool excess = chi2 > chi2_crit;
-  // It is scatter when measured by repeats, or when no effect explains the gaps and their
-  // neighbours are not alike (structure is physics). Whatever the gap's verdict: an
+  // It is scatter when measured by repeats, or when no effect explains the gaps, their
+  // neighbours are not alike and neither their means nor their spreads depend on frequency,
+  // amplitude, direction, orientation or time (structure is physics: a stray field's 1/f^4
+  // bias raises the low-frequency runs' gaps alone). Whatever the gap's verdict: an
   // overdispersion below the gap's own 5-sigma test is still reported.
-  const bool scatter = from_repeats || (!d.explained() && rho_sigma < o.structure_threshold_sigma);
+  const bool structured = rho_sigma >= o.structure_threshold_sigma || structure.sigma >= o.structure_threshold_sigma;
+  const bool scatter = from_repeats || (!d.explained() && !structured);
   // A physical gap is not scatter: scaled from the gaps alone (no repeats), the scaling is not
   // applied when, judged with the corrected sigma, one library effect's held-out evidence still
   // exceeds the targeted test's level (significance^2 = 25). With the right sigma, 30 clean
@@ -178,7 +283,26 @@ Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d
     }
   } else if (excess) {
     scale.note += d.explained() ? "; not applied: the chosen effect explains the gap (only repeated runs would tell scatter apart)"
-                              : "; not applied: the gaps are alike between neighbouring runs (structure, not scatter)";
+                              : rho_sigma >= o.structure_threshold_sigma
+                                  ? "; not applied: the gaps are alike between neighbouring runs (structure, not scatter)"
+                                  : "; not applied: the gaps depend on " + structure.factor + " (structure, not scatter)";
+  } else if (!d.gap_significant) {
+    // The other tail: with V right, the nominal gap's chi^2 = r^T V^-1 r is chi^2 with n
+    // degrees of freedom exactly (the coefficients' errors are in V, not taken out). Below its
+    // quantile at kNuisanceTail the covariance is too large (the stated sigma, or the
+    // simulation's accuracy, model_accuracy), and a gap may hide beneath it: said, never
+    // "no gap", and not applied (a smaller sigma is the lab's to state).
+    const double low = boost::math::quantile(boost::math::chi_squared(n), kNuisanceTail);
+    if (d.chi2_nominal < low) {
+      scale.value = std::sqrt(d.chi2_nominal / n), scale.sigma = scale.value / std::sqrt(2.0 * n);
+      scale.significant = true;
+      char buf[240];
+      std::snprintf(buf, sizeof buf,
+                    "; the covariance is overstated: the nominal gap's chi^2 %.4g for %d runs is below its %.3g %% quantile %.4g "
+                    "(the stated sigma or model_accuracy too large; not applied)",
+                    d.chi2_nominal, n, 100 * kNuisanceTail, low);
+      scale.note += buf;
+    }
   }
   return scale;
 }

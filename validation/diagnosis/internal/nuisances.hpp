@@ -12,6 +12,7 @@
 //        sigma falls short by (from repeats, else from the gaps), whether it is beyond chance
 //        and, when it is scatter, the diagnosis judged again with the sigma scaled.
 #include <functional>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -34,9 +35,24 @@ std::pair<double, int> neighbour_correlation(const Campaign& c, const std::vecto
 // scatter over the stated sigma (chi^2 about each group's weighted mean), and its degrees of freedom.
 std::pair<double, int> repeat_scatter(const Campaign& c);
 
+// Whether gaps w (one per run of c) look like scatter, w_i independent N(0, s^2) with one
+// unknown s: grouped by frequency, by amplitude, by direction, by static orientation and by
+// time order (quarters of the runs by time_h when every run has one, else in the file's
+// order), each factor with at least two groups of at least two runs is tested twice, its
+// groups' means (sum n_g mean_g^2 / s^2, chi^2 with G degrees of freedom) and spreads
+// (Bartlett's statistic about the known mean 0, chi^2 with G - 1), s^2 the mean of w^2. The
+// smallest p times the number of tests (Bonferroni: the family's level) as a normal deviate.
+struct ScatterStructure {
+  std::string factor;  // the factor of the strongest departure ("" when none was testable)
+  std::string test;    // "means" or "spreads"
+  double sigma = 0;    // the family's p as a normal deviate (0 when none was testable)
+  int tests = 0;
+};
+ScatterStructure scatter_structure(const Campaign& c, const std::vector<double>& w);
+
 struct SigmaScaleOptions {
-  double simulation_rel_accuracy = 0.002;  // the simulation's error over its prediction, in each run's sigma as in z's
-  double structure_threshold_sigma = 3;    // gaps whose neighbours correlate below this (normal deviate) are scatter
+  double structure_threshold_sigma = 3;    // gaps are scatter when neither their neighbours' correlation nor
+                                           // scatter_structure reaches this (normal deviate)
   double threshold_sigma = 5;              // a library effect's evidence beyond its square, judged again: a physical gap
 };
 

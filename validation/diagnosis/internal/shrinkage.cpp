@@ -4,14 +4,18 @@
 
 namespace vrelab::validation::internal {
 
-void shrinkage_before(const Eigen::VectorXd& heldout_nominal, const Data& data, Diagnosis& d) {
+void shrinkage_before(const Eigen::VectorXd& heldout_nominal, const Eigen::VectorXd& heldout_floor2, const Data& data,
+                      Diagnosis& d) {
   const int n = static_cast<int>(heldout_nominal.size());
-  double ss_b = 0, zs_b = 0;
+  double ss_b = 0, zs_b = 0, ss_f = 0, zs_f = 0;
   for (int k = 0; k < n; ++k) {
     ss_b += heldout_nominal(k) * heldout_nominal(k), zs_b += heldout_nominal(k) * heldout_nominal(k) / data.sigma2(k);
+    ss_f += heldout_floor2(k), zs_f += heldout_floor2(k) / data.sigma2(k);
     d.runs[static_cast<std::size_t>(k)].heldout_before_g = heldout_nominal(k);
+    d.runs[static_cast<std::size_t>(k)].heldout_floor_g = std::sqrt(heldout_floor2(k));
   }
   d.rms_before_g = std::sqrt(ss_b / n), d.rms_before_sigma = std::sqrt(zs_b / n);
+  d.rms_floor_g = std::sqrt(ss_f / n), d.rms_floor_sigma = std::sqrt(zs_f / n);
 }
 
 void shrinkage_after(const Scored& best_candidate, const Data& data, Diagnosis& d) {

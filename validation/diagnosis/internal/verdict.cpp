@@ -138,7 +138,7 @@ Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, c
       << o.threshold_sigma * o.threshold_sigma << ")";
     d.where += w.str();
   }
-  shrinkage_before(ev.heldout_nominal, data, d);
+  shrinkage_before(ev.heldout_nominal, ev.heldout_floor2, data, d);
   d.pair_evidence_margin = o.threshold_sigma * o.threshold_sigma;
   Chosen chosen = {{find_effect(best->fit.name), best->fit.values()}};
   Scored pair_best;
