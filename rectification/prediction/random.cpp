@@ -180,7 +180,10 @@ Eigen::Matrix3d cross_spectrum_g2_per_Hz(const vibration::RandomProfile& p, doub
   return cross_spectral_matrix_g2_per_Hz(p, f).real();
 }
 
-RandomResponse random_response(const vibration::RandomProfile& p, const ResponseAt& response, const RandomQuadrature& q) {
+RandomResponse random_response(const vibration::RandomProfile& p, const ResponseAt& response, const RandomQuadrature& q,
+                               const Eigen::Matrix3d& turn) {
+  if (!turn.allFinite()) throw std::invalid_argument("random_response: turn must be finite");
+  const bool turned = !turn.isIdentity(0.0);
   const PreparedTables tables = prepared_tables(p);
   if (!(q.max_log_step > 0)) throw std::invalid_argument("random_response: max_log_step must be positive");
   // Every table's breakpoints: the PSD is a power law between them (smooth in ln f), and
@@ -225,7 +228,8 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
       for (std::size_t n = 0; n < points; ++n) {
         const double f = std::exp(mid + 0.5 * h * (two ? kGl2X[n] : kGlX[n]));
         const double weight = 0.5 * h * (two ? kGl2W[n] : kGlW[n]) * f;  // df = f d(ln f)
-        const Eigen::Matrix3cd s = cross_spectral_matrix(p, tables, f);
+        Eigen::Matrix3cd s = cross_spectral_matrix(p, tables, f);
+        if (turned) s = turn * s * turn.transpose();
         if (s.isZero(0.0)) continue;
         const LoopResponse r = response(f);
         ++out.frequencies;

@@ -71,8 +71,11 @@ Eigen::Matrix3cd cross_spectral_matrix_g2_per_Hz(const vibration::RandomProfile&
 // Its real part (the covariance density of the input itself).
 Eigen::Matrix3d cross_spectrum_g2_per_Hz(const vibration::RandomProfile& p, double frequency_Hz);
 
+// turn: a fixed linear map of the motion in sensor axes, the same at every frequency (a
+// fixture's turn, validation's mounting_misalignment): the case moves as M x, S' = M S M^T.
+// The identity (default): the profile's motion as it is (the same numbers as without it).
 RandomResponse random_response(const vibration::RandomProfile& p, const ResponseAt& response,
-                               const RandomQuadrature& q = {});
+                               const RandomQuadrature& q = {}, const Eigen::Matrix3d& turn = Eigen::Matrix3d::Identity());
 RandomResponse random_response(const plant::PlantConfig& plant, const vibration::RandomProfile& p,
                                const RandomQuadrature& q = {});
 

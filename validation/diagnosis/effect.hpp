@@ -36,6 +36,10 @@ namespace vrelab::validation {
 // shaker set these.
 struct TableMotion {
   vibration::SineVibration sine;
+  // A random part's motion in sensor axes is random_turn times the profile's (S' = M S M^T,
+  // rectification::random_response): the table-motion effects that are a linear map the same
+  // at every frequency set it (mounting_misalignment); the identity otherwise.
+  Eigen::Matrix3d random_turn = Eigen::Matrix3d::Identity();
   std::vector<vibration::Harmonic> harmonics;  // vibration/decorators.hpp's HarmonicDistortion
   // Rocking of the fixture about OA, rad per g of commanded amplitude, in phase with the
   // table (negative: in antiphase); the sensor 30 mm from the axis along IA. The natural

@@ -5,6 +5,13 @@
 
 namespace vrelab::validation {
 
+namespace {
+// The turn about OA by a, then about PA by b, as a matrix: R_PA(b) R_OA(a).
+Eigen::Matrix3d turn_matrix(double a_rad, double b_rad) {
+  return (Eigen::AngleAxisd(b_rad, Vec3::UnitY()) * Eigen::AngleAxisd(a_rad, Vec3::UnitZ())).toRotationMatrix();
+}
+}  // namespace
+
 Effect effect_mounting_misalignment() {
   Effect e;
   e.name = "mounting_misalignment";
@@ -30,14 +37,14 @@ Effect effect_mounting_misalignment() {
     const Vec3 a = effects::signed_in_phase(m.sine);
     const Vec3 t(std::cos(a0) * a[0] - std::sin(a0) * a[1], std::sin(a0) * a[0] + std::cos(a0) * a[1], a[2]);
     effects::set_in_phase(m.sine, Vec3(std::cos(b0) * t[0] + std::sin(b0) * t[2], t[1], -std::sin(b0) * t[0] + std::cos(b0) * t[2]));
+    // A random part turned alike, its cross-spectra and all (S' = R S R^T).
+    m.random_turn = turn_matrix(a0, b0) * m.random_turn;
   };
   // The table's motion in sensor axes turned by the rotation matrices (the static gravity is
   // the run's stated orientation).
   e.truth = [](ParameterValues v, VirtualLab& lab) {
     if (v[0] == 0 && v[1] == 0) return;
-    const Eigen::Matrix3d turn =
-        (Eigen::AngleAxisd(v[1], Vec3::UnitY()) * Eigen::AngleAxisd(v[0], Vec3::UnitZ())).toRotationMatrix();
-    effects::set_phasors(lab.table, turn.cast<std::complex<double>>() * effects::phasors(lab.table));
+    effects::set_phasors(lab.table, turn_matrix(v[0], v[1]).cast<std::complex<double>>() * effects::phasors(lab.table));
   };
   e.draw = [](std::mt19937_64& rng) {
     const double s = effects::random_sign(rng);

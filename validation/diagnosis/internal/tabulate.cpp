@@ -48,7 +48,7 @@ rectification::PeriodicInput run_input(const RunRecord& r, const TableMotion& m)
 // already holds what a table-motion effect does.
 void apply_effect(const Effect* e, ParameterValues values, const RunRecord& r, PlantConfig& cfg, TableMotion& m) {
   if (!e || (motion_used(r) && e->acts_on == ActsOn::table_motion)) return;
-  e->apply(values, cfg, m);  // a random run: what the effect does to the table's motion is not applied
+  e->apply(values, cfg, m);  // a random part: only random_turn of what it does to the table's motion
 }
 
 Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e,
@@ -133,8 +133,8 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     std::optional<vibration::SineVibration> sine;
     std::optional<rectification::LoopResponse> sine_h;
     if (r.random) {
-      rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature);
-      if (r.sine_part) sine = measured_sine(r) ? m.sine : r.vibration(), sine_h = h(r.frequency_Hz);
+      rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature, m.random_turn);
+      if (r.sine_part) sine = m.sine, sine_h = h(r.frequency_Hz);
     }
     // Coefficients as identified, then the effect's own change of them (if any) on top.
     const Coefficients shift = [&] {
@@ -241,10 +241,10 @@ double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effe
     return it->second;
   };
   if (r.random) {
-    const rectification::RandomResponse rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature);
+    const rectification::RandomResponse rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature, m.random_turn);
     std::optional<vibration::SineVibration> sine;
     std::optional<rectification::LoopResponse> sine_h;
-    if (r.sine_part) sine = measured_sine(r) ? m.sine : r.vibration(), sine_h = h(r.frequency_Hz);
+    if (r.sine_part) sine = m.sine, sine_h = h(r.frequency_Hz);
     return rectification::random_rectification_at_frequency(cfg, r.orientation_g, rr, sine, sine_h).total_g();
   }
   return rectification::periodic_rectification(cfg, r.orientation_g, rectification::film_harmonic_balance(with_films, cfg, run_input(r, m), h), h)
