@@ -68,8 +68,8 @@ void run_measure(const MeasureOptions& o, std::ostream& out) {
   rectification::SeriesWindows w;
   w.on_from_s = o.on_s[0], w.on_to_s = o.on_s[1];
   w.baseline_from_s = o.baseline_s[0], w.baseline_to_s = o.baseline_s[1];
-  w.frequency_Hz = o.frequency_Hz, w.K1 = o.K1, w.blocks = o.blocks, w.input_rms_g = o.input_rms_g;
-  const io::MeasureStudy s = io::measure(o.series_path, o.column, w);
+  w.frequency_Hz = o.frequency_Hz, w.blocks = o.blocks, w.input_rms_g = o.input_rms_g;
+  const io::MeasureStudy s = io::measure(o.series_path, o.column, w, o.K1);
   out << io::measure_report(s);
   write_json(o.json_path, io::measure_json(s));
 }

@@ -45,7 +45,7 @@ struct MeasureOptions {
   std::string json_path;
   std::vector<double> on_s, baseline_s;  // [from, to] each
   double frequency_Hz = 0;
-  double K1 = 1;
+  std::optional<double> K1;  // nullopt: the series' stated K1, else output in g
   std::string column;  // output column name; default the last column
   int blocks = 4;
   double input_rms_g = 0;  // > 0: the VRC is reported too

@@ -124,7 +124,9 @@ Command add_measure(CLI::App& app) {
       ->expected(2)
       ->required();
   cmd->add_option("--frequency", o.frequency_Hz, "Sine frequency in Hz: measure over whole periods");
-  cmd->add_option("--K1", o.K1, "Scale factor, output units per g (default 1: output in g)");
+  cmd->add_option("--K1", o.K1,
+                  "Scale factor, output units per g (default: the series' comment 'K1 = 1.25 mA/g' as shake --series "
+                  "writes it, else 1: output in g; refused for an output_<unit> column other than g)");
   cmd->add_option("--column", o.column, "Output column name (default: the one output_* column or dataset, else the last column)");
   cmd->add_option("--blocks", o.blocks, "Blocks for the batch-means uncertainty (default 4)");
   cmd->add_option("--input-rms-g", o.input_rms_g,

@@ -247,7 +247,7 @@ json measure_json(const MeasureStudy& s) {
   j["program"] = program_record();
   j["command"] = "measure";
   j["settings"] = series_windows_json(w);
-  j["series"] = {{"file", s.path}, {"column", s.column}, {"K1", w.K1}};
+  j["series"] = {{"file", s.path}, {"column", s.column}, {"K1", w.K1}, {"K1_unit", s.K1_unit}, {"K1_source", s.K1_source}};
   j["windows"] = {{"baseline_s", {w.baseline_from_s, w.baseline_to_s}},
                   {"on_s", {w.on_from_s, r.on_to_used_s}},
                   {"frequency_Hz", w.frequency_Hz > 0 ? json(w.frequency_Hz) : json(nullptr)},

@@ -489,9 +489,22 @@ std::string ratio(double x, int digits = 4) { return std::isfinite(x) ? fmt::for
 
 }  // namespace
 
-MeasureStudy measure(const std::string& series_path, const std::string& column, const rectification::SeriesWindows& w) {
-  if (std::string why; !w.IsValid(&why)) throw InputError("measure: " + why);
+MeasureStudy measure(const std::string& series_path, const std::string& column, rectification::SeriesWindows w,
+                     std::optional<double> K1) {
   MeasureStudy s;
+  // The scale factor: given, else the one the series states, else none (output in g).
+  const std::optional<StatedScaleFactor> stated = stated_scale_factor(series_path);
+  if (K1) {
+    w.K1 = *K1, s.K1_source = "--K1";
+    if (stated) s.K1_unit = stated->unit;
+    if (stated && std::abs(stated->K1 - *K1) > 1e-12 * std::abs(*K1))
+      s.K1_note = fmt::format("the series states K1 = {:g} {}/g (line {}); --K1 {:g} used", stated->K1, stated->unit, stated->line, *K1);
+  } else if (stated) {
+    w.K1 = stated->K1, s.K1_unit = stated->unit, s.K1_source = fmt::format("stated by the series, line {}", stated->line);
+  } else {
+    w.K1 = 1, s.K1_unit = "g", s.K1_source = "none given: output in g";
+  }
+  if (std::string why; !w.IsValid(&why)) throw InputError("measure: " + why);
   s.path = series_path;
   s.windows = w;
   rectification::SeriesMeasurer m(w);
@@ -517,6 +530,17 @@ MeasureStudy measure(const std::string& series_path, const std::string& column, 
     for (int i = 0; i < 3; ++i) sum[i] += g[static_cast<std::size_t>(i)], sum2[i] += g[static_cast<std::size_t>(i)] * g[static_cast<std::size_t>(i)];
   };
   s.column = read_series(series_path, column, [&m](double t, double u) { m.add(t, u); }, ref);
+  // An output in other units than g read as g would be off by K1 without a word.
+  if (const std::string unit = output_unit_of(s.column); !unit.empty()) {
+    if (!K1 && !stated && unit != "g")
+      throw InputError(fmt::format("{}: the output column '{}' is in {}, not g, and no scale factor is given: give --K1 ({} per g) "
+                                   "or a comment line '# K1 = <value> {}/g' before the header",
+                                   series_path, s.column, unit, unit, unit));
+    if (stated && unit != stated->unit)
+      throw InputError(fmt::format("{}:{}: the comment states K1 in {}/g, the output column '{}' is in {}", series_path,
+                                   stated->line, stated->unit, s.column, unit));
+    if (s.K1_unit.empty()) s.K1_unit = unit;
+  }
   if (n_ref > 1) {
     const double n = static_cast<double>(n_ref);
     for (int i = 0; i < 3; ++i) s.reference_rms_g[i] = std::sqrt(std::max(0.0, sum2[i] / n - (sum[i] / n) * (sum[i] / n)));
@@ -555,7 +579,9 @@ std::string measure_report(const MeasureStudy& s) {
   const rectification::SeriesWindows& w = s.windows;
   const rectification::SeriesResult& r = s.result;
   std::string out = fmt::format("vrelab {} ({}) measure {}\n", kProgramVersion, kGitDescribe, s.path);
-  out += fmt::format("Output column '{}', K1 = {:g} per g; sample rate {:.6g} Hz\n", s.column, w.K1, r.sample_rate_Hz);
+  out += fmt::format("Output column '{}', K1 = {:g} {}/g ({}); sample rate {:.6g} Hz\n", s.column, w.K1,
+                     s.K1_unit.empty() ? "output units" : s.K1_unit, s.K1_source, r.sample_rate_Hz);
+  if (!s.K1_note.empty()) out += "  Note: " + s.K1_note + "\n";
   out += fmt::format("Baseline [{:g}, {:g}) s: {} samples, mean {:.9f} g\n", w.baseline_from_s, w.baseline_to_s,
                      r.samples_baseline, r.baseline_g);
   out += fmt::format("Vibration [{:g}, {:g}) s{}: {} samples\n", w.on_from_s, r.on_to_used_s,

@@ -46,7 +46,11 @@ ShakeStudy shake(const Case& c, const rectification::SampleSink& sink);
 std::string shake_report(const Case& c, const ShakeStudy& s);
 
 // ---- measure: the vibration error of a recorded series (io/formats/csv.hpp).
-MeasureStudy measure(const std::string& series_path, const std::string& column, const rectification::SeriesWindows& w);
+// K1: the scale factor (output units per g); nullopt: the one the series states in a comment
+// (`# ... K1 = 1.25 mA/g`), else 1 (output in g), refused (InputError) when the output column
+// says another unit (output_mA) and nothing states K1.
+MeasureStudy measure(const std::string& series_path, const std::string& column, rectification::SeriesWindows w,
+                     std::optional<double> K1 = std::nullopt);
 std::string measure_report(const MeasureStudy& s);
 
 // ---- sweep: a grid of shaker runs into a resumable CSV file.

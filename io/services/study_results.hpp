@@ -50,6 +50,9 @@ struct ShakeStudy {
 // ---- measure: the vibration error of a recorded series (io/formats/csv.hpp).
 struct MeasureStudy {
   std::string path, column;
+  // windows.K1's unit (output units per g; "" unknown), where it came from ("--K1", "stated by
+  // the series, line 2", "none given: output in g") and a note when the two disagreed.
+  std::string K1_unit, K1_source, K1_note;
   rectification::SeriesWindows windows;
   rectification::SeriesResult result;
   // With reference channels (io/formats/csv.hpp ReferenceSink): the measured motion over the vibration

@@ -34,6 +34,7 @@ random_lab() {  # random_lab <name>: a fresh copy of the hand-written campaign w
 }
 measure_args=(--on 1,2 --baseline 0,1 --frequency 10)
 record=$src/fuzz/corpus/raw_csv/three-axes-sine  # 10 Hz along IA from t = 1 s, three reference axes
+k1=(--K1 1.25)  # its output_mA states no scale factor: measure needs one
 
 # ---- Paths that are not regular files: refused before they are opened.
 random_lab fifo
@@ -88,13 +89,24 @@ expect 2 "big-ref\.csv:311:3: column ref_IA_g: -200000 g is outside a reference 
 # ---- A header naming a column twice; reference channels that do not give the VRC.
 expect 2 "ref-column-twice:1:4: column 'ref_IA_g' appears twice in the header \(columns 3 and 4\)" measure "$src/fuzz/corpus/raw_csv/ref-column-twice" "${measure_args[@]}"
 cut -d, -f1,2,4 "$record" >"$tmp/pa-only.csv"
-expect 2 "pa-only\.csv: the reference channels cover PA only \(none for IA, OA\): without the input axis IA's channel .*give ref_IA_g \(or all three channels\) or --input-rms-g" measure "$tmp/pa-only.csv" "${measure_args[@]}"
-expect 0 "per axis \[-, [0-9.e+-]+, -\]; -: no channel" measure "$tmp/pa-only.csv" "${measure_args[@]}" --input-rms-g 1.414
+expect 2 "pa-only\.csv: the reference channels cover PA only \(none for IA, OA\): without the input axis IA's channel .*give ref_IA_g \(or all three channels\) or --input-rms-g" measure "$tmp/pa-only.csv" "${measure_args[@]}" "${k1[@]}"
+expect 0 "per axis \[-, [0-9.e+-]+, -\]; -: no channel" measure "$tmp/pa-only.csv" "${measure_args[@]}" "${k1[@]}" --input-rms-g 1.414
 check "no nan or inf printed with one reference axis" bash -c "! grep -Eiq '(^|[^a-z])(nan|inf)([^a-z]|\$)' '$tmp/out'"
 cut -d, -f1,2,3 "$record" >"$tmp/ia-only.csv"  # the drive axis alone: the VRC from its rms, the others' ratios "-"
-expect 0 "per axis \[[0-9.e+-]+, -, -\]; -: no channel" measure "$tmp/ia-only.csv" "${measure_args[@]}"
+expect 0 "per axis \[[0-9.e+-]+, -, -\]; -: no channel" measure "$tmp/ia-only.csv" "${measure_args[@]}" "${k1[@]}"
 check "no nan or inf printed with the IA reference alone" bash -c "! grep -Eiq '(^|[^a-z])(nan|inf)([^a-z]|\$)' '$tmp/out'"
-expect 0 "VRC \(input rms 1\.41[0-9]* g, reference channels\)" measure "$record" "${measure_args[@]}"
+expect 0 "VRC \(input rms 1\.41[0-9]* g, reference channels\)" measure "$record" "${measure_args[@]}" "${k1[@]}"
+
+# ---- An output in mA is not read as g: refused without a scale factor, the one the series
+# states used (shake --series writes "# ...; K1 = 1.25 mA/g; ...").
+expect 2 "three-axes-sine: the output column 'output_mA' is in mA, not g, and no scale factor is given: give --K1 \(mA per g\)" measure "$record" "${measure_args[@]}"
+{ echo "# output in mA; K1 = 1.25 mA/g"; cat "$record"; } >"$tmp/stated.csv"
+expect 0 "Output column 'output_mA', K1 = 1\.25 mA/g \(stated by the series, line 1\)" measure "$tmp/stated.csv" "${measure_args[@]}"
+expect 0 "Note: the series states K1 = 1\.25 mA/g \(line 1\); --K1 2 used" measure "$tmp/stated.csv" "${measure_args[@]}" --K1 2
+{ echo "# K1 = 1.25 V/g"; cat "$record"; } >"$tmp/stated-v.csv"
+expect 2 "stated-v\.csv:1: the comment states K1 in V/g, the output column 'output_mA' is in mA" measure "$tmp/stated-v.csv" "${measure_args[@]}"
+{ echo "# K1 = -3 mA/g"; cat "$record"; } >"$tmp/stated-neg.csv"
+expect 2 "stated-neg\.csv:1: the comment states K1 = '-3': a scale factor is a positive number" measure "$tmp/stated-neg.csv" "${measure_args[@]}"
 
 # ---- Results that are not finite: the command fails naming the quantity.
 expect 2 "the result /[a-z_/0-9]+ is not a finite number \(inf\)" measure "$record" "${measure_args[@]}" --K1 1e-320

@@ -69,6 +69,7 @@ TEST(LabWindows, MeasureAndDiagnoseReadAHalfOpenWindowAlike) {
   mo.baseline_s = {-0.5, 0.0};
   mo.frequency_Hz = 10;
   mo.blocks = 8;
+  mo.K1 = 1.0;  // the record's output_mA read as it stands
   std::ostringstream text;
   app::run_measure(mo, text);
   const json m = json::parse(read_file(mo.json_path));
