@@ -526,6 +526,9 @@ PYBIND11_MODULE(_core, m) {
                              "The measured vibration error <U/K1 under vibration> - U/K1 at rest, g.")
       .def_property_readonly("sigma_g", [](const ShakeResult& r) { return r.s.result.sigma_g; }, "Its standard uncertainty (batch means), g.")
       .def_property_readonly("predicted_g", [](const ShakeResult& r) { return r.s.predicted_g; }, "Eq. (3) corrected with the truth's coefficients, g.")
+      .def_property_readonly("predicted_frequency_dependent_g", [](const ShakeResult& r) { return r.s.frequency_dependent_g; },
+                             "Eq. (3) through the plant's dynamics (predict --frequency-dependent), g; None for a sweep, shaker "
+                             "imperfections or a Gaussian given by its rms.")
       .def_property_readonly("integral_slope_g", [](const ShakeResult& r) { return r.s.result.integral_slope_g; },
                              "The paper's estimate: slope of the running integral, g.")
       .def_property_readonly("method", [](const ShakeResult& r) { return r.s.result.method; }, "\"continuous integral\" or \"sampled record\".")

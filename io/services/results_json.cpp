@@ -206,6 +206,7 @@ json shake_json(const Case& c, const ShakeStudy& s) {
   j["measured_g"] = r.measured_g;
   j["sigma_g"] = r.sigma_g;
   j["predicted_eq3_g"] = s.predicted_g;
+  j["predicted_frequency_dependent_g"] = s.frequency_dependent_g ? nlohmann::json(*s.frequency_dependent_g) : nlohmann::json();
   j["integral_slope_g"] = r.integral_slope_g;
   j["baseline_g"] = r.baseline_g;
   const double rms = vibration_input_rms_g(*c.vibration);  // the commanded motion's
@@ -236,7 +237,7 @@ json shake_json(const Case& c, const ShakeStudy& s) {
                        {"path", r.path},
                        {"shooting_iterations", r.shooting_iterations},
                        {"simulated_s", r.simulated_s}};
-  j["units"] = {{"measured_g", "g"}, {"sigma_g", "g"}, {"predicted_eq3_g", "g"}, {"input_rms_g", "g"}, {"vrc_ug_per_g2", "ug/g^2"}};
+  j["units"] = {{"measured_g", "g"}, {"sigma_g", "g"}, {"predicted_eq3_g", "g"}, {"predicted_frequency_dependent_g", "g"}, {"input_rms_g", "g"}, {"vrc_ug_per_g2", "ug/g^2"}};
   return j;
 }
 

@@ -43,6 +43,10 @@ struct ShakeStudy {
   rectification::ShakerMotion table;
   rectification::ShakeResult result;
   double predicted_g = 0;  // eq. (3) corrected, the truth's coefficients
+  // Eq. (3) through the plant's dynamics (predict --frequency-dependent) for a sine on a
+  // perfect shaker, a random or a sine-on-random run given by PSD tables; nullopt otherwise
+  // (a sweep, shaker imperfections, a Gaussian given by its rms).
+  std::optional<double> frequency_dependent_g;
   double wall_s = 0;
   double cpu_s = 0;  // CPU time of the run's own thread (CLOCK_THREAD_CPUTIME_ID)
 };

@@ -90,6 +90,9 @@ def test_shake_equals_cli(tmp_path):
     assert strip_times(r.to_dict()) == strip_times(d)
     # eq. (3) holds at 5 Hz (1 % of the loop crossover): the measured error is the prediction.
     assert r.measured_g == pytest.approx(r.predicted_g, rel=1e-3)
+    # Through the loop as the JSON has it, and closer still to the ODE at 5 Hz.
+    assert r.predicted_frequency_dependent_g == d["predicted_frequency_dependent_g"]
+    assert abs(r.measured_g - r.predicted_frequency_dependent_g) <= abs(r.measured_g - r.predicted_g)
 
 
 def test_diagnose_equals_cli(tmp_path):
