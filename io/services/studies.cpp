@@ -132,6 +132,53 @@ std::string identify_table(const Case& c, const validation::StaticTestReport& r)
   return out;
 }
 
+// The datasheet form of a coefficient's unit (IEEE Std 1293 style): model (1)'s g-based
+// units times 1e6 (k0 in ug, k2 in ug/g^2, k3 in ug/g^3, a misalignment in urad); the scale
+// factor as it is. {unit, factor}.
+std::pair<std::string, double> datasheet_unit(int i, const Case& c) {
+  const std::string u(plant::coefficient_info()[i].unit);
+  if (u == "g") return {"ug", 1e6};
+  if (u == "1") return {"ug/g", 1e6};
+  if (u == "1/g") return {"ug/g^2", 1e6};
+  if (u == "1/g^2") return {"ug/g^3", 1e6};
+  if (u == "1/g^3") return {"ug/g^4", 1e6};
+  if (u == "rad") return {"urad", 1e6};
+  return {unit_of(i, c), 1.0};
+}
+
+// Least squares' estimates in datasheet units, and every other method's estimate that departs
+// from it by more than 5 of that method's sigma (the same readings: a gap that size is the
+// method's own error, e.g. the printed k2 formula's, not noise).
+std::string identify_datasheet(const Case& c, const validation::StaticTestReport& r) {
+  const validation::MethodResult* ls = nullptr;
+  for (const auto& m : r.methods)
+    if (m.name == "least_squares") ls = &m;
+  if (!ls) return "";
+  std::string out = "\nDatasheet form (least_squares, IEEE Std 1293 units), estimate +- sigma:\n";
+  for (int i = 0; i < kNumCoefficients; ++i) {
+    if (!ls->estimate.available[i]) continue;
+    const auto [unit, f] = datasheet_unit(i, c);
+    const std::string name(plant::coefficient_name(i));
+    out += ls->estimate.assumed[i]
+               ? fmt::format("  {:<10}{:>14.6g} {:<8} (given)\n", name, ls->estimate.value[i] * f, unit)
+               : fmt::format("  {:<10}{:>14.6g} {:<8} +- {:.3g}\n", name, ls->estimate.value[i] * f, unit, ls->first_order.sigma[i] * f);
+  }
+  for (const auto& m : r.methods) {
+    if (&m == ls) continue;
+    for (int i = 0; i < kNumCoefficients; ++i) {
+      if (!m.estimate.available[i] || m.estimate.assumed[i] || !ls->estimate.available[i]) continue;
+      const double sigma = m.first_order.sigma[i], d = m.estimate.value[i] - ls->estimate.value[i];
+      if (!(sigma > 0) || !(std::abs(d) > 5 * sigma)) continue;
+      const auto [unit, f] = datasheet_unit(i, c);
+      out += fmt::format("  warning: {}'s {} = {:.4g} {} departs from least squares' {:.4g} {} by {:.3g} of its sigma: "
+                         "that method's own error, not the instrument (docs/identification.md)\n",
+                         m.name, plant::coefficient_name(i), m.estimate.value[i] * f, unit, ls->estimate.value[i] * f, unit,
+                         std::abs(d) / sigma);
+    }
+  }
+  return out;
+}
+
 std::string identify_monte_carlo(const Case& c, const IdentifyStudy& s) {
   std::string out = fmt::format("\nUncertainty: first-order propagation vs Monte Carlo ({} trials, seed {})\n",
                                 s.settings.monte_carlo_trials, c.seed + 1);
@@ -176,6 +223,7 @@ std::string identify_report(const Case& c, const IdentifyStudy& s) {
   if (!fixed_list.empty()) out += "  fixed at known values: " + fixed_list + "\n";
   for (const auto& n : r.notes) out += "  note: " + n + "\n";
   out += "\n" + identify_table(c, r);
+  out += identify_datasheet(c, r);
   if (s.settings.monte_carlo_trials > 0) out += identify_monte_carlo(c, s);
   return out;
 }

@@ -80,6 +80,30 @@ TEST(CliIdentify, OtherPositionSetsRunLeastSquaresOnlyAndSaySo) {
   EXPECT_NE(j["notes"][0].get<std::string>().find("3 x 8"), std::string::npos);
 }
 
+// The datasheet form: least squares' estimates times 1e6 in ug, ug/g^2, ug/g^3, urad (read
+// back from the text against the JSON's 1/g values); the printed method's k2 (the sum over
+// the wrong positions, docs/identification.md: about 1 instead of 1.5e-5) flagged, the
+// corrected method's estimates (within a few sigma of least squares') not.
+TEST(CliIdentify, TheDatasheetFormIsInMicroGAndThePrintedK2IsFlagged) {
+  TempDir d;
+  IdentifyOptions o;
+  o.case_path = std::string(VRELAB_CASES_DIR) + "/paper-static.toml";
+  o.json_path = (d.path / "identify.json").string();
+  std::ostringstream text;
+  run_identify(o, text);
+  const std::string t = text.str();
+  const json j = json::parse(read_file(o.json_path));
+  const json& ls = j["estimates"]["least_squares"];
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(t, m, std::regex(R"(\n  k2 +(-?[0-9.e+-]+) ug/g\^2 +\+- ([0-9.e+-]+)\n)"))) << t;
+  const double k2 = ls["k2"].get<double>();
+  EXPECT_NEAR(std::stod(m[1]), k2 * 1e6, 1e-5 * std::abs(k2 * 1e6));  // printed to 6 digits
+  ASSERT_TRUE(std::regex_search(t, m, std::regex(R"(\n  delta_OA +(-?[0-9.e+-]+) urad )"))) << t;
+  EXPECT_NEAR(std::stod(m[1]), ls["delta_OA"].get<double>() * 1e6, 1e-3);
+  EXPECT_TRUE(std::regex_search(t, std::regex(R"(warning: paper_printed's k2 = 1\.00[0-9]*e\+06 ug/g\^2 departs)"))) << t;
+  EXPECT_EQ(t.find("warning: paper_corrected"), std::string::npos) << t;
+}
+
 TEST(CliPredict, WritesTotalAndTermsThatAddUp) {
   TempDir d;
   PredictOptions o;
