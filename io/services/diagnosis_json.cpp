@@ -430,17 +430,20 @@ json to_json(const validation::BlindResult& r) {
 }
 
 std::string confusion_csv(const validation::BlindResult& r) {
+  // Columns: every verdict blind can call (ambiguous and error too); rows: clean, the library,
+  // two, then every other truth the run met (natural forms, out-of-library effects by name,
+  // the nuisance and dynamics families), so that no campaign is left out.
   std::vector<std::string> called_names = {"clean"};
   for (const auto& n : r.library) called_names.push_back(n);
-  called_names.push_back("two_effects");  // any "A + B" verdict
-  called_names.push_back("unexplained");
+  for (const char* n : {"two_effects", "ambiguous", "unexplained", "error"}) called_names.push_back(n);  // two_effects: any "A + B"
   std::string csv = "# rows: the hidden truth; columns: what diagnose called it (without the key)\ntruth";
   for (const auto& n : called_names) csv += "," + n;
   csv += "\n";
   std::vector<std::string> truths = {"clean"};
   for (const auto& n : r.library) truths.push_back(n);
-  truths.push_back("out_of_library");
   truths.push_back("two");
+  for (const auto& [t, row] : r.confusion)
+    if (std::find(truths.begin(), truths.end(), t) == truths.end()) truths.push_back(t);
   for (const auto& t : truths) {
     csv += t;
     const auto row = r.confusion.find(t);
@@ -479,14 +482,17 @@ std::string blind_html(const validation::BlindResult& r) {
                    "right physics, not the right effect; unexplained; no gap; confidently wrong (explained by an effect of "
                    "another physics); ambiguous (the truth among them).</p>\n",
                    r.settings.n, r.settings.seed, r.wall_s, r.threads);
-  h += "<h2>Issue 15's rates</h2>\n<p>The 95 % interval is Clopper-Pearson's (exact binomial): what a run of this size "
+  h += "<h2>Rates against their targets</h2>\n<p>The 95 % interval is Clopper-Pearson's (exact binomial): what a run of this size "
        "can tell. \"met\" compares the rate itself with the target.</p>\n<table><tr><th class=\"l\">criterion</th><th>k/n</th>"
        "<th>rate</th><th>95 % interval</th><th>target</th><th></th></tr>\n";
   for (const auto& c : r.Criteria())
-    h += fmt::format("<tr><td class=\"l\">{}</td><td>{}/{}</td><td>{:.1f} %</td><td>{:.1f} &ndash; {:.1f} %</td><td>{} {:.0f} %</td>"
-                     "<td class=\"{}\">{}</td></tr>\n",
-                     html_escape(c.name), c.k, c.n, 100 * c.rate(), 100 * c.ci95.lo, 100 * c.ci95.hi, c.at_least ? "&ge;" : "&le;",
-                     100 * c.target, c.n == 0 ? "" : c.met() ? "ok" : "bad", c.n == 0 ? "no campaigns" : c.met() ? "met" : "not met");
+    h += c.n == 0 ? fmt::format("<tr><td class=\"l\">{}</td><td>0/0</td><td>&ndash;</td><td>&ndash;</td><td>{} {:.0f} %</td>"
+                                "<td>no campaigns</td></tr>\n",
+                                html_escape(c.name), c.at_least ? "&ge;" : "&le;", 100 * c.target)
+                  : fmt::format("<tr><td class=\"l\">{}</td><td>{}/{}</td><td>{:.1f} %</td><td>{:.1f} &ndash; {:.1f} %</td>"
+                                "<td>{} {:.0f} %</td><td class=\"{}\">{}</td></tr>\n",
+                                html_escape(c.name), c.k, c.n, 100 * c.rate(), 100 * c.ci95.lo, 100 * c.ci95.hi,
+                                c.at_least ? "&ge;" : "&le;", 100 * c.target, c.met() ? "ok" : "bad", c.met() ? "met" : "not met");
   h += "</table>\n";
   h += "<h2>Per family</h2>\n<table><tr><th class=\"l\">family</th><th>n</th><th>right</th><th>right physics</th>"
        "<th>unexplained</th><th>no gap</th><th>confidently wrong</th><th>ambiguous</th><th>(right among)</th><th>error</th>"

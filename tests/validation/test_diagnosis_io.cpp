@@ -62,10 +62,27 @@ TEST(Blind, ConfusionCsvCountsPairVerdictsAsTwoEffects) {
   r.confusion["two"]["a + b"] = 2;
   r.confusion["two"]["b"] = 1;
   r.confusion["a"]["a"] = 3;
+  // Truths beyond the library's rows (blind --n 4 once left its out-of-library campaign out)
+  // and the verdicts beyond its columns.
+  r.confusion["clipping (out of library)"]["unexplained"] = 1;
+  r.confusion["a (natural form)"]["ambiguous"] = 1;
+  r.confusion["sigma_understated"]["error"] = 1;
   const std::string csv = io::confusion_csv(r);
-  EXPECT_NE(csv.find("truth,clean,a,b,two_effects,unexplained\n"), std::string::npos) << csv;
-  EXPECT_NE(csv.find("\na,0,3,0,0,0\n"), std::string::npos) << csv;
-  EXPECT_NE(csv.find("\ntwo,0,0,1,2,0\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("truth,clean,a,b,two_effects,ambiguous,unexplained,error\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\na,0,3,0,0,0,0,0\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\ntwo,0,0,1,2,0,0,0\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\nclipping (out of library),0,0,0,0,0,1,0\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\na (natural form),0,0,0,0,1,0,0\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\nsigma_understated,0,0,0,0,0,0,1\n"), std::string::npos) << csv;
+  int counted = 0;  // every campaign (9) in the CSV's cells once
+  std::istringstream lines(csv);
+  std::string line;
+  while (std::getline(lines, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("truth,", 0) == 0) continue;
+    std::istringstream cells(line.substr(line.find(',') + 1));
+    for (std::string cell; std::getline(cells, cell, ',');) counted += std::stoi(cell);
+  }
+  EXPECT_EQ(counted, 9) << csv;
   r.settings.n = 3, r.settings.seed = 11;
   const nlohmann::json j = io::to_json(r);
   EXPECT_EQ(j["settings"]["n"], 3);

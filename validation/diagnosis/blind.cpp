@@ -764,11 +764,13 @@ std::string BlindResult::BriefReport() const {
   t += fmt::format("  median held-out shrinkage above the floor (the residuals' rms beyond what no effect removes; {} single "
                    "campaigns): {:.0f} %\n",
                    s.above_floor_campaigns, 100 * s.median_shrinkage_above_floor);
-  t += "Issue 15's rates (the 95 % interval is Clopper-Pearson's: what a run of this size can tell):\n";
+  t += "Rates against their targets (the 95 % interval is Clopper-Pearson's: what a run of this size can tell):\n";
   for (const BlindCriterion& c : Criteria())
-    t += fmt::format("  {:<72} {:>4}/{:<4} {:>5.1f} %  [{:5.1f}, {:5.1f}] %  target {} {:.0f} %: {}\n", c.name, c.k, c.n,
-                     100 * c.rate(), 100 * c.ci95.lo, 100 * c.ci95.hi, c.at_least ? ">=" : "<=", 100 * c.target,
-                     c.n == 0 ? "no campaigns" : c.met() ? "met" : "not met");
+    t += c.n == 0 ? fmt::format("  {:<72} {:>4}/{:<4} {:>7}  {:>16}  target {} {:.0f} %: no campaigns\n", c.name, c.k, c.n, "-", "-",
+                                c.at_least ? ">=" : "<=", 100 * c.target)
+                  : fmt::format("  {:<72} {:>4}/{:<4} {:>5.1f} %  [{:5.1f}, {:5.1f}] %  target {} {:.0f} %: {}\n", c.name, c.k,
+                                c.n, 100 * c.rate(), 100 * c.ci95.lo, 100 * c.ci95.hi, c.at_least ? ">=" : "<=", 100 * c.target,
+                                c.met() ? "met" : "not met");
   t += "Per family (right; right physics, not the right effect; unexplained; no gap; WRONG: explained by another physics):\n";
   t += FamilyTable();
   t += "The single and natural families sized by the largest run (its gap in its sigma):\n";
