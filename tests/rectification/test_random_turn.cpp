@@ -15,6 +15,7 @@
 #include "rectification/prediction/frequency.hpp"
 #include "rectification/prediction/random.hpp"
 #include "support/instrument.hpp"
+#include "support/vibrations.hpp"
 #include "vibration/random.hpp"
 
 namespace test_random_turn {
@@ -22,13 +23,6 @@ namespace test_random_turn {
 using namespace vrelab;
 
 namespace {
-
-vibration::PsdTable gevs_like(double scale) {
-  vibration::PsdTable t;
-  t.rows = {vibration::PsdRow::level(20, 0.026 * scale), vibration::PsdRow::level(50, 0.16 * scale),
-            vibration::PsdRow::level(800, 0.16 * scale), vibration::PsdRow::level(2000, 0.026 * scale)};
-  return t;
-}
 
 rectification::RandomResponse response(const vibration::RandomProfile& p, const Eigen::Matrix3d& turn) {
   const plant::PlantConfig cfg = test::paper_like_plant();
@@ -40,8 +34,8 @@ rectification::RandomResponse response(const vibration::RandomProfile& p, const 
 
 TEST(RandomTurn, TheInputCovarianceIsTurnedAndTheIdentityChangesNothing) {
   vibration::RandomProfile p;
-  p.psd[IA] = gevs_like(1.0);
-  p.psd[PA] = gevs_like(0.5);
+  p.psd[IA] = test::gevs_psd(1.0);
+  p.psd[PA] = test::gevs_psd(0.5);
   p.coupling = vibration::AxisCoupling::independent;
   const Eigen::Matrix3d m =
       (Eigen::AngleAxisd(-0.07, Vec3::UnitY()) * Eigen::AngleAxisd(0.12, Vec3::UnitZ())).toRotationMatrix();
@@ -60,14 +54,14 @@ TEST(RandomTurn, TheInputCovarianceIsTurnedAndTheIdentityChangesNothing) {
 
 TEST(RandomTurn, AOneAxisMotionTurnedIsTheHandBuiltProfileAlongItsNewDirection) {
   vibration::RandomProfile ia;
-  ia.psd[IA] = gevs_like(1.0);
+  ia.psd[IA] = test::gevs_psd(1.0);
   // About OA by +0.1 rad, then about PA by -0.05 rad: u = (0.993, 0.0998, 0.0497) > 0.
   const Eigen::Matrix3d m =
       (Eigen::AngleAxisd(-0.05, Vec3::UnitY()) * Eigen::AngleAxisd(0.1, Vec3::UnitZ())).toRotationMatrix();
   const Vec3 u = m.col(IA);
   ASSERT_GT(u.minCoeff(), 0.0);
   vibration::RandomProfile along;  // the same motion along u, by the tables
-  for (int i = 0; i < 3; ++i) along.psd[static_cast<std::size_t>(i)] = gevs_like(u[i] * u[i]);
+  for (int i = 0; i < 3; ++i) along.psd[static_cast<std::size_t>(i)] = test::gevs_psd(u[i] * u[i]);
   along.coupling = vibration::AxisCoupling::common;
   const rectification::RandomResponse turned = response(ia, m), by_hand = response(along, Eigen::Matrix3d::Identity());
   ASSERT_EQ(turned.frequencies, by_hand.frequencies);

@@ -10,11 +10,18 @@
 namespace vrelab::test {
 
 // GEVS: +6 dB/octave from 0.026 g^2/Hz at 20 Hz to 0.16 at 50 Hz, flat to 800 Hz, -6 dB/octave
-// to 0.026 at 2000 Hz (14.14 g rms).
-inline vibration::PsdTable gevs_psd() {
+// to 0.026 at 2000 Hz (14.14 g rms); every level times `scale` (the rms times its root).
+inline vibration::PsdTable gevs_psd(double scale = 1.0) {
   vibration::PsdTable t;
-  t.rows = {vibration::PsdRow::level(20, 0.026), vibration::PsdRow::level(50, 0.16), vibration::PsdRow::level(800, 0.16),
-            vibration::PsdRow::level(2000, 0.026)};
+  t.rows = {vibration::PsdRow::level(20, 0.026 * scale), vibration::PsdRow::level(50, 0.16 * scale),
+            vibration::PsdRow::level(800, 0.16 * scale), vibration::PsdRow::level(2000, 0.026 * scale)};
+  return t;
+}
+
+// A flat PSD of `level_g2_per_Hz` from from_Hz to to_Hz.
+inline vibration::PsdTable flat_psd(double from_Hz, double to_Hz, double level_g2_per_Hz) {
+  vibration::PsdTable t;
+  t.rows = {vibration::PsdRow::level(from_Hz, level_g2_per_Hz), vibration::PsdRow::level(to_Hz, level_g2_per_Hz)};
   return t;
 }
 

@@ -34,6 +34,7 @@
 #include "support/files.hpp"
 #include "support/hdf5_file.hpp"
 #include "support/instrument.hpp"
+#include "support/vibrations.hpp"
 #include "validation/diagnosis/campaign.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "vibration/decorators.hpp"
@@ -47,12 +48,6 @@ namespace fs = std::filesystem;
 using vrelab::test::write_h5;
 
 namespace {
-
-vibration::PsdTable flat(double level) {
-  vibration::PsdTable t;
-  t.rows = {vibration::PsdRow::level(20, level), vibration::PsdRow::level(500, level)};
-  return t;
-}
 
 plant::PlantConfig truth() {
   plant::PlantConfig p = test::paper_like_linear_plant();
@@ -70,8 +65,8 @@ struct OdeRun {
 // The random table: IA the drive, PA half of it 0.5 ms late plus an independent 0.3 part.
 std::shared_ptr<const vibration::Excitation> coherent_transverse_random() {
   vibration::RandomProfile drive, noise;
-  drive.psd[IA] = flat(0.02);
-  noise.psd[PA] = flat(0.02 * 0.3 * 0.3);
+  drive.psd[IA] = test::flat_psd(20, 500, 0.02);
+  noise.psd[PA] = test::flat_psd(20, 500, 0.02 * 0.3 * 0.3);
   const auto ia = std::make_shared<vibration::RandomExcitation>(drive, 4000, 6001);
   const auto pa = std::make_shared<vibration::RandomExcitation>(noise, 4000, 6002);
   vibration::TransverseSpec across;

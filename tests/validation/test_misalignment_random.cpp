@@ -17,6 +17,7 @@
 
 #include "rectification/simulation/shake.hpp"
 #include "support/instrument.hpp"
+#include "support/vibrations.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/effect.hpp"
 #include "vibration/random.hpp"
@@ -28,12 +29,6 @@ using namespace vrelab;
 using namespace vrelab::validation;
 
 namespace {
-
-vibration::PsdTable flat_band(double level) {
-  vibration::PsdTable t;
-  t.rows = {vibration::PsdRow::level(20, level), vibration::PsdRow::level(500, level)};
-  return t;
-}
 
 plant::PlantConfig cross_terms_only() {
   plant::PlantConfig p = test::paper_like_linear_plant();
@@ -60,7 +55,7 @@ TEST(MisalignmentRandom, TheHypothesisTurnsTheRandomPartAndLeavesItAtZero) {
 TEST(MisalignmentRandomCampaign, ARandomRunsTurnIsWhatTheOdeMeasuresOnTheTurnedMotion) {
   const double level = 0.05;  // g^2/Hz over 20-500 Hz: 4.9 g rms
   vibration::RandomProfile ia;
-  ia.psd[IA] = flat_band(level);
+  ia.psd[IA] = test::flat_psd(20, 500, level);
   const plant::PlantConfig cfg = cross_terms_only();
   RunRecord r;
   r.id = "random-ia";
@@ -78,7 +73,7 @@ TEST(MisalignmentRandomCampaign, ARandomRunsTurnIsWhatTheOdeMeasuresOnTheTurnedM
   const Vec3 u = turn.col(IA);
   ASSERT_GT(u.minCoeff(), 0.0);  // the hand-built profile needs every component >= 0
   vibration::RandomProfile along;
-  for (int i = 0; i < 3; ++i) along.psd[static_cast<std::size_t>(i)] = flat_band(level * u[i] * u[i]);
+  for (int i = 0; i < 3; ++i) along.psd[static_cast<std::size_t>(i)] = test::flat_psd(20, 500, level * u[i] * u[i]);
   along.coupling = vibration::AxisCoupling::common;
   const vibration::RandomExcitation motion(along, 4000, 17);
   rectification::ShakeSettings s;
