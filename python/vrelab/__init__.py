@@ -46,13 +46,13 @@ from . import _core
 
 def _find_plot_scripts():
     """The library finds its plot scripts beside the running program, which here is Python:
-    point it (VRELAB_PLOTS_DIR, unless set) at the build tree's share/vrelab/plots
-    (build/python/vrelab -> build/share/vrelab/plots) or the installed prefix's
-    (<prefix>/lib/python3.X/dist-packages/vrelab -> <prefix>/share/vrelab/plots)."""
+    point it (VRELAB_PLOTS_DIR, unless set) at the package's own vrelab/plots (pip install),
+    the build tree's share/vrelab/plots (build/python/vrelab -> build/share/vrelab/plots) or
+    the installed prefix's (<prefix>/lib/python3.X/dist-packages/vrelab -> <prefix>/share/vrelab/plots)."""
     if os.environ.get("VRELAB_PLOTS_DIR"):
         return
     here = os.path.dirname(os.path.realpath(__file__))
-    for up in ("../../share/vrelab/plots", "../../../../share/vrelab/plots"):
+    for up in ("plots", "../../share/vrelab/plots", "../../../../share/vrelab/plots"):
         d = os.path.normpath(os.path.join(here, up))
         if os.path.isfile(os.path.join(d, "reproduce.py")):
             os.environ["VRELAB_PLOTS_DIR"] = d
@@ -60,6 +60,44 @@ def _find_plot_scripts():
 
 
 _find_plot_scripts()
+
+# What a result's repr shows: its headline attributes, units in their names (g, s), so that a
+# notebook or the REPL prints "<vrelab.PredictResult total_g=0.00012 ...>" rather than an address.
+_REPR_FIELDS = {
+    "PredictResult": ("total_g", "frequency_dependent_g"),
+    "ShakeResult": ("measured_g", "sigma_g", "predicted_g", "predicted_frequency_dependent_g"),
+    "IdentifyResult": ("methods", "rank", "condition_number"),
+    "Diagnosis": ("verdict", "chosen", "rms_before_g", "rms_after_g", "rms_floor_g"),
+    "FrequencyResult": ("mechanisms",),
+    "ReproduceResult": ("out_dir", "report_html", "figures_missing"),
+    "CampaignWritten": ("out_dir", "statics", "runs", "seed"),
+    "SweepRun": ("conditions", "ran", "written", "failures", "path"),
+}
+
+
+def _repr_value(v):
+    if isinstance(v, float):
+        return "%.6g" % v
+    if isinstance(v, (list, tuple)) and len(v) > 4:
+        return "[%s, ... %d in all]" % (", ".join(_repr_value(x) for x in v[:3]), len(v))
+    if isinstance(v, (list, tuple)):
+        return "[%s]" % ", ".join(_repr_value(x) for x in v)
+    return repr(v)
+
+
+def _make_repr(name, fields):
+    def __repr__(self):
+        shown = []
+        for f in fields:
+            v = getattr(self, f)
+            if v is not None:
+                shown.append("%s=%s" % (f, _repr_value(v)))
+        return "<vrelab.%s %s>" % (name, " ".join(shown))
+    return __repr__
+
+
+for _name, _fields in _REPR_FIELDS.items():
+    setattr(getattr(_core, _name), "__repr__", _make_repr(_name, _fields))
 
 __all__ = [
     "Case", "InputError", "SolverError", "load_case", "case_toml", "identify", "predict", "shake",
@@ -84,11 +122,53 @@ def load_case(case, name=None):
     raise TypeError("a case is a path, a dict of tables or a vrelab.Case, not %s" % type(case).__name__)
 
 
+def _signature(fn):
+    """inspect.Signature of a pybind11 function from its docstring's first line,
+    'name(a: T, b: T = default) -> R' (pybind11 gives builtins no __signature__), with `case`
+    annotated as every form _wrap takes; None where the line does not parse."""
+    import ast
+    import inspect
+    first = (fn.__doc__ or "").split("\n", 1)[0]
+    head, sep, ret = first.partition(") -> ")
+    if not sep or "(" not in head:
+        return None
+    params, depth, cur = [], 0, ""
+    for ch in head.split("(", 1)[1]:
+        depth += 1 if ch in "[(" else -1 if ch in "])" else 0
+        if ch == "," and depth == 0:
+            params.append(cur.strip())
+            cur = ""
+        else:
+            cur += ch
+    if cur.strip():
+        params.append(cur.strip())
+    out = []
+    for text in params:
+        decl, has_default, default_text = text.partition(" = ")
+        name, _, annotation = decl.partition(": ")
+        if not name.isidentifier():
+            return None
+        default = inspect.Parameter.empty
+        if has_default:
+            try:
+                default = ast.literal_eval(default_text)
+            except (ValueError, SyntaxError):
+                default = default_text
+        if name == "case":
+            annotation = "vrelab.Case | str | os.PathLike | dict"
+        out.append(inspect.Parameter(name, inspect.Parameter.POSITIONAL_OR_KEYWORD, default=default,
+                                     annotation=annotation or inspect.Parameter.empty))
+    return inspect.Signature(out, return_annotation=ret.strip())
+
+
 def _wrap(fn):
     """Lets fn take a path or a dict where it takes a Case (help() shows fn's signature and units)."""
     @functools.wraps(fn)
     def call(case, *args, **kwargs):
         return fn(load_case(case), *args, **kwargs)
+    sig = _signature(fn)
+    if sig is not None:
+        call.__signature__ = sig  # what inspect, IDEs and notebooks show
     call.__doc__ = (fn.__doc__ or "") + (
         "\n\ncase: a vrelab.Case, a case file path (str or os.PathLike) or a dict of tables "
         "(vrelab.load_case). Bad input raises vrelab.InputError (a ValueError) with the CLI's "

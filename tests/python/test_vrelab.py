@@ -66,6 +66,29 @@ def test_predict_equals_cli(tmp_path):
     assert vrelab.predict(path).to_dict() == cli_json(tmp_path, "predict", path)
 
 
+def test_results_print_their_headline_not_an_address():
+    p = vrelab.predict(case("paper-predict.toml"))
+    text = repr(p)
+    assert text.startswith("<vrelab.PredictResult total_g=") and " at 0x" not in text
+    assert ("total_g=%.6g" % p.total_g) in text
+    d = vrelab.diagnose(os.path.join(CASES, "lab-example"))
+    text = repr(d)
+    assert text.startswith("<vrelab.Diagnosis verdict=") and repr(d.verdict) in text and " at 0x" not in text
+
+
+def test_signatures_are_what_the_calls_take():
+    import inspect
+    for fn, params in ((vrelab.predict, ["case", "frequency_dependent"]), (vrelab.identify, ["case", "monte_carlo", "seed"]),
+                       (vrelab.shake, ["case", "series", "seed"]), (vrelab.frequency, ["case"])):
+        sig = inspect.signature(fn)
+        assert list(sig.parameters) == params, (fn.__name__, sig)
+    sig = inspect.signature(vrelab.predict)
+    assert sig.parameters["frequency_dependent"].default is False
+    # The signature's names are the call's keywords: bound and called, the same result.
+    bound = sig.bind(case("shake-sine.toml"), frequency_dependent=True)
+    assert vrelab.predict(*bound.args, **bound.kwargs).frequency_dependent_g is not None
+
+
 def test_frequency_dependent_predict_equals_cli(tmp_path):
     path = case("shake-sine.toml")
     r = vrelab.predict(path, frequency_dependent=True)
