@@ -181,7 +181,7 @@ struct RunDiagnosis {
   double gap_g = 0, sigma_g = 0;                  // measured - predicted; sigma from V's diagonal
   double adjusted_gap_g = 0;  // the gap the static test's coefficient errors cannot take up (all runs)
   double z = 0;               // adjusted_gap_g over the run's own sigma (measurement, simulation accuracy)
-  double sigma_simulation_g = 0;  // the simulation's accuracy: model_accuracy x the nominal prediction
+  double sigma_simulation_g = 0;  // the simulation's accuracy: model_accuracy x the run's best estimate (docs/diagnose.md, "Covariance")
   double sigma_adjusted_g = 0;    // adjusted_gap_g's own sd with no gap (less than sigma: the coefficients take up a share)
   double heldout_before_g = 0;                    // the gap the coefficient errors cannot take up (nominal), held out
   double heldout_after_g = 0;                     // the same with the chosen effect, fitted without this run's fold

@@ -126,7 +126,7 @@ void nominal_model(const Identified& id, CampaignModel& m) {
   }
 
 
-  // The nominal simulation; the simulation's own accuracy at its prediction joins each run's variance.
+  // The nominal simulation; the simulation's own accuracy at each run's best estimate joins its variance.
   m.nominal = tabulate(plant, c.runs, nullptr, 0, cache, absorbed);
   add_simulation_accuracy(data, m.nominal, m.simulation_rel_accuracy);
   m.all.resize(static_cast<std::size_t>(n));

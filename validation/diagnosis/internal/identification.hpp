@@ -10,8 +10,8 @@
 //        the readings' sigma; the runs' data (measured g, variance g^2, the coefficients'
 //        covariance); what the static test takes up of each library effect that acts at rest
 //        (coefficient units per unit of its parameter); the nominal simulation's table of the
-//        runs; and the runs' variances with the simulation's own, (relative accuracy x nominal
-//        prediction)^2, added. Throws std::invalid_argument without static readings or runs,
+//        runs; and the runs' variances with the simulation's own, (relative accuracy x the
+//        run's best estimate)^2, added (likelihood.hpp, best_estimate). Throws std::invalid_argument without static readings or runs,
 //        or when the readings do not determine the free coefficients.
 #include <vector>
 
@@ -23,7 +23,7 @@ namespace vrelab::validation::internal {
 
 // The identification from the static readings, weighted by their sigma, with its first-order
 // covariance, and the runs' data (sigma2 the runs' own variance: the simulation's accuracy is
-// added at the nominal prediction by nominal_model).
+// added at the runs' best estimate by nominal_model).
 struct Identified {
   std::vector<Position> positions;
   std::vector<double> weights;

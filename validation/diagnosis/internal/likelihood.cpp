@@ -50,8 +50,16 @@ Eigen::VectorXd adjusted_residual(const Data& d, const Eigen::VectorXd& pred, co
   return sub(d.measured, at) - sub(pred, at) - rows(G, at) * dc;
 }
 
+Eigen::VectorXd best_estimate(const Data& d, const Table& nominal) {
+  std::vector<int> all(static_cast<std::size_t>(d.measured.size()));
+  for (std::size_t k = 0; k < all.size(); ++k) all[k] = static_cast<int>(k);
+  const Eigen::VectorXd dc = factored(d, nominal.G, all).conditional_mean(d.measured - nominal.pred);
+  return nominal.pred + nominal.G * dc;
+}
+
 void add_simulation_accuracy(Data& d, const Table& nominal, double f) {
-  d.sigma2 = d.sigma2.array() + (f * nominal.pred.array()).square();
+  if (f == 0) return;
+  d.sigma2 = d.sigma2.array() + (f * best_estimate(d, nominal).array()).square();
 }
 
 // chi^2 with n degrees of freedom as a normal deviate (Wilson-Hilferty).

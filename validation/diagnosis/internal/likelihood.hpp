@@ -4,7 +4,7 @@
 // "Covariance" and "The factored likelihood").
 //
 // Takes: the runs' measured vibration errors (g) and variances (g^2: the run's own plus the
-//        simulation's, (its relative accuracy x nominal prediction)^2), the static test's coefficient
+//        simulation's, (its relative accuracy x best estimate)^2), the static test's coefficient
 //        covariance Sigma (coefficient units^2), a table of predictions (g) and their gradient
 //        G in the coefficients (g per coefficient unit), and a subset of the runs (indices).
 // Gives: the residual's covariance V = diag(sigma2) + G Sigma G^T on the subset, -2 ln L and
@@ -29,12 +29,12 @@ struct Table {
 };
 
 // -2 log(likelihood) of the runs `idx` (up to a constant), with the residual's covariance
-// V = diag(sigma_run^2 + (f_model pred)^2) + G Sigma G^T; and chi^2 = r^T V^-1 r.
+// V = diag(sigma_run^2 + (f_model best)^2) + G Sigma G^T; and chi^2 = r^T V^-1 r.
 struct Likelihood {
   double m2logl = 0, chi2 = 0;
 };
 struct Data {
-  Eigen::VectorXd measured, sigma2;  // sigma2: the run's variance plus the simulation's own, (f_model pred_nominal)^2
+  Eigen::VectorXd measured, sigma2;  // sigma2: the run's variance plus the simulation's own, (f_model best_estimate)^2
   Eigen::MatrixXd Sigma;
 };
 
@@ -48,10 +48,14 @@ Likelihood likelihood(const Data& d, const Eigen::VectorXd& pred, const Eigen::M
 // the runs `at`.
 Eigen::VectorXd adjusted_residual(const Data& d, const Eigen::VectorXd& pred, const Eigen::MatrixXd& G,
                                   const std::vector<int>& from, const std::vector<int>& at);
-// The simulation's own accuracy joins each run's variance: sigma2 += (f pred_nominal)^2, fixed
-// at the nominal prediction for every effect, so that no effect can lower chi^2 by inflating
-// its predictions (docs/diagnose.md, "Covariance": what that costs at several g). d.sigma2
-// holds the runs' own variances on entry.
+// The runs' vibration error (g) as best the nominal model and every run know it: the nominal
+// prediction with the coefficients' correction that the runs (their variances d.sigma2) and
+// the static test's prior (d.Sigma) estimate, pred + G dc*. The static test alone pins k2..k4
+// poorly: its prediction at several g can be off by orders more than the runs' sigma.
+Eigen::VectorXd best_estimate(const Data& d, const Table& nominal);
+// The simulation's own accuracy joins each run's variance: sigma2 += (f best_estimate)^2, the
+// same for every effect, so that no effect can lower chi^2 by inflating its predictions
+// (docs/diagnose.md, "Covariance"). d.sigma2 holds the runs' own variances on entry.
 void add_simulation_accuracy(Data& d, const Table& nominal, double f);
 // chi^2 with n degrees of freedom as a normal deviate (Wilson-Hilferty).
 double chi2_as_sigma(double chi2, int n);
