@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <limits>
 #include <numbers>
 #include <set>
@@ -14,6 +15,7 @@
 #include <toml++/toml.h>
 
 #include "io/formats/case_file_internal.hpp"
+#include "io/formats/lab_data.hpp"
 #include "io/formats/paths.hpp"
 #include "plant/physical.hpp"
 
@@ -283,6 +285,67 @@ void read_reproduce(Table t, Case& c) {
   c.reproduce = r;
 }
 
+// [[campaign.random_runs]]: per table a PSD file (relative to the case file; the lab data
+// format's, docs/data-format.md), its coupling, an optional rms to scale it to (g, the motion's
+// magnitude), the static orientations (default: the design's; one run each) and an optional
+// sine on it (sine_frequency_Hz, sine_amplitude_g, sine_direction: all three or none).
+void read_random_runs(Table& t, validation::CampaignDesign& d) {
+  const toml::node* n = t.get("random_runs", false);
+  if (!n) return;
+  const toml::array* a = n->as_array();
+  if (!a || a->empty()) t.fail(n, "random_runs", "expected an array of tables [[campaign.random_runs]]");
+  int index = 0;
+  for (auto&& x : *a) {
+    ++index;
+    const toml::table* e = x.as_table();
+    if (!e) t.fail(&x, "random_runs", "expected a table");
+    Table rt(*e, "campaign.random_runs[" + std::to_string(index) + "]", t.file());
+    const std::string file = rt.string("psd", "");
+    if (file.empty()) rt.fail(nullptr, "psd", "missing (required): the PSD file (frequency_Hz, psd_IA_g2_per_Hz, ...)");
+    const std::string coupling = rt.string("coupling", "common");
+    if (coupling != "common" && coupling != "independent") rt.fail(rt.raw().get("coupling"), "coupling", "must be common or independent");
+    const std::filesystem::path path = std::filesystem::path(t.file()).parent_path() / file;
+    if (!std::filesystem::is_regular_file(path))
+      rt.fail(rt.raw().get("psd"), "psd", "no PSD file " + path.string() + " (the path is relative to the case file)");
+    validation::RandomRunDesign r;
+    r.profile = read_psd_file(path.string(), coupling);
+    r.psd_name = std::filesystem::path(file).stem().string();
+    if (const auto rms = rt.opt_number("rms_g")) {
+      if (!(*rms > 0)) rt.fail(rt.raw().get("rms_g"), "rms_g", "must be positive");
+      check_amplitude(rt, "rms_g", *rms);
+      double now2 = 0;
+      for (const auto& p : r.profile.psd)
+        if (p) now2 += std::pow(vibration::rms_g(*p), 2);
+      const double scale = *rms * *rms / now2;
+      for (auto& p : r.profile.psd)
+        if (p)
+          for (auto& row : p->rows)
+            if (row.psd_g2_per_Hz) *row.psd_g2_per_Hz *= scale;
+    }
+    const int sine_keys = rt.has("sine_frequency_Hz") + rt.has("sine_amplitude_g") + rt.has("sine_direction");
+    if (sine_keys != 0 && sine_keys != 3)
+      rt.fail(nullptr, "sine_frequency_Hz", "a sine on random needs sine_frequency_Hz, sine_amplitude_g and sine_direction");
+    if (sine_keys == 3) {
+      r.sine_part = true;
+      r.frequency_Hz = rt.number("sine_frequency_Hz");
+      r.amplitude_g = rt.number("sine_amplitude_g");
+      if (!(r.frequency_Hz > 0)) rt.fail(rt.raw().get("sine_frequency_Hz"), "sine_frequency_Hz", "must be positive");
+      if (!(r.amplitude_g > 0)) rt.fail(rt.raw().get("sine_amplitude_g"), "sine_amplitude_g", "must be positive");
+      check_amplitude(rt, "sine_amplitude_g", r.amplitude_g);
+      const auto dir = rt.opt_vec3("sine_direction");
+      if (!(dir->norm() > 0)) rt.fail(rt.raw().get("sine_direction"), "sine_direction", "must not be zero");
+      r.direction = dir->normalized();
+    }
+    std::vector<Vec3> orientations = vec3_list(rt, "orientations_g", false);
+    if (orientations.empty()) orientations = d.orientations_g;
+    rt.check_unknown({"psd", "coupling", "rms_g", "orientations_g", "sine_frequency_Hz", "sine_amplitude_g", "sine_direction"});
+    for (const Vec3& o : orientations) {
+      r.orientation_g = o;
+      d.random_runs.push_back(r);
+    }
+  }
+}
+
 void read_campaign(Table t, Case& c) {
   CampaignSpec s;
   s.name = t.string("name", s.name);
@@ -333,8 +396,15 @@ void read_campaign(Table t, Case& c) {
     if (!(d.raw_record_s > 0)) t.fail(t.raw().get("raw_record_s"), "raw_record_s", "must be positive");
     d.raw_sample_rate_Hz = rate;
   }
+  d.random_record_s = t.non_negative("random_record_s", d.random_record_s);
+  if (!(d.random_record_s > 0) || d.random_record_s > 3600)
+    t.fail(t.raw().get("random_record_s"), "random_record_s", "must lie in (0, 3600] s");
+  read_random_runs(t, d);
+  if (s.raw_series && !d.random_runs.empty())
+    t.fail(t.raw().get("random_runs"), "random_runs", "raw records of random runs are not made: leave raw_series out");
   t.check_unknown({"name", "hidden", "frequencies_Hz", "amplitudes_g", "directions", "orientations_g", "run_sigma_ug",
-                   "positions_per_series", "raw_series", "raw_sample_rate_Hz", "raw_noise_sigma_ug", "raw_record_s"});
+                   "positions_per_series", "raw_series", "raw_sample_rate_Hz", "raw_noise_sigma_ug", "raw_record_s",
+                   "random_runs", "random_record_s"});
   c.campaign = s;
 }
 

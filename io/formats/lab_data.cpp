@@ -546,16 +546,8 @@ std::optional<std::string> read_run_motion(RunRow& rr, VibrationKind kind, valid
   const auto o0 = rr.get("a_IA_g"), o1 = rr.get("a_PA_g"), o2 = rr.get("a_OA_g");
   if (!o0 || !o1 || !o2) return rr.missing();
   if (kind == VibrationKind::random) {
-    // No sine: frequency, amplitude and direction describe the PSD (its mean frequency,
-    // sqrt(2) x its rms, each axis's rms share); the row's cells are not read.
-    Vec3 rms = Vec3::Zero();
-    double moment1 = 0;
-    for (int i = 0; i < 3; ++i)
-      if (const auto& t = r.random->psd[static_cast<std::size_t>(i)]) {
-        rms[i] = vibration::rms_g(*t);
-        moment1 += vibration::psd_moment(vibration::resolve(*t), 1);
-      }
-    r.frequency_Hz = moment1 / rms.squaredNorm(), r.amplitude_g = std::sqrt(2.0) * rms.norm(), r.direction = rms.normalized();
+    // No sine: frequency, amplitude and direction describe the PSD; the row's cells are not read.
+    validation::describe_random_motion(r);
     r.orientation_g = Vec3(*o0, *o1, *o2);
   } else {
     const auto f = rr.get("frequency_Hz"), a = rr.get("amplitude_g"), d0 = rr.get("d_IA"), d1 = rr.get("d_PA"),
@@ -734,6 +726,32 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
 
 vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling) { return psd_file(path, coupling); }
 
+namespace {
+// A random run's PSD file (read_psd_file reads it back): the axes' tables at their shared
+// frequencies, levels resolved (straight lines on log-log axes between rows, as they were).
+std::string psd_file_text(const validation::RunRecord& r) {
+  std::string head = "frequency_Hz", body;
+  std::vector<vibration::ResolvedPsd> axes;
+  std::vector<int> moving;
+  for (int i = 0; i < 3; ++i)
+    if (const auto& t = r.random->psd[static_cast<std::size_t>(i)]) {
+      axes.push_back(vibration::resolve(*t));
+      moving.push_back(i);
+      head += fmt::format(",psd_{}_g2_per_Hz", i == 0 ? "IA" : i == 1 ? "PA" : "OA");
+    }
+  for (const auto& a : axes)
+    if (a.frequency_Hz != axes.front().frequency_Hz)
+      throw std::invalid_argument("write_campaign: run " + r.id + ": the axes' PSD tables must share their frequencies (one frequency_Hz column)");
+  for (std::size_t j = 0; j < axes.front().frequency_Hz.size(); ++j) {
+    body += fmt::format("{:.10g}", axes.front().frequency_Hz[j]);
+    for (const auto& a : axes) body += fmt::format(",{:.10g}", a.psd_g2_per_Hz[j]);
+    body += "\n";
+  }
+  return fmt::format("# {}'s random part: one-sided PSD per sensor axis, g^2/Hz (docs/data-format.md, \"Random runs\")\n{}\n{}",
+                     r.id, head, body);
+}
+}  // namespace
+
 void write_campaign(const std::string& dir, const validation::Campaign& c, const LabManifest& m,
                     const std::vector<RawSeriesRef>& raw_series, RawFormat raw_format) {
   std::vector<RawSeriesRef> raw = raw_series;
@@ -777,15 +795,34 @@ void write_campaign(const std::string& dir, const validation::Campaign& c, const
     st += fmt::format("{:.12g},{:.12g},{:.12g},{:.15g},{:.6g},1\n", s.orientation_g[0], s.orientation_g[1], s.orientation_g[2],
                       s.output, s.sigma_output);
   write_atomic(dir + "/static.csv", st);
+  const bool any_random = std::any_of(c.runs.begin(), c.runs.end(), [](const validation::RunRecord& r) { return r.random.has_value(); });
+  if (any_random && !raw.empty()) throw std::invalid_argument("write_campaign: raw records beside random runs are not written");
   std::string rn = "# shaker runs: sine, amplitude in g peak along d (sensor axes, in phase), static orientation a in g;\n"
                    "# measured vibration error and its sigma in ug, or a raw series (time_s, output) with its windows in s\n";
-  rn += raw.empty() ? "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,measured_ug,sigma_ug\n"
+  if (any_random)
+    rn += "# kind random: the PSD file's motion (frequency_Hz, amplitude_g and d_* empty); sine_on_random: the sine in\n"
+          "# frequency_Hz, amplitude_g, d_* and the random part in the PSD file; coupling of the random part's axes\n";
+  rn += raw.empty() ? std::string("id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,measured_ug,sigma_ug") +
+                          (any_random ? ",kind,psd,coupling\n" : "\n")
                     : "id,frequency_Hz,amplitude_g,d_IA,d_PA,d_OA,a_IA_g,a_PA_g,a_OA_g,series,rest_from_s,rest_to_s,on_from_s,on_to_s\n";
   for (std::size_t k = 0; k < c.runs.size(); ++k) {
     const auto& r = c.runs[k];
-    rn += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.12g},{:.12g},{:.12g},", r.id, r.frequency_Hz, r.amplitude_g,
-                      r.direction[0], r.direction[1], r.direction[2], r.orientation_g[0], r.orientation_g[1], r.orientation_g[2]);
-    if (raw.empty())
+    if (r.random && !r.sine_part)
+      rn += fmt::format("{},,,,,,{:.12g},{:.12g},{:.12g},", r.id, r.orientation_g[0], r.orientation_g[1], r.orientation_g[2]);
+    else
+      rn += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.12g},{:.12g},{:.12g},", r.id, r.frequency_Hz, r.amplitude_g,
+                        r.direction[0], r.direction[1], r.direction[2], r.orientation_g[0], r.orientation_g[1], r.orientation_g[2]);
+    if (any_random) {
+      rn += fmt::format("{:.10g},{:.6g},", r.measured_g * 1e6, r.sigma_g * 1e6);
+      if (!r.random) {
+        rn += "sine,,\n";
+        continue;
+      }
+      const std::string psd = "psd/" + r.id + ".csv";
+      write_atomic(dir + "/" + psd, psd_file_text(r));
+      rn += fmt::format("{},{},{}\n", r.sine_part ? "sine_on_random" : "random", psd,
+                        r.random->coupling == vibration::AxisCoupling::common ? "common" : "independent");
+    } else if (raw.empty())
       rn += fmt::format("{:.10g},{:.6g}\n", r.measured_g * 1e6, r.sigma_g * 1e6);
     else
       rn += fmt::format("{},{:.10g},{:.10g},{:.10g},{:.10g}\n", raw[k].file, raw[k].rest_from_s, raw[k].rest_to_s,

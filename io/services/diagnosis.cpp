@@ -32,8 +32,10 @@ CampaignWritten write_virtual_campaign(const CampaignRequest& request) {
   w.request.seed = c.seed;
   if (w.request.key_path.empty()) w.request.key_path = request.out_dir + ".key.json";
   const auto start = std::chrono::steady_clock::now();
-  core::Progress progress(std::cerr, "campaign", spec.design.frequencies_Hz.size() * spec.design.amplitudes_g.size() *
-                                                    spec.design.directions.size() * spec.design.orientations_g.size(),
+  core::Progress progress(std::cerr, "campaign",
+                          spec.design.frequencies_Hz.size() * spec.design.amplitudes_g.size() * spec.design.directions.size() *
+                                  spec.design.orientations_g.size() +
+                              spec.design.random_runs.size(),
                           request.progress);
   validation::Campaign camp =
       validation::simulate_campaign(c.plant, spec.hidden, spec.design, c.seed, 0, [&progress] { progress.tick(); });

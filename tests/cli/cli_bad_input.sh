@@ -86,6 +86,17 @@ expect 2 'samples.*set by --monte-carlo' identify "$cases/ideal-static.toml" --m
 sed 's/^frequencies_Hz = \[10.0, 40.0/frequencies_Hz = [10.0, 4.0e8/' "$cases/campaign.toml" >"$tmp/cf.toml"
 expect 2 'highest frequency 4e\+08 Hz, from \[campaign\] frequencies_Hz.*--no-work-limit' campaign "$tmp/cf.toml" --out "$tmp/o/cf"
 [ -e "$tmp/o/cf" ] && { echo "FAIL: campaign wrote a folder beyond the work limit"; fail=$((fail + 1)); }
+# [[campaign.random_runs]]: the PSD file relative to the case file, its keys checked by name.
+mkdir -p "$tmp/rr/psd" && cp "$cases/psd/gevs-ia.csv" "$tmp/rr/psd/"
+rr() { cat "$cases/campaign.toml" - >"$tmp/rr/$1.toml"; }
+printf '\n[[campaign.random_runs]]\npsd = "psd/nope.csv"\n' | rr nofile
+expect 2 'nofile.toml:[0-9]+: \[campaign.random_runs\[1\]\] psd: no PSD file .*psd/nope.csv' campaign "$tmp/rr/nofile.toml" --out "$tmp/o/rr1"
+printf '\n[[campaign.random_runs]]\npsd = "psd/gevs-ia.csv"\nrms_g = -1.0\n' | rr rms
+expect 2 'rms.toml:[0-9]+: \[campaign.random_runs\[1\]\] rms_g: must be positive' campaign "$tmp/rr/rms.toml" --out "$tmp/o/rr2"
+printf '\n[[campaign.random_runs]]\npsd = "psd/gevs-ia.csv"\nsine_amplitude_g = 2.0\n' | rr sine
+expect 2 'needs sine_frequency_Hz, sine_amplitude_g and sine_direction' campaign "$tmp/rr/sine.toml" --out "$tmp/o/rr3"
+sed 's/^run_sigma_ug = .*/random_record_s = 1e9/' "$cases/campaign.toml" >"$tmp/rr/rec.toml"
+expect 2 'random_record_s: must lie in \(0, 3600\] s' campaign "$tmp/rr/rec.toml" --out "$tmp/o/rr4"
 # Issue 13 item 6: min_measure_s = 1e9 is refused by its range, not overflowed in an int (which
 # would drop it and measure 4 periods).
 sed 's/^min_measure_s = .*/min_measure_s = 1e9/' "$cases/shake-sine-lab.toml" >"$tmp/measure.toml"

@@ -87,6 +87,11 @@ struct Campaign {
   std::vector<std::string> skipped;  // runs the reader could not use, each with why
 };
 
+// A random run (no sine part) described by its PSD for the grouping of the gap: frequency_Hz
+// its mean frequency (integral f G df / integral G df), amplitude_g sqrt(2) x the rms of the
+// motion's magnitude, direction each axis's rms share. std::invalid_argument without a random part.
+void describe_random_motion(RunRecord& r);
+
 // The table's motion of a run as the prediction takes it: the commanded sine, no imperfection.
 TableMotion table_motion(const RunRecord& r);
 

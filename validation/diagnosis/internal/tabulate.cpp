@@ -207,6 +207,18 @@ vibration::SineVibration RunRecord::vibration() const {
   return v;
 }
 
+void describe_random_motion(RunRecord& r) {
+  if (!r.random) throw std::invalid_argument("describe_random_motion: run " + r.id + " has no random part");
+  Vec3 rms = Vec3::Zero();
+  double moment1 = 0;
+  for (int i = 0; i < 3; ++i)
+    if (const auto& t = r.random->psd[static_cast<std::size_t>(i)]) {
+      rms[i] = vibration::rms_g(*t);
+      moment1 += vibration::psd_moment(vibration::resolve(*t), 1);
+    }
+  r.frequency_Hz = moment1 / rms.squaredNorm(), r.amplitude_g = std::sqrt(2.0) * rms.norm(), r.direction = rms.normalized();
+}
+
 namespace {
 double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effect* e, ParameterValues values);
 }  // namespace

@@ -1,0 +1,138 @@
+// The virtual lab's random and sine-on-random runs (CampaignDesign::random_runs): measured on the
+// ODE plant through the effects' truth hooks, they agree with what the diagnosis predicts of
+// the truth (predict_run_g: each term's Gaussian expectation through the plant's dynamics,
+// an independent path: no sample, no ODE), and they go through the lab data format and back
+// (kind, PSD file, coupling) as written (4 s in Release on the ODE: label "campaign"). The
+// shipped mixed campaign with a hidden k5 mostly in its random runs is diagnosed to it (label
+// "long").
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "io/formats/case_file.hpp"
+#include "io/formats/lab_data.hpp"
+#include "support/files.hpp"
+#include "support/instrument.hpp"
+#include "support/small_design.hpp"
+#include "support/vibrations.hpp"
+#include "validation/diagnosis/campaign.hpp"
+#include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
+
+namespace test_campaign_random {
+
+using namespace vrelab;
+using namespace vrelab::validation;
+
+namespace {
+
+// A flat 20-500 Hz table on IA (and PA, for the common two-axis run) at `level` g^2/Hz.
+vibration::RandomProfile flat(double level_g2_per_Hz, bool two_axes, vibration::AxisCoupling coupling) {
+  vibration::RandomProfile p;
+  p.psd[0] = test::flat_psd(20, 500, level_g2_per_Hz);
+  if (two_axes) p.psd[1] = test::flat_psd(20, 500, level_g2_per_Hz / 2);
+  p.coupling = coupling;
+  return p;
+}
+
+// 72 sine runs and three random ones: 4 g rms on IA, 3 + 2.1 g on IA and PA with common
+// phases, and a 2 g 100 Hz sine along IA on 3 g rms independent (each at a_IA = +0.71 g).
+CampaignDesign mixed_design(double record_s) {
+  CampaignDesign d = test::small_design();
+  const Vec3 o = Vec3(1, 0, 1).normalized();
+  RandomRunDesign a;
+  a.profile = flat(16.0 / 480, false, vibration::AxisCoupling::common), a.orientation_g = o;
+  RandomRunDesign b;
+  b.profile = flat(9.0 / 480, true, vibration::AxisCoupling::common), b.orientation_g = o;
+  RandomRunDesign c;
+  c.profile = flat(9.0 / 480, false, vibration::AxisCoupling::independent), c.orientation_g = o;
+  c.sine_part = true, c.frequency_Hz = 100, c.amplitude_g = 2, c.direction = Vec3::UnitX();
+  d.random_runs = {a, b, c};
+  d.random_record_s = record_s;
+  return d;
+}
+
+}  // namespace
+
+// Each random run against the diagnosis' prediction for the truth with its hidden k5 at the
+// key's value: within 4 of the run's sigma (the ODE's blocks and the lab's 0.3 ug; 4: three
+// runs, and the Gaussian expectation's own approximation is far below a record's scatter).
+// Then written and read back: the kind, coupling, PSD levels (10 digits) and the measured
+// error (10 digits of ug) as they were; the random run's description (mean frequency,
+// sqrt(2) x rms, direction) is the reader's, the same function.
+TEST(CampaignRandomRunsCampaign, AreMeasuredAsTheDiagnosisPredictsTheTruthAndReadBackAsWritten) {
+  plant::PlantConfig truth = test::paper_like_plant();
+  const HiddenEffect k5("higher_order_k5", 2e-7);
+  const Campaign c = simulate_campaign(truth, {k5}, mixed_design(8.0), 41, 2);
+  ASSERT_EQ(c.runs.size(), 75u);
+  const Effect& e = *find_effect("higher_order_k5");
+  for (std::size_t k = 72; k < 75; ++k) {
+    const RunRecord& r = c.runs[k];
+    ASSERT_TRUE(r.random.has_value());
+    const double predicted = predict_run_g(truth, r, e, k5.values(e));
+    const double without = predict_run_g(truth, r);
+    std::printf("  %s (%s): measured %.3f +- %.3f ug, predicted %.3f ug (k5's part %.3f ug)\n", r.id.c_str(),
+                r.sine_part ? "sine on random" : "random", r.measured_g * 1e6, r.sigma_g * 1e6, predicted * 1e6,
+                (predicted - without) * 1e6);
+    EXPECT_NEAR(r.measured_g, predicted, 4 * r.sigma_g) << r.id;
+    EXPECT_GT(std::abs(predicted - without), 4 * r.sigma_g) << r.id << ": k5 must be seen in the random runs";
+  }
+  EXPECT_FALSE(c.runs[72].sine_part);
+  EXPECT_TRUE(c.runs[74].sine_part);
+
+  test::TempDir dir;
+  io::LabManifest m;
+  io::write_campaign(dir.path.string(), c, m);
+  const Campaign back = io::read_campaign(dir.path.string());
+  ASSERT_TRUE(back.skipped.empty()) << back.skipped.front();
+  ASSERT_EQ(back.runs.size(), c.runs.size());
+  for (std::size_t k = 0; k < c.runs.size(); ++k) {
+    const RunRecord &a = c.runs[k], &b = back.runs[k];
+    EXPECT_NEAR(b.measured_g, a.measured_g, 1e-9 * std::abs(a.measured_g) + 1e-16) << a.id;
+    EXPECT_EQ(b.random.has_value(), a.random.has_value()) << a.id;
+    if (!a.random) continue;
+    EXPECT_EQ(b.sine_part, a.sine_part) << a.id;
+    EXPECT_EQ(b.random->coupling, a.random->coupling) << a.id;
+    EXPECT_NEAR(b.amplitude_g, a.amplitude_g, 1e-9 * a.amplitude_g) << a.id;
+    EXPECT_NEAR(b.frequency_Hz, a.frequency_Hz, 1e-9 * a.frequency_Hz) << a.id;
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_EQ(b.random->psd[static_cast<std::size_t>(i)].has_value(), a.random->psd[static_cast<std::size_t>(i)].has_value());
+      if (!a.random->psd[static_cast<std::size_t>(i)]) continue;
+      EXPECT_NEAR(vibration::rms_g(*b.random->psd[static_cast<std::size_t>(i)]), vibration::rms_g(*a.random->psd[static_cast<std::size_t>(i)]),
+                  1e-9)
+          << a.id << " axis " << i;
+    }
+  }
+}
+
+// The mixed campaign, cases/campaign-mixed.toml (36 sine, 11 random, 2 sine-on-random
+// runs; a hidden k5 of 4e-9 /g^4 whose gap lies mostly in the random runs: their z^2 sum 94
+// against the sine runs' 52 on seed 12), as `campaign` then `diagnose` make it: explained by
+// k5, within 2 of its sigma of the key's value. ~40 s in Release: label "long".
+TEST(CampaignRandomRunsLong, TheMixedCaseIsExplainedByItsHiddenK5) {
+  const io::Case k = io::read_case(std::string(VRELAB_CASES_DIR) + "/campaign-mixed.toml");
+  ASSERT_TRUE(k.campaign.has_value());
+  const Campaign c = simulate_campaign(k.plant, k.campaign->hidden, k.campaign->design, k.seed, 2);
+  EXPECT_EQ(c.runs.size(), 49u);
+  const Diagnosis d = diagnose(c);
+  std::printf("  %s; k5 %.4g +- %.2g (truth %.4g)\n", verdict_text(d).c_str(), d.effects.front().value, d.effects.front().sigma,
+              k.campaign->hidden.front().parameter);
+  EXPECT_EQ(verdict_text(d), "explained by higher_order_k5");
+  ASSERT_EQ(d.effects.front().name, "higher_order_k5");
+  EXPECT_NEAR(d.effects.front().value, k.campaign->hidden.front().parameter, 2 * d.effects.front().sigma);
+}
+
+// A hidden misalignment beside random runs: refused, naming why (the virtual lab does not
+// turn a random part; the hypothesis would).
+TEST(CampaignRandomRuns, AHiddenMisalignmentBesideRandomRunsIsRefused) {
+  try {
+    simulate_campaign(test::paper_like_plant(), {{"mounting_misalignment", 0.05}}, mixed_design(1.0), 42, 1);
+    FAIL() << "no exception";
+  } catch (const std::invalid_argument& x) {
+    EXPECT_NE(std::string(x.what()).find("mounting_misalignment"), std::string::npos) << x.what();
+  }
+}
+
+}  // namespace test_campaign_random
