@@ -3,9 +3,10 @@
 The library and the module are compiled in Release by CMake for the interpreter running pip
 (-DPython_EXECUTABLE), in build-python/<interpreter tag>/ under the source tree, so a second
 `pip install` rebuilds only what changed. VRELAB_BUILD_DIR names an existing build folder
-instead (e.g. setup.sh's build/): its module is taken as built there, after checking that it
-was built for this interpreter. CMAKE_ARGS adds CMake options; VRELAB_BUILD_JOBS the parallel
-jobs (default: all cores). The plot scripts (tools/plots) are installed as vrelab/plots.
+instead (e.g. setup.sh's build/): its module is taken as that build made it (nothing is
+compiled; build it first), after checking that it was built for this interpreter.
+CMAKE_ARGS adds CMake options; VRELAB_BUILD_JOBS the parallel jobs (default: all cores).
+The plot scripts (tools/plots) are installed as vrelab/plots.
 """
 import glob
 import os
@@ -33,7 +34,7 @@ class CMakeBuild(build_ext):
     def build_extension(self, ext):
         suffix = sysconfig.get_config_var("EXT_SUFFIX")
         given = os.environ.get("VRELAB_BUILD_DIR")
-        if given:
+        if given:  # the module as that build made it: nothing is compiled here
             build_dir = os.path.abspath(given)
             if not os.path.isfile(os.path.join(build_dir, "CMakeCache.txt")):
                 sys.exit("setup.py: VRELAB_BUILD_DIR=%s is not a configured CMake build folder" % build_dir)
@@ -44,8 +45,8 @@ class CMakeBuild(build_ext):
             self._cmake(["cmake", "-S", HERE, "-B", build_dir, *generator, "-DCMAKE_BUILD_TYPE=Release",
                       "-DVRELAB_TESTS=OFF", "-DVRELAB_BENCH=OFF", "-DVRELAB_PYTHON=ON",
                       "-DPython_EXECUTABLE=" + sys.executable, *os.environ.get("CMAKE_ARGS", "").split()])
-        jobs = os.environ.get("VRELAB_BUILD_JOBS", str(os.cpu_count() or 1))
-        self._cmake(["cmake", "--build", build_dir, "--target", "vrelab_python", "-j", jobs])
+            jobs = os.environ.get("VRELAB_BUILD_JOBS", str(os.cpu_count() or 1))
+            self._cmake(["cmake", "--build", build_dir, "--target", "vrelab_python", "-j", jobs])
         built = os.path.join(build_dir, "python", "vrelab", "_core" + suffix)
         if not os.path.isfile(built):
             found = glob.glob(os.path.join(build_dir, "python", "vrelab", "_core*"))

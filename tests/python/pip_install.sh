@@ -4,7 +4,7 @@
 # build tools from Debian), `pip install --no-build-isolation --no-index SRC`, then from
 # another folder: the installed package is the one imported (not build/python or setup.sh's
 # .pth), its version is CMake's, its plot scripts are found, and a prediction is eq. (3) by hand.
-# The module is taken from BUILD (VRELAB_BUILD_DIR: the build ctest runs in, already compiled);
+# The module is taken from BUILD as built (VRELAB_BUILD_DIR: the build ctest runs in; nothing compiled);
 # pip's own build from nothing, CMake and all, is the same setup.py without it (docs/python.md).
 # Usage: pip_install.sh SRC BUILD PYTHON VERSION
 set -euo pipefail
