@@ -309,7 +309,6 @@ void read_random_runs(Table& t, validation::CampaignDesign& d) {
       rt.fail(rt.raw().get("psd"), "psd", "no PSD file " + path.string() + " (the path is relative to the case file)");
     validation::RandomRunDesign r;
     r.profile = read_psd_file(path.string(), coupling);
-    r.psd_name = std::filesystem::path(file).stem().string();
     if (const auto rms = rt.opt_number("rms_g")) {
       if (!(*rms > 0)) rt.fail(rt.raw().get("rms_g"), "rms_g", "must be positive");
       check_amplitude(rt, "rms_g", *rms);

@@ -732,11 +732,9 @@ namespace {
 std::string psd_file_text(const validation::RunRecord& r) {
   std::string head = "frequency_Hz", body;
   std::vector<vibration::ResolvedPsd> axes;
-  std::vector<int> moving;
   for (int i = 0; i < 3; ++i)
     if (const auto& t = r.random->psd[static_cast<std::size_t>(i)]) {
       axes.push_back(vibration::resolve(*t));
-      moving.push_back(i);
       head += fmt::format(",psd_{}_g2_per_Hz", i == 0 ? "IA" : i == 1 ? "PA" : "OA");
     }
   for (const auto& a : axes)

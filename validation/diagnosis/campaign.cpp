@@ -82,14 +82,22 @@ VirtualLab truth_lab(const plant::PlantConfig& truth, const std::vector<HiddenEf
 
 // The design's random and sine-on-random runs appended to c.runs (a random run described by
 // its PSD); std::invalid_argument for what the virtual lab does not make.
-void add_random_runs(const CampaignDesign& design, const std::vector<HiddenEffect>& hidden, bool raw, Campaign& c) {
+void add_random_runs(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden, const CampaignDesign& design,
+                     bool raw, Campaign& c) {
   if (design.random_runs.empty()) return;
   if (raw) throw std::invalid_argument("campaign: random_runs: raw records of random runs are not made (summaries only)");
   if (!(design.random_record_s > 0)) throw std::invalid_argument("campaign: random_record_s: must be positive");
-  for (const HiddenEffect& h : hidden)
-    if (h.name == "mounting_misalignment")
-      throw std::invalid_argument("campaign: random_runs: the virtual lab does not turn a random part by a hidden "
-                                  "mounting_misalignment (the diagnosis' hypothesis does): hide it in a design of sine runs");
+  // A hidden effect whose hypothesis turns a random part (TableMotion::random_turn): the truth
+  // hooks move the sine only, so the lab would not do what the hypothesis says.
+  for (const HiddenEffect& h : hidden) {
+    const Effect& e = *find_effect(h.name);
+    plant::PlantConfig p = truth;
+    TableMotion m;
+    e.apply(h.values(e), p, m);
+    if (!m.random_turn.isIdentity())
+      throw std::invalid_argument("campaign: random_runs: the virtual lab does not turn a random part by a hidden " + h.name +
+                                  " (the diagnosis' hypothesis does): hide it in a design of sine runs");
+  }
   for (const RandomRunDesign& rd : design.random_runs) {
     vibration::validate(rd.profile);
     RunRecord r;
@@ -168,7 +176,7 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
   // Random and sine-on-random runs, after the sine runs (their noise draws come after the sine
   // runs': a design without them draws as before).
   const bool raw = design.raw_sample_rate_Hz > 0;
-  add_random_runs(design, hidden, raw, c);
+  add_random_runs(truth, hidden, design, raw, c);
   std::vector<double> noise(c.runs.size());
   for (double& x : noise) x = n01(rng);
   if (raw) c.raw.resize(c.runs.size());

@@ -51,10 +51,9 @@ HiddenEffect draw_hidden_natural(const Effect& e, std::mt19937_64& rng);
 // A random or sine-on-random run of the design (docs/data-format.md, "Random and
 // sine-on-random runs"): the random part's PSD tables (g^2/Hz per sensor axis) and coupling,
 // the static orientation (g) and, for sine on random, the sine (Hz, g peak, direction in
-// sensor axes; the two parts independent). psd_name names the PSD file the lab folder writes.
+// sensor axes; the two parts independent).
 struct RandomRunDesign {
   vibration::RandomProfile profile;
-  std::string psd_name = "psd";
   Vec3 orientation_g = Vec3::UnitZ();
   bool sine_part = false;
   double frequency_Hz = 0, amplitude_g = 0;
@@ -77,8 +76,8 @@ struct CampaignDesign {
   // plus Gaussian noise of run_sigma_g, its sigma the blocks' and run_sigma_g in quadrature.
   // Plant and acquisition effects act on them as on sine runs; of the table-motion effects,
   // the sine of a sine-on-random run takes them, the random part none (as the diagnosis'
-  // hypotheses, docs/data-format.md), so a hidden mounting_misalignment, which the hypothesis
-  // turns a random part by, is refused beside random runs (std::invalid_argument). Summaries
+  // hypotheses, docs/data-format.md), so a hidden effect whose hypothesis turns a random part
+  // (mounting_misalignment) is refused beside random runs (std::invalid_argument). Summaries
   // only: raw records of random runs are refused.
   std::vector<RandomRunDesign> random_runs;
   double random_record_s = 16.0;
