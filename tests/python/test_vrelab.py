@@ -54,6 +54,12 @@ def case(name):
     return os.path.join(CASES, name)
 
 
+@pytest.fixture(scope="module")
+def lab_example():
+    """vrelab.diagnose of cases/lab-example, once for the tests that read it (~3 s of CPU each)."""
+    return vrelab.diagnose(case("lab-example"))
+
+
 def test_version_is_the_programs():
     out = cli("--version").stdout
     assert vrelab.__version__ in out and vrelab.git_describe in out
@@ -66,12 +72,12 @@ def test_predict_equals_cli(tmp_path):
     assert vrelab.predict(path).to_dict() == cli_json(tmp_path, "predict", path)
 
 
-def test_results_print_their_headline_not_an_address():
+def test_results_print_their_headline_not_an_address(lab_example):
     p = vrelab.predict(case("paper-predict.toml"))
     text = repr(p)
     assert text.startswith("<vrelab.PredictResult total_g=") and " at 0x" not in text
     assert ("total_g=%.6g" % p.total_g) in text
-    d = vrelab.diagnose(os.path.join(CASES, "lab-example"))
+    d = lab_example
     text = repr(d)
     assert text.startswith("<vrelab.Diagnosis verdict=") and repr(d.verdict) in text and " at 0x" not in text
 
@@ -118,9 +124,9 @@ def test_shake_equals_cli(tmp_path):
     assert abs(r.measured_g - r.predicted_frequency_dependent_g) <= abs(r.measured_g - r.predicted_g)
 
 
-def test_diagnose_equals_cli(tmp_path):
+def test_diagnose_equals_cli(tmp_path, lab_example):
     folder = case("lab-example")
-    r = vrelab.diagnose(folder)
+    r = lab_example
     assert strip_times(r.to_dict()) == strip_times(cli_json(tmp_path, "diagnose", folder))
     assert r.verdict and r.runs > 0
     # The held-out floor: the runs' floors' rms, and the shrinkage above it in quadrature,
@@ -391,13 +397,13 @@ def columns(path):
     return out
 
 
-def test_diagnose_data_in_memory_equals_the_folder():
+def test_diagnose_data_in_memory_equals_the_folder(lab_example):
     folder = case("lab-example")
     static, runs = columns(os.path.join(folder, "static.csv")), columns(os.path.join(folder, "runs.csv"))
     with open(os.path.join(folder, "manifest.toml"), "rb") as f:
         manifest = tomllib.load(f)
     a = strip_times(vrelab.diagnose_data(static, runs, manifest, name="lab-1").to_dict())
-    b = strip_times(vrelab.diagnose(folder).to_dict())
+    b = strip_times(lab_example.to_dict())
     assert a.pop("data") == "lab-1" and b.pop("data") == folder  # the data as named
     assert a == b
     del runs["frequency_Hz"]

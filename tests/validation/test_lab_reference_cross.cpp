@@ -15,6 +15,12 @@
 // The instrument: k2 (IA alone), k_IP at the output (E[F_IA F_PA] = integral Re S_IA,PA) and
 // the pendulum geometry (E[F_PA theta]: theta is IA through the loop, so Re(H_theta S) needs
 // the cross-spectrum's phase, not its real part alone).
+//
+// The two ODE comparisons are campaign tests (8 s records: 1.5 s each in Release, 25 s under
+// the sanitizers). Their pieces run under the sanitizers in fast tests: the reference channels'
+// reading and Welch analysis in the HDF5 test below and LabReference.*, the prediction from a
+// measured matrix in LabRandom.*, the shaker on summed and random motions in ShakeRandom.* and
+// SumExcitation.*.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -129,7 +135,7 @@ OdeRun ode_run(const fs::path& dir, const vibration::Excitation& table, const st
 
 }  // namespace
 
-TEST(LabReferenceCross, MeasuredCrossSpectraPredictTheOdeOnACoherentTransverseTable) {
+TEST(LabReferenceCrossCampaign, MeasuredCrossSpectraPredictTheOdeOnACoherentTransverseTable) {
   test::TempDir tmp;
   const OdeRun ode = ode_run(tmp.path, *coherent_transverse_random(), "random-coherent,random,psd-ia.csv,independent,,,,,", 8.0);
   const validation::RunRecord& run = ode.run;
@@ -181,7 +187,7 @@ TEST(LabReferenceCross, MeasuredCrossSpectraPredictTheOdeOnACoherentTransverseTa
 // the random on IA (independent axes). From its references the prediction takes the sine's
 // measured fundamental (lock-in) and the random part's Welch matrix with that fundamental
 // taken off every segment: against the ODE within 3 sigma or 1 %; from the command it misses.
-TEST(LabReferenceCross, SineOnRandomRunIsPredictedFromItsMeasuredSineAndSpectra) {
+TEST(LabReferenceCrossCampaign, SineOnRandomRunIsPredictedFromItsMeasuredSineAndSpectra) {
   test::TempDir tmp;
   vibration::SineVibration sine;
   sine.amplitude_g = Vec3(2, 0.2, 0), sine.phase_rad = Vec3(0, 0.5, 0), sine.frequency_Hz = 300;
