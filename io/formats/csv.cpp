@@ -16,10 +16,10 @@
 
 namespace vrelab::io {
 
-std::vector<std::string> split_csv_line(const std::string& line, const std::string& path, long line_no) {
+std::vector<std::string> split_csv_line(const std::string& line, const std::string& path, long line_no, char separator) {
   std::vector<std::string> out;
   std::size_t i = 0;
-  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  const auto blank = [separator](char c) { return c != separator && (c == ' ' || c == '\t' || c == '\r'); };
   while (true) {
     while (i < line.size() && blank(line[i])) ++i;
     std::string cell;
@@ -35,16 +35,16 @@ std::vector<std::string> split_csv_line(const std::string& line, const std::stri
       }
       ++i;
       while (i < line.size() && blank(line[i])) ++i;
-      if (i < line.size() && line[i] != ',') throw FormatError({.file = path, .line = line_no}, "text after a quoted cell");
+      if (i < line.size() && line[i] != separator) throw FormatError({.file = path, .line = line_no}, "text after a quoted cell");
     } else {
-      const std::size_t end = std::min(line.find(',', i), line.size());
+      const std::size_t end = std::min(line.find(separator, i), line.size());
       cell = line.substr(i, end - i);
       while (!cell.empty() && blank(cell.back())) cell.pop_back();
       i = end;
     }
     out.push_back(std::move(cell));
     if (i >= line.size()) break;
-    ++i;  // the comma
+    ++i;  // the separator
   }
   return out;
 }
@@ -130,15 +130,13 @@ void check_text_line(std::string& line, long line_no, const std::string& path) {
                                   at + 1, static_cast<unsigned>(static_cast<unsigned char>(line[at]))));
 }
 
-void check_separator(const std::string& header_line, long line_no, const std::string& path) {
-  if (header_line.find(',') != std::string::npos) return;
-  for (const auto& [sep, name] : {std::pair<char, const char*>{';', "';'"}, {'\t', "a tab"}})
-    if (header_line.find(sep) != std::string::npos)
-      throw FormatError({.file = path, .line = line_no},
-                        fmt::format("the header uses {} as separator; vrelab reads ',' (save as CSV, comma-delimited, "
-                                    "with a decimal point)",
-                                    name));
+char header_separator(const std::string& header_line) {
+  for (const char c : {',', ';', '\t'})
+    if (header_line.find(c) != std::string::npos) return c;
+  return ',';
 }
+
+std::string separator_name(char separator) { return separator == '\t' ? std::string("a tab") : fmt::format("'{}'", separator); }
 
 void check_header_names(const std::vector<std::string>& header, const std::string& path, long line_no) {
   std::map<std::string_view, std::size_t> seen;  // name -> its first column (0-based)
@@ -229,6 +227,7 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
   long line_no = 0;
   std::size_t column = 0;
   std::vector<std::string> header;
+  char separator = ',';
   std::size_t tcol = 0;  // the column time_s, else the first
   std::array<std::size_t, 3> ref_col{};
   std::array<bool, 3> ref_present{};
@@ -239,9 +238,9 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
     check_text_line(line, line_no, path);
     if (line.empty() || line[0] == '#') continue;
     const FormatLocation where{.file = path, .line = line_no};
-    const std::vector<std::string> f = split_csv_line(line, path, line_no);
+    if (header.empty()) separator = header_separator(line);
+    const std::vector<std::string> f = split_csv_line(line, path, line_no, separator);
     if (header.empty()) {
-      check_separator(line, line_no, path);
       check_header_names(f, path, line_no);
       header = f;
       column = static_cast<std::size_t>(series_column(header, column_name, where));

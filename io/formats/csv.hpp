@@ -5,7 +5,8 @@
 // Cells are trimmed of blanks; a cell may be quoted ("a, b"; "" is a quote inside), as
 // spreadsheets write them. '#' lines are comments. Text must be UTF-8 (a UTF-8 byte-order
 // mark, as Excel's "CSV UTF-8" writes it, is dropped); numbers are finite decimals
-// (parse_decimal); the separator is ',' (a header split by ';' is refused with a hint).
+// (parse_decimal: a decimal comma is refused, naming it); the separator is the header's: ','
+// when it has one, else ';' or a tab (a spreadsheet's export in a comma-decimal locale).
 #include <cstddef>
 #include <array>
 #include <functional>
@@ -17,9 +18,10 @@
 
 namespace vrelab::io {
 
-// One CSV line into cells. An unclosed quote, or text after a quoted cell, is FormatError at
-// `path`:`line_no`.
-std::vector<std::string> split_csv_line(const std::string& line, const std::string& path, long line_no);
+// One CSV line into cells at `separator` (',', ';' or '\t'); blanks around a cell are trimmed
+// (a tab only when it is not the separator). An unclosed quote, or text after a quoted cell,
+// is FormatError at `path`:`line_no`.
+std::vector<std::string> split_csv_line(const std::string& line, const std::string& path, long line_no, char separator = ',');
 
 // A finite decimal number as a lab writes it: [+-]digits[.digits][(e|E)[+-]digits] (".5" and
 // "5." too), nothing else: no blanks, no hexadecimal (strtod reads "0x1E" as 30), no inf or
@@ -38,9 +40,12 @@ std::size_t first_non_utf8(std::string_view s);
 // FormatError "<path>:<line>:<column>: not UTF-8 at byte N (0xB0) ...; save the file as UTF-8".
 void check_text_line(std::string& line, long line_no, const std::string& path);
 
-// A header line that uses ';' (or a tab) as its separator and holds no ',' is FormatError
-// naming the separator: vrelab reads ',' only (a ';' file usually has decimal commas too).
-void check_separator(const std::string& header_line, long line_no, const std::string& path);
+// The separator a file's header line uses: ',' when the line has one (outside or inside
+// quotes: a comma file's header never needs ';'), else ';', else a tab, else ',' (one column).
+// Every row of the file is split at it.
+char header_separator(const std::string& header_line);
+// The separator in words for messages: "','", "';'", "a tab".
+std::string separator_name(char separator);
 
 // A header naming a column twice (or an empty name twice) is FormatError at
 // "<path>:<line>:<column>" naming the column: which of the two a reader took would be a guess.

@@ -33,8 +33,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // A CSV file with a header: rows with their line numbers; '#' lines and blank lines skipped.
-// Text checked line by line (UTF-8, a byte-order mark dropped, ',' as separator); a row with
-// more cells than the header, or a header naming a column twice, is refused.
+// Text checked line by line (UTF-8, a byte-order mark dropped, the header's separator: ',',
+// ';' or a tab); a row with more cells than the header, or a header naming a column twice, is
+// refused.
 struct Csv {
   std::string path;
   std::map<std::string, std::size_t> column;
@@ -58,13 +59,14 @@ Csv read_csv(const std::string& path, const std::string& what, const CsvLimit& l
   std::string line;
   int n = 0;
   bool header = false;
+  char separator = ',';
   while (std::getline(in, line)) {
     ++n;
     check_text_line(line, n, path);
     if (line.empty() || line[0] == '#' || line.find_first_not_of(" \t\r") == std::string::npos) continue;
-    std::vector<std::string> cells = split_csv_line(line, path, n);
+    if (!header) separator = header_separator(line);
+    std::vector<std::string> cells = split_csv_line(line, path, n, separator);
     if (!header) {
-      check_separator(line, n, path);
       check_header_names(cells, path, n);
       for (std::size_t i = 0; i < cells.size(); ++i) csv.column[cells[i]] = i;
       csv.names = cells;
@@ -73,8 +75,8 @@ Csv read_csv(const std::string& path, const std::string& what, const CsvLimit& l
     }
     if (cells.size() > csv.names.size())
       throw FormatError({.file = path, .line = n, .column = static_cast<long>(csv.names.size() + 1)},
-                        fmt::format("{} cells, the header has {} (a ',' inside a cell? quote the cell)", cells.size(),
-                                    csv.names.size()));
+                        fmt::format("{} cells, the header has {} (a {} inside a cell? quote the cell)", cells.size(),
+                                    csv.names.size(), separator == '\t' ? std::string("tab") : separator_name(separator)));
     if (csv.rows.size() == limit.max_rows)
       throw FormatError({.file = path, .line = n}, rows_problem(limit.max_rows, limit.rows_what, limit.rows_why));
     csv.rows.emplace_back(n, std::move(cells));

@@ -1,8 +1,10 @@
 // The CSV text checks every reader makes (io/formats/csv.hpp): finite decimal numbers only,
-// UTF-8 byte by byte, the closest column name suggested.
+// UTF-8 byte by byte, the closest column name suggested, the header's separator.
 #include <gtest/gtest.h>
 
+#include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/formats/csv.hpp"
@@ -55,6 +57,44 @@ TEST(CsvText, ClosestColumnNameIsSuggested) {
   EXPECT_EQ(io::closest_name("frequency_hz", names), "frequency_Hz");
   EXPECT_EQ(io::closest_name("amplitud_g", names), "amplitude_g");
   EXPECT_EQ(io::closest_name("temperature_C", names), "");
+}
+
+// A spreadsheet's export in a comma-decimal locale separates by ';' (or a tab): the header
+// says which, every row is split at it. Cells are trimmed of blanks but a tab separator is not
+// a blank (an empty cell between two tabs stays a cell); a quoted cell may hold the separator.
+TEST(CsvText, TheHeadersSeparatorSplitsEveryRow) {
+  EXPECT_EQ(io::header_separator("id,frequency_Hz"), ',');
+  EXPECT_EQ(io::header_separator("id;frequency_Hz"), ';');
+  EXPECT_EQ(io::header_separator("id\tfrequency_Hz"), '\t');
+  EXPECT_EQ(io::header_separator("\"a;b\",c"), ',');  // a comma anywhere: a comma file
+  EXPECT_EQ(io::header_separator("time_s"), ',');
+  using Cells = std::vector<std::string>;
+  EXPECT_EQ(io::split_csv_line(" a ; 1.5;;\"x;y\" ", "f.csv", 2, ';'), (Cells{"a", "1.5", "", "x;y"}));
+  EXPECT_EQ(io::split_csv_line("a\t\t 2 \t", "f.csv", 2, '\t'), (Cells{"a", "", "2", ""}));
+  EXPECT_EQ(io::split_csv_line("0,88;1", "f.csv", 2, ';'), (Cells{"0,88", "1"}));  // a decimal comma is a cell's text
+  EXPECT_EQ(io::split_csv_line("a, b", "f.csv", 2), (Cells{"a", "b"}));
+  EXPECT_EQ(io::separator_name('\t'), "a tab");
+  EXPECT_EQ(io::separator_name(';'), "';'");
+  // A series in ';' reads as its comma twin, sample for sample; with decimal commas it is
+  // refused at the line, naming the decimal comma.
+  const auto read = [](const std::string& text) {
+    std::istringstream in(text);
+    std::vector<std::pair<double, double>> s;
+    io::read_series_csv(in, "rec.csv", "", [&](double t, double u) { s.emplace_back(t, u); });
+    return s;
+  };
+  const auto comma = read("time_s,output_mA\n0,0.88\n0.001,0.89\n");
+  ASSERT_EQ(comma.size(), 2u);
+  EXPECT_EQ(read("time_s;output_mA\n0;0.88\n0.001;0.89\n"), comma);
+  EXPECT_EQ(read("time_s\toutput_mA\n0\t0.88\n0.001\t0.89\n"), comma);
+  try {
+    read("time_s;output_mA\n0;0,88\n");
+    ADD_FAILURE() << "read a decimal comma";
+  } catch (const io::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rec.csv:2: not a number in '0;0,88' (column 2, '0,88': a decimal comma; write a decimal point)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace test_csv_text

@@ -105,6 +105,50 @@ TEST(LabData, QuotedCsvCellsAreRead) {
   }
 }
 
+// A campaign as a spreadsheet in a comma-decimal locale exports it (';'-separated tables; or
+// tab-separated) reads as its comma twin: written back by the writer, file for file the same
+// bytes. With decimal commas it is refused, naming the file, the line, the cell and why.
+TEST(LabData, SemicolonAndTabTablesReadAsTheirCommaTwin) {
+  TempDir t;
+  const std::string comma = (t.path / "comma").string();
+  fs::copy(std::string(VRELAB_CASES_DIR) + "/lab-example", comma);
+  io::LabManifest m;
+  const Campaign plain = io::read_campaign(comma, &m);
+  const auto with_separator = [&](const std::string& name, const std::string& sep) {
+    const std::string dir = (t.path / name).string();
+    fs::copy(comma, dir);
+    for (const char* table : {"/static.csv", "/runs.csv"}) {
+      std::istringstream in(read_file(dir + table));
+      std::string line, text;
+      while (std::getline(in, line)) text += (line.empty() || line[0] == '#' ? line : std::regex_replace(line, std::regex(","), sep)) + "\n";
+      std::ofstream(dir + table) << text;
+    }
+    EXPECT_NE(read_file(dir + "/runs.csv").find("id" + sep + "frequency_Hz" + sep), std::string::npos);
+    return dir;
+  };
+  const auto written = [&](const Campaign& c, const std::string& name) {
+    const std::string out = (t.path / ("written-" + name)).string();
+    io::write_campaign(out, c, m);
+    return read_file(out + "/static.csv") + read_file(out + "/runs.csv");
+  };
+  const std::string reference = written(plain, "comma");
+  for (const auto& [name, sep] : {std::pair<std::string, std::string>{"semicolon", ";"}, {"tab", "\t"}}) {
+    const Campaign c = io::read_campaign(with_separator(name, sep));
+    ASSERT_EQ(c.runs.size(), plain.runs.size()) << name;
+    ASSERT_EQ(c.statics.size(), plain.statics.size()) << name;
+    EXPECT_EQ(written(c, name), reference) << name;
+  }
+  // Decimal commas (what such an export usually holds): refused at the first one.
+  const std::string dir = with_separator("decimal-comma", ";");
+  std::string runs = read_file(dir + "/runs.csv");
+  runs = std::regex_replace(runs, std::regex(";53\\.443;"), ";53,443;");
+  std::ofstream(dir + "/runs.csv") << runs;
+  const Campaign c = io::read_campaign(dir);
+  ASSERT_EQ(c.skipped.size(), 1u);
+  EXPECT_TRUE(std::regex_search(c.skipped[0], std::regex(R"(runs\.csv:\d+:10: column measured_ug: '53,443' is not a number \(a decimal comma; write a decimal point\))")))
+      << c.skipped[0];
+}
+
 TEST(LabData, RawRecordIsMeasuredAsTheSummaryWouldBe) {
   // A synthetic record: 0.88 mA at rest, then a 50 Hz sine of 1 mA with a 25 ug (x K1) offset.
   TempDir t;

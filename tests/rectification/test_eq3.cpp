@@ -61,7 +61,7 @@ Draw draw(std::mt19937_64& rng, int n) {
 
 }  // namespace
 
-TEST(Eq3Sine, EachTermEqualsThePeriodAverageOfModel1) {
+TEST(Eq3SineCampaign, EachTermEqualsThePeriodAverageOfModel1) {
   std::mt19937_64 rng(21);
   int asymmetry_inside = 0;
   for (int n = 0; n < 60; ++n) {

@@ -92,7 +92,7 @@ TEST(ExponentialIntegrator, LinearPlantOutputEqualsCvodeSampleBySample) {
   EXPECT_LT(std::abs(ra.measured_g), 1e-9);  // output minus its own linearisation: nothing
 }
 
-TEST(ExponentialIntegrator, GevsRectificationAgreesWithCvodeFarInsideItsSigma) {
+TEST(ExponentialIntegratorCampaign, GevsRectificationAgreesWithCvodeFarInsideItsSigma) {
   // The shipped GEVS instrument, 1 s, 14 g rms: the rectification is ~22 mg, its statistical
   // sigma ~1.3 mg. Against CVODE at rtol 1e-8 (itself within ~1e-9 g of rtol 1e-10) the
   // exponential integrator is within 5e-8 g sampled at 20 kHz and 9e-8 g continuous (the

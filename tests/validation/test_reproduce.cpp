@@ -91,7 +91,7 @@ TEST(PredictionUncertainty, GradientIsExactAndSigmaMatchesMonteCarloOverTheCoeff
   }
 }
 
-TEST(PredictionUncertainty, TheStaticTestsCovarianceCarriesEq3sScatterOverRepeatedTests) {
+TEST(PredictionUncertaintyCampaign, TheStaticTestsCovarianceCarriesEq3sScatterOverRepeatedTests) {
   // The chain the report uses: static test -> least squares -> eq. (3), its sigma from the
   // first-order covariance, against the scatter of eq. (3) over 1000 simulated tests (same
   // initial orientation error, fresh set-angle errors and noise). Relative sd of the sample
