@@ -1,6 +1,7 @@
 #include "validation/diagnosis/internal/response_cache.hpp"
 
 #include <complex>
+#include <cstdint>
 #include <numbers>
 #include <stdexcept>
 
@@ -12,7 +13,33 @@ void ResponseCache::bind(const PlantConfig& plant) {
   const bool same = bound_ && plant.coefficients.v == plant_.coefficients.v && key(plant.dynamics) == key(plant_.dynamics);
   if (same) return;
   plant_ = plant, bound_ = true;
-  tables_.clear(), absorbed_.clear(), cache_.clear(), responders_.clear();
+  tables_.clear(), absorbed_.clear(), cache_.clear(), responders_.clear(), random_.clear();
+}
+
+const rectification::RandomResponse& ResponseCache::random_response(const std::string& key, const vibration::RandomProfile& p,
+                                                                    const Eigen::Matrix3d& turn,
+                                                                    const rectification::RandomQuadrature& q,
+                                                                    const rectification::ResponseAt& h) {
+  std::string k = key;
+  k += '\0';
+  const auto put = [&k](double x) { k.append(reinterpret_cast<const char*>(&x), sizeof x); };
+  for (const auto& table : p.psd) {
+    put(table ? static_cast<double>(table->rows.size()) : -1.0);
+    if (!table) continue;
+    for (const vibration::PsdRow& row : table->rows) {
+      put(row.frequency_Hz);
+      put(row.psd_g2_per_Hz ? 1.0 : 0.0), put(row.psd_g2_per_Hz.value_or(0.0));
+      put(row.slope_dB_per_octave ? 1.0 : 0.0), put(row.slope_dB_per_octave.value_or(0.0));
+    }
+  }
+  put(static_cast<double>(static_cast<int>(p.coupling)));
+  const auto address = reinterpret_cast<std::uintptr_t>(p.measured.get());
+  k.append(reinterpret_cast<const char*>(&address), sizeof address);
+  for (Eigen::Index i = 0; i < 9; ++i) put(turn(i));
+  put(q.max_log_step), put(q.common_grid ? 1.0 : 0.0);
+  auto it = random_.find(k);
+  if (it == random_.end()) it = random_.emplace(std::move(k), RandomEntry{p.measured, rectification::random_response(p, h, q, turn)}).first;
+  return it->second.response;
 }
 
 const rectification::LoopResponse& ResponseCache::get(const PlantConfig& cfg, const std::string& key, double f) {

@@ -25,6 +25,8 @@
 
 #include "plant/accelerometer.hpp"
 #include "rectification/prediction/frequency.hpp"
+#include "rectification/prediction/random.hpp"
+#include "vibration/random.hpp"
 #include "validation/diagnosis/internal/likelihood.hpp"
 
 namespace vrelab::validation::internal {
@@ -49,6 +51,15 @@ class ResponseCache {
   // a linear part alike (rectification::LoopResponder: the same numbers).)
   const rectification::LoopResponse& get(const plant::PlantConfig& cfg, const std::string& key, double f);
 
+  // A random part's covariances through the loop (rectification::random_response of `p`,
+  // turned by `turn`, with the responses `h` of `key`), computed once per (key, profile, turn,
+  // quadrature): every table of an effect that leaves the dynamics alone (the empty key), at
+  // every value, gradient point and fold, takes the same one. `h` must be get(., key, .): the
+  // responses are fixed per key, so the result is the same numbers as computed afresh.
+  const rectification::RandomResponse& random_response(const std::string& key, const vibration::RandomProfile& p,
+                                                       const Eigen::Matrix3d& turn, const rectification::RandomQuadrature& q,
+                                                       const rectification::ResponseAt& h);
+
  private:
   // Every field of plant::Dynamics (design_servo's only input).
   using DynamicsKey = std::tuple<double, double, double, double, double, bool, double, double>;
@@ -60,6 +71,13 @@ class ResponseCache {
   std::map<std::string, std::map<double, rectification::LoopResponse>, std::less<>> cache_;
   std::map<std::pair<std::string, std::vector<double>>, std::unique_ptr<rectification::LoopResponder>> responders_;
   std::map<DynamicsKey, plant::Servo> servos_;
+  // By the key's and the profile's bytes; the measured matrix (compared by address) is held
+  // so that its address is not reused while the entry lives.
+  struct RandomEntry {
+    std::shared_ptr<const vibration::CrossSpectralMatrix> measured;
+    rectification::RandomResponse response;
+  };
+  std::map<std::string, RandomEntry, std::less<>> random_;
   plant::PlantConfig plant_;
   bool bound_ = false;
 };

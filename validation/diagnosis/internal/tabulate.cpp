@@ -133,7 +133,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     std::optional<vibration::SineVibration> sine;
     std::optional<rectification::LoopResponse> sine_h;
     if (r.random) {
-      rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature, m.random_turn);
+      rr = cache.random_response(key, run_random(r), m.random_turn, kRandomRunQuadrature, h);
       if (r.sine_part) sine = m.sine, sine_h = h(r.frequency_Hz);
     }
     // Coefficients as identified, then the effect's own change of them (if any) on top.
