@@ -99,19 +99,28 @@ int term_of_coefficient(int coef) {
   }
 }
 
-Eq3Terms sine_rectification(const plant::Coefficients& c, const Vec3& a,
-                            const vibration::SineVibration& v, std::optional<double> range_g) {
+SineMoments sine_moments(const vibration::SineVibration& v) {
   // Covariance of w_i sin(wt + p_i) and w_j sin(wt + p_j): w_i w_j cos(p_i - p_j) / 2.
-  Eigen::Matrix3d cov;
+  SineMoments m;
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j)
-      cov(i, j) = 0.5 * v.amplitude_g[i] * v.amplitude_g[j] * std::cos(v.phase_rad[i] - v.phase_rad[j]);
-  const double w = v.amplitude_g[IA];
+      m.covariance_g2(i, j) = 0.5 * v.amplitude_g[i] * v.amplitude_g[j] * std::cos(v.phase_rad[i] - v.phase_rad[j]);
+  m.amplitude_ia_g = v.amplitude_g[IA];
+  return m;
+}
+
+Eq3Terms sine_rectification(const plant::Coefficients& c, const Vec3& a, const SineMoments& m, std::optional<double> range_g) {
+  const double w = m.amplitude_ia_g;
   Eq3Terms t;
-  moment_terms(c, a, cov, 3.0 / 8.0 * w * w * w * w, t);
+  moment_terms(c, a, m.covariance_g2, 3.0 / 8.0 * w * w * w * w, t);
   t.g[t_k1_asym] = c[Coef::k1_asym] * asymmetry_sine(a[IA], w);
   if (range_g) t.g[t_clipping] = clipping_sine(a[IA], w, *range_g);
   return t;
+}
+
+Eq3Terms sine_rectification(const plant::Coefficients& c, const Vec3& a,
+                            const vibration::SineVibration& v, std::optional<double> range_g) {
+  return sine_rectification(c, a, sine_moments(v), range_g);
 }
 
 Eq3Terms random_rectification(const plant::Coefficients& c, const Vec3& a,

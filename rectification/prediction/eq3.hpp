@@ -41,6 +41,16 @@ struct Eq3Terms {
 Eq3Terms sine_rectification(const plant::Coefficients& c, const Vec3& a_g,
                             const vibration::SineVibration& v,
                             std::optional<double> range_limit_g = std::nullopt);
+// What sine_rectification takes of the vibration: the axes' covariance (g^2) and the IA
+// amplitude (g). A caller that evaluates many coefficient sets on one vibration computes it
+// once (nine cosines); the overload below gives the same numbers as the one above.
+struct SineMoments {
+  Eigen::Matrix3d covariance_g2;
+  double amplitude_ia_g = 0;
+};
+SineMoments sine_moments(const vibration::SineVibration& v);
+Eq3Terms sine_rectification(const plant::Coefficients& c, const Vec3& a_g, const SineMoments& m,
+                            std::optional<double> range_limit_g = std::nullopt);
 Eq3Terms random_rectification(const plant::Coefficients& c, const Vec3& a_g,
                               const vibration::RandomVibration& v,
                               std::optional<double> range_limit_g = std::nullopt);

@@ -158,12 +158,12 @@ PreparedSineRectification::PreparedSineRectification(const PlantConfig& config, 
     if (e->readout_averaged_in_prediction()) readout_.push_back(e);
   }
   Eigen::Vector3cd W;  // the case's vibration; F_: what the pendulum's base feels
-  felt_ = v;
+  vibration::SineVibration felt = v;
   for (int i = 0; i < 3; ++i) {
     W[i] = v.amplitude_g[i] * std::exp(std::complex<double>(0, v.phase_rad[i]));
     F_[i] = h.mechanical[static_cast<std::size_t>(i)] * W[i];
-    felt_.amplitude_g[i] = std::abs(F_[i]);
-    felt_.phase_rad[i] = std::arg(F_[i]);
+    felt.amplitude_g[i] = std::abs(F_[i]);
+    felt.phase_rad[i] = std::arg(F_[i]);
   }
   current_ = h.current[0] * W[0] + h.current[1] * W[1] + h.current[2] * W[2];
   const double dc_gain = h.dc_gain;
@@ -171,8 +171,9 @@ PreparedSineRectification::PreparedSineRectification(const PlantConfig& config, 
   out.current_amplitude_g = current_;
   out.angle_amplitude_rad = h.angle_rad[0] * W[0] + h.angle_rad[1] * W[1] + h.angle_rad[2] * W[2];
   amp_i_ = std::abs(current_);
-  through_loop_ = felt_;
-  through_loop_.amplitude_g[IA] = amp_i_;
+  vibration::SineVibration through_loop = felt;
+  through_loop.amplitude_g[IA] = amp_i_;
+  felt_ = sine_moments(felt), through_loop_ = sine_moments(through_loop);
   // Effects beyond (1), from the averaged torque balance.
   const Dynamics& d = config.dynamics;
   const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;

@@ -183,7 +183,9 @@ class PreparedSineRectification {
   Vec3 a_;
   std::optional<double> range_;
   Eigen::Vector3cd F_;
-  vibration::SineVibration felt_, through_loop_;
+  // What the pendulum's base feels, and the same with the current's oscillation along IA
+  // (the loop-placed terms): their moments once, for every coefficient set.
+  SineMoments felt_, through_loop_;
   std::complex<double> current_;
   double amp_i_ = 0;
   FrequencyPrediction fixed_;  // the parts independent of the coefficients

@@ -115,7 +115,9 @@ TEST(NuisancesCampaign, AStatedSigmaTooSmallIsFlaggedAndTheGapJudgedWithTheCorre
     again.measured_g += std::sqrt(2.5 * 2.5 - 1) * r.sigma_g * n01(rng);
     twice.runs.push_back(again);
   }
-  const Nuisance* y = diagnose(twice).nuisance("sigma_scale");
+  const Diagnosis d_twice = diagnose(twice);  // y points into it
+  const Nuisance* y = d_twice.nuisance("sigma_scale");
+  ASSERT_NE(y, nullptr);
   EXPECT_NE(y->note.find("repeated runs"), std::string::npos) << y->note;
   EXPECT_NEAR(y->value, std::sqrt(2.5 * 2.5 - 1), 3 * y->sigma) << y->note;
 }

@@ -44,6 +44,24 @@ rectification::PeriodicInput run_input(const RunRecord& r, const TableMotion& m)
   in.tones = r.motion->tones;
   return in;
 }
+// The bytes of what periodic_input(m, f) depends on, for a motion that is not a pure sine (a
+// pure sine's input is exact and cheap): the tone, its harmonics, the rocking and, only where
+// the fixture rocks (it turns gravity), the static orientation.
+std::string motion_key(const TableMotion& m, double frequency_Hz) {
+  std::string key;
+  const auto put = [&key](double x) { key.append(reinterpret_cast<const char*>(&x), sizeof x); };
+  put(frequency_Hz), put(m.sine.frequency_Hz);
+  for (int i = 0; i < 3; ++i) put(m.sine.amplitude_g[i]), put(m.sine.phase_rad[i]);
+  put(static_cast<double>(m.harmonics.size()));
+  for (const vibration::Harmonic& h : m.harmonics) put(h.order), put(h.ratio), put(h.phase_rad);
+  put(m.rocking_rad_per_g);
+  if (m.rocking_rad_per_g != 0) {
+    put(m.rocking_axis), put(m.commanded_amplitude_g);
+    for (int i = 0; i < 3; ++i) put(m.static_gravity_g[i]);
+  }
+  return key;
+}
+
 // (values: every parameter of e.) A run whose table motion was measured (reference channels)
 // already holds what a table-motion effect does.
 void apply_effect(const Effect* e, ParameterValues values, const RunRecord& r, PlantConfig& cfg, TableMotion& m) {
@@ -83,6 +101,17 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
   const int n = static_cast<int>(runs.size());
   Table t{Eigen::VectorXd(n), Eigen::MatrixXd(n, plant::kNumCoefficients)};
   std::map<std::string, std::pair<PlantConfig, rectification::PeriodicInput>> film_memo;
+  // A distorted or rocking table's period resolved into harmonics once per motion in the
+  // table: runs that differ only in orientation shake alike (the same function of the same
+  // numbers).
+  std::map<std::string, rectification::PeriodicInput> input_memo;
+  const auto motion_of = [&input_memo](const RunRecord& r, const TableMotion& m) {
+    if (measured_sine(r) || m.pure_sine()) return run_input(r, m);
+    const std::string key = motion_key(m, r.frequency_Hz);
+    auto it = input_memo.find(key);
+    if (it == input_memo.end()) it = input_memo.emplace(key, run_input(r, m)).first;
+    return it->second;
+  };
   for (int k = 0; k < n; ++k) {
     const RunRecord& r = runs[static_cast<std::size_t>(k)];
     PlantConfig cfg = nominal;
@@ -91,7 +120,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     const PlantConfig with_films = cfg;
     // A film's linearisation and balance once per (plant, motion) in the table: runs that
     // differ only in orientation share them (the same function of the same numbers).
-    const rectification::PeriodicInput motion = r.random ? rectification::PeriodicInput{} : run_input(r, m);
+    const rectification::PeriodicInput motion = r.random ? rectification::PeriodicInput{} : motion_of(r, m);
     const std::string film_key = r.random ? std::string() : rectification::film_balance_key(with_films, m.sine, motion);
     const auto memo = film_key.empty() ? film_memo.end() : film_memo.find(film_key);
     if (memo != film_memo.end()) cfg = memo->second.first;
