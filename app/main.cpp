@@ -233,7 +233,9 @@ Command add_diagnose(CLI::App& app) {
                   "Diagnose every campaign given and write one row per campaign to this CSV (resumed if it exists; "
                   "docs/mpi.md)")
       ->check(kOutputFile);
-  cmd->add_option("--threads", o.threads, "With --summary: threads (0: all cores; under mpirun 1 per rank)");
+  cmd->add_option("--threads", o.threads,
+                  "Threads (default 0: all cores): one campaign's effects fitted in parallel; with --summary, "
+                  "campaigns in parallel, one thread each (under mpirun 1 per rank). The results do not depend on it");
   cmd->add_flag_callback("--no-progress", [&o] { o.progress = false; }, "With --summary: no progress bar");
   cmd->add_option("--json", o.json_path, "Write the diagnosis as JSON")->check(kOutputFile);
   cmd->add_option("--report", o.report_dir, "Write report.md, report.html and diagnosis.json to this folder");

@@ -679,19 +679,20 @@ PYBIND11_MODULE(_core, m) {
       .def("to_dict", [](const io::FolderDiagnosis& f) { return to_py(io::to_json(f)); }, "`vrelab diagnose --json` as a dict.");
   // Every DiagnoseSettings field a keyword (its description: name, type, default, range, help).
   static const std::string diagnose_doc =
-      "diagnose(dir, **settings) -> Diagnosis\n\n"
+      "diagnose(dir, threads=0, **settings) -> Diagnosis\n\n"
       "The sim-to-real gap of a campaign folder in the lab data format (docs/data-format.md): static readings "
       "(output units) and shaker runs (measured error and sigma, g). Settings given here (keywords, None: not "
       "given) win over the manifest's [diagnose] table; `vrelab diagnose DIR` takes the same as flags "
-      "(--significance-sigma for significance_sigma; --no-NAME for a flag). Releases the GIL.\n\n" +
+      "(--significance-sigma for significance_sigma; --no-NAME for a flag). threads: the effects' fits on this "
+      "many threads (0: all cores); the result does not depend on it. Releases the GIL.\n\n" +
       diagnose_keywords_doc();
   m.def(
       "diagnose",
-      [](const std::string& dir, const py::kwargs& kw) {
+      [](const std::string& dir, int threads, const py::kwargs& kw) {
         const io::DiagnoseOverrides o = diagnose_overrides("diagnose", kw);
-        return interruptible([&] { return io::diagnose_folder(dir, o); });
+        return interruptible([&] { return io::diagnose_folder(dir, o, threads); });
       },
-      py::arg("dir"), diagnose_doc.c_str());
+      py::arg("dir"), py::arg("threads") = 0, diagnose_doc.c_str());
   m.def(
       "check_campaign",
       [](const std::string& dir, const py::kwargs& kw) {

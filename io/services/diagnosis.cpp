@@ -12,6 +12,7 @@
 #include "io/services/internal.hpp"
 #include "io/formats/output.hpp"
 #include "validation/diagnosis/campaign.hpp"
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 
@@ -83,11 +84,13 @@ FolderDiagnosis read_folder(const std::string& dir, const DiagnoseOverrides& o) 
   return f;
 }
 
-FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& o) {
+FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& o, int threads) {
+  if (threads < 0) throw InputError("diagnose: threads must not be negative (0: all cores)");
   FolderDiagnosis f = read_folder(dir, o);
+  f.threads = core::thread_count(threads);
   const auto start = std::chrono::steady_clock::now();
   try {
-    f.diagnosis = validation::diagnose(f.campaign, f.settings);
+    f.diagnosis = validation::diagnose(f.campaign, f.settings, f.threads);
   } catch (const std::invalid_argument& e) {
     throw InputError(dir + ": " + e.what());
   }

@@ -52,6 +52,7 @@ struct FolderDiagnosis {
   std::string settings_from;              // where they came from (defaults, the manifest, overrides)
   validation::Diagnosis diagnosis;
   double wall_s = 0;  // the diagnosis alone
+  int threads = 1;    // the effects' fits ran on these (the results do not depend on it)
   bool diagnosed = false;  // false: read and checked only (read_folder)
   // "diagnose DIR", the counts, then the verdict (brief) or everything the diagnosis found (full).
   std::string BriefReport() const;
@@ -63,6 +64,7 @@ struct FolderDiagnosis {
 // The campaign read and checked, the settings resolved and validated; no diagnosis
 // (`diagnose --check`). InputError as diagnose_folder's.
 FolderDiagnosis read_folder(const std::string& dir, const DiagnoseOverrides& overrides = {});
-FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& overrides = {});
+// threads: the effects' fits on this many threads (0: all cores; validation::diagnose).
+FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& overrides = {}, int threads = 1);
 
 }  // namespace vrelab::io

@@ -368,6 +368,7 @@ json to_json(const FolderDiagnosis& f) {
   j["settings"] = to_json(f.settings);
   j["settings"]["from"] = f.settings_from;
   j["wall_s"] = f.wall_s;
+  j["threads"] = f.threads;
   if (f.diagnosed) {
     j.update(to_json(f.diagnosis, c));
     if (f.diagnosis.runs_with_measured_motion > 0) j["motion"] = motion_summary_json(f.diagnosis, c);

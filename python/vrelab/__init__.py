@@ -272,8 +272,8 @@ def campaign(case, out_dir, key=None, seed=None, raw_format="csv"):
     return _core._campaign(os.fspath(case), os.fspath(out_dir), os.fspath(key) if key else "", seed, raw_format)
 
 
-def diagnose(dir, **settings):
-    return _core.diagnose(os.fspath(dir), **settings)
+def diagnose(dir, threads=0, **settings):
+    return _core.diagnose(os.fspath(dir), threads, **settings)
 
 
 diagnose.__doc__ = _core.diagnose.__doc__

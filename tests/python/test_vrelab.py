@@ -12,6 +12,7 @@ records' measured errors, CSV against HDF5 (test_campaign_writes_raw_records...)
 
 Run by ctest (python_tests, label python) with PYTHONPATH at build/python and VRELAB_CLI at
 the program of the same build."""
+import inspect
 import json
 import math
 import os
@@ -140,6 +141,16 @@ def test_diagnose_equals_cli(tmp_path, lab_example):
     above = 1 - math.sqrt(max(0.0, after**2 - floor**2)) / math.sqrt(before**2 - floor**2)
     assert r.shrinkage_above_floor == pytest.approx(above, rel=1e-12)
     assert s["fraction_above_floor_removed"] == pytest.approx(above, rel=1e-12)
+
+
+def test_diagnose_on_one_thread_is_the_same_numbers(lab_example):
+    # The fixture ran on every core (threads=0); one thread gives the same numbers.
+    assert "threads" in inspect.signature(vrelab.diagnose).parameters
+    one = vrelab.diagnose(case("lab-example"), threads=1).to_dict()
+    every = lab_example.to_dict()
+    assert one["threads"] == 1 and every["threads"] == (os.cpu_count() or 1)
+    del one["threads"], every["threads"]
+    assert strip_times(one) == strip_times(every)
 
 
 def test_frequency_equals_cli_summary(tmp_path):

@@ -62,7 +62,7 @@ namespace {
 // One diagnosis of a campaign whose drift is removed, with its runs' sigma as given. cache: the
 // tables and what the static test takes up, shared by the wrapper's passes over the same
 // campaign (the runs' sigma may differ between them, nothing else).
-Diagnosis diagnose_once(const Campaign& c, const internal::StageOptions& o, internal::ResponseCache& cache) {
+Diagnosis diagnose_once(const Campaign& c, const internal::StageOptions& o, internal::ResponseCache& cache, int threads) {
   using namespace internal;
   Diagnosis d;
   note_measured_motion(c, d);  // the table-motion effects a reference channel measures
@@ -79,7 +79,7 @@ Diagnosis diagnose_once(const Campaign& c, const internal::StageOptions& o, inte
   Evidence ev;
   heldout_nominal(m, ev, d);
   const Scorer scorer(m, ev.folds);
-  score_effects(m, scorer, ev, d);
+  score_effects(m, scorer, ev, d, threads);
   // 4-5. The verdict (pairs, ambiguity) and the held-out shrinkage.
   const Chosen chosen = judge(m, ev, scorer, o.verdict, d);
   if (o.next_runs) suggest_next_runs(m.plant, c, o.simulation_rel_accuracy, d);  // for an ambiguous or unexplained gap
@@ -90,15 +90,15 @@ Diagnosis diagnose_once(const Campaign& c, const internal::StageOptions& o, inte
 
 }  // namespace
 
-Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s) {
+Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s, int threads) {
   const internal::StageOptions o = internal::stage_options(s);
   Campaign c = c0;
   const Nuisance drift = remove_drift(c);  // the bias drift, removed first
   internal::ResponseCache cache;
-  Diagnosis d = diagnose_once(c, o, cache);
+  Diagnosis d = diagnose_once(c, o, cache, threads);
   // The stated sigma: scaled and judged again when the gaps say it is scatter.
   const Nuisance scale =
-      internal::sigma_scale(c, o.scatter, d, [&](const Campaign& scaled) { return diagnose_once(scaled, o, cache); });
+      internal::sigma_scale(c, o.scatter, d, [&](const Campaign& scaled) { return diagnose_once(scaled, o, cache, threads); });
   d.nuisances = {drift, scale};  // (a drift removed or a sigma scaled is said after the verdict: verdict_text)
   return d;
 }

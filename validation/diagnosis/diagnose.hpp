@@ -255,7 +255,9 @@ struct Diagnosis {
 // removed from every run with a time. Fewer than 3 rest readings: not estimated, c unchanged.
 Nuisance remove_drift(Campaign& c);
 
-Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {});
+// threads: the effects' fits and folds on this many threads (0: all cores); the diagnosis is
+// the same numbers whatever the count. A caller that diagnoses campaigns in parallel keeps 1.
+Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {}, int threads = 1);
 
 // The gap a hidden effect makes, as the diagnosis' nominal model sees it (blind's family size;
 // docs/blind.md, "Blind's measures"). `with` and `without` are one virtual-lab campaign

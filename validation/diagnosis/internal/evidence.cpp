@@ -5,6 +5,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "core/parallel.hpp"
 #include "validation/diagnosis/internal/tabulate.hpp"
 
 namespace vrelab::validation::internal {
@@ -72,12 +73,18 @@ void Scorer::score(const std::function<Fitted(const std::vector<int>&)>& fit_on,
       Ga << f.t.G, f.slopes;
       with = conditional_on(da, f.t.pred, Ga, train);
     }
-    auto known = nominal_heldout_.find(key);
-    if (known == nominal_heldout_.end())
-      known = nominal_heldout_
-                  .emplace(key, train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all) : conditional_on(data, nominal.pred, nominal.G, train))
-                  .first;
-    const Likelihood without = known->second;
+    const double fold = key;  // (a structured binding: clang 14 captures none)
+    const Likelihood without = [&] {
+      {
+        const std::lock_guard<std::mutex> g(nominal_heldout_lock_);
+        const auto known = nominal_heldout_.find(fold);
+        if (known != nominal_heldout_.end()) return known->second;
+      }
+      const Likelihood l = train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all)
+                                                       : conditional_on(data, nominal.pred, nominal.G, train);
+      const std::lock_guard<std::mutex> g(nominal_heldout_lock_);
+      return nominal_heldout_.try_emplace(fold, l).first->second;
+    }();
     sc.fit.evidence += without.m2logl - with.m2logl;
     sc.fit.heldout_chi2 += with.chi2;
     const Eigen::VectorXd a = adjusted_residual(data, f.t.pred, f.t.G, train, test);
@@ -143,18 +150,33 @@ void heldout_nominal(const CampaignModel& m, Evidence& ev, Diagnosis& d) {
   }
 }
 
-void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, Diagnosis& d) {
+void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, Diagnosis& d, int threads) {
   const Data& data = m.data;
   const std::vector<int>& all = m.all;
-  std::map<std::string, std::unique_ptr<EffectFitter>>& fitters = ev.fitters;
-  std::vector<Scored>& scored = ev.scored;
+  std::vector<const Effect*> effects;
+  for (const Effect& e : effect_library())
+    if (std::find(d.measured_effects.begin(), d.measured_effects.end(), e.name) == d.measured_effects.end()) effects.push_back(&e);
+  std::vector<std::unique_ptr<EffectFitter>> fitters(effects.size());
+  std::vector<Scored> scored(effects.size());
   const auto fitted_one = [&](const EffectFitter& fitter, const Data& dd, const std::vector<int>& runs) {
     return scorer.fitted_multi(fitter, fitter.fit_all(dd, runs));
   };
-  for (const Effect& e : effect_library()) {
-    if (std::find(d.measured_effects.begin(), d.measured_effects.end(), e.name) != d.measured_effects.end()) continue;
-    const EffectFitter& fitter = *(fitters[e.name] = std::make_unique<EffectFitter>(make_effect_fitter(e, m.nominal, m.plant, m.campaign.runs, m.cache, m.absorbed)));
-    Scored sc;
+  // Handed out costliest first (those that change the loop's dynamics need their own loop
+  // responses at every value; then by the parameters a natural form fits), so that the last
+  // effect to finish is a cheap one. The results stay in the library's order.
+  std::vector<std::size_t> order(effects.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const Effect &x = *effects[a], &y = *effects[b];
+    if (x.changes_dynamics != y.changes_dynamics) return x.changes_dynamics;
+    return x.parameters.size() > y.parameters.size();
+  });
+  core::parallel_for(order.size(), threads, [&](std::size_t k) {
+    const std::size_t i = order[k];
+    const Effect& e = *effects[i];
+    fitters[i] = std::make_unique<EffectFitter>(make_effect_fitter(e, m.nominal, m.plant, m.campaign.runs, m.cache, m.absorbed));
+    const EffectFitter& fitter = *fitters[i];
+    Scored& sc = scored[i];
     sc.fit.name = e.name, sc.fit.parameter = e.fitted().name, sc.fit.unit = e.fitted().unit;
     scorer.score([&](const std::vector<int>& runs) { return fitted_one(fitter, data, runs); }, sc);
     EffectFitter::Multi mf = fitter.fit_all(data, all);
@@ -164,16 +186,21 @@ void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, D
     sc.fit.at_bound = !std::isfinite(sp);
     sc.fit.parameters = fitted_parameters(e, mf);
     sc.all = std::move(mf);
-    scored.push_back(std::move(sc));
+  });
+  for (std::size_t i = 0; i < effects.size(); ++i) {
+    ev.fitters[effects[i]->name] = std::move(fitters[i]);
+    ev.scored.push_back(std::move(scored[i]));
   }
+  std::vector<Scored>& scored_all = ev.scored;
   // An effect whose held-out evidence or chi^2 is not a finite number (a fold's -2 ln L not
   // finite) is no candidate: listed after the ranked ones with why, never chosen.
-  for (Scored& sc : scored)
+  for (Scored& sc : scored_all)
     if (!std::isfinite(sc.fit.evidence) || !std::isfinite(sc.fit.heldout_chi2))
       sc.fit.not_ranked = "its held-out evidence or chi^2 is not a finite number";
-  const auto ranked_end = std::stable_partition(scored.begin(), scored.end(), [](const Scored& a) { return a.fit.not_ranked.empty(); });
-  std::sort(scored.begin(), ranked_end, [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
-  for (const auto& sc : scored) d.effects.push_back(sc.fit);
+  const auto ranked_end =
+      std::stable_partition(scored_all.begin(), scored_all.end(), [](const Scored& a) { return a.fit.not_ranked.empty(); });
+  std::sort(scored_all.begin(), ranked_end, [](const Scored& a, const Scored& b) { return a.fit.evidence > b.fit.evidence; });
+  for (const auto& sc : scored_all) d.effects.push_back(sc.fit);
 }
 
 }  // namespace vrelab::validation::internal

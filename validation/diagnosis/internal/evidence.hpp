@@ -15,6 +15,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -83,7 +84,10 @@ class Scorer {
                             const std::vector<int>& train) const;
   const CampaignModel& m_;
   const Folds& folds_;
-  mutable std::map<double, Likelihood> nominal_heldout_;  // the nominal's held-out -2 ln L per fold
+  // The nominal's held-out -2 ln L per fold, computed once (the effects' fits on several
+  // threads ask for it: under the lock).
+  mutable std::map<double, Likelihood> nominal_heldout_;
+  mutable std::mutex nominal_heldout_lock_;
 };
 
 struct Evidence {
@@ -100,6 +104,9 @@ struct Evidence {
 // The folds and the nominal's held-out gap (d.folds said).
 void heldout_nominal(const CampaignModel& m, Evidence& ev, Diagnosis& d);
 // Every library effect not in d.measured_effects fitted, scored and ranked; d.effects filled.
-void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, Diagnosis& d);
+// The effects on `threads` threads (0: all cores), each effect's fits and folds on one: the
+// same numbers whatever the count (each is a function of the data and the effect alone; the
+// response cache they share keeps what is computed first, the same numbers by any thread).
+void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, Diagnosis& d, int threads = 1);
 
 }  // namespace vrelab::validation::internal

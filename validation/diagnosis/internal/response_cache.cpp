@@ -10,6 +10,7 @@ namespace vrelab::validation::internal {
 using plant::PlantConfig;
 
 void ResponseCache::bind(const PlantConfig& plant) {
+  const std::lock_guard<std::mutex> g(mutex_);
   const bool same = bound_ && plant.coefficients.v == plant_.coefficients.v && key(plant.dynamics) == key(plant_.dynamics);
   if (same) return;
   plant_ = plant, bound_ = true;
@@ -37,27 +38,50 @@ const rectification::RandomResponse& ResponseCache::random_response(const std::s
   k.append(reinterpret_cast<const char*>(&address), sizeof address);
   for (Eigen::Index i = 0; i < 9; ++i) put(turn(i));
   put(q.max_log_step), put(q.common_grid ? 1.0 : 0.0);
-  auto it = random_.find(k);
-  if (it == random_.end()) it = random_.emplace(std::move(k), RandomEntry{p.measured, rectification::random_response(p, h, q, turn)}).first;
-  return it->second.response;
+  {
+    const std::lock_guard<std::mutex> g(mutex_);
+    const auto it = random_.find(k);
+    if (it != random_.end()) return it->second.response;
+  }
+  // Computed without the lock (h asks get() for the responses).
+  RandomEntry entry{p.measured, rectification::random_response(p, h, q, turn)};
+  const std::lock_guard<std::mutex> g(mutex_);
+  return random_.try_emplace(std::move(k), std::move(entry)).first->second.response;
+}
+
+std::shared_ptr<const Table> ResponseCache::table(const std::string& key) {
+  const std::lock_guard<std::mutex> g(mutex_);
+  const auto it = tables_.find(key);
+  return it == tables_.end() ? nullptr : it->second;
+}
+
+void ResponseCache::store_table(const std::string& key, std::shared_ptr<const Table> t) {
+  const std::lock_guard<std::mutex> g(mutex_);
+  tables_[key] = std::move(t);
 }
 
 const rectification::LoopResponse& ResponseCache::get(const PlantConfig& cfg, const std::string& key, double f) {
-  // (By key, then frequency: the key is not copied for every look-up.)
-  auto by_key = cache_.find(key);
-  if (by_key == cache_.end()) by_key = cache_.emplace(key, std::map<double, rectification::LoopResponse>()).first;
-  auto it = by_key->second.find(f);
-  if (it == by_key->second.end()) {
-    if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
-    if (cfg.servo) {
-      it = by_key->second.emplace(f, responder(cfg, key)(f)).first;
-    } else {
-      PlantConfig with_servo = cfg;
-      with_servo.servo = servo(cfg.dynamics);
-      it = by_key->second.emplace(f, responder(with_servo, key)(f)).first;
+  {
+    const std::lock_guard<std::mutex> g(mutex_);
+    // (By key, then frequency: the key is not copied for every look-up.)
+    const auto by_key = cache_.find(key);
+    if (by_key != cache_.end()) {
+      const auto it = by_key->second.find(f);
+      if (it != by_key->second.end()) return it->second;
     }
   }
-  return it->second;
+  // Computed without the lock, so that other threads' look-ups go on meanwhile.
+  if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+  rectification::LoopResponse response;
+  if (cfg.servo) {
+    response = responder(cfg, key)(f);
+  } else {
+    PlantConfig with_servo = cfg;
+    with_servo.servo = servo(cfg.dynamics);
+    response = responder(with_servo, key)(f);
+  }
+  const std::lock_guard<std::mutex> g(mutex_);
+  return cache_[key].try_emplace(f, std::move(response)).first->second;
 }
 
 ResponseCache::DynamicsKey ResponseCache::key(const plant::Dynamics& d) {
@@ -67,9 +91,14 @@ ResponseCache::DynamicsKey ResponseCache::key(const plant::Dynamics& d) {
 
 const plant::Servo& ResponseCache::servo(const plant::Dynamics& d) {
   const DynamicsKey k = key(d);
-  auto it = servos_.find(k);
-  if (it == servos_.end()) it = servos_.emplace(k, plant::design_servo(d)).first;
-  return it->second;
+  {
+    const std::lock_guard<std::mutex> g(mutex_);
+    const auto it = servos_.find(k);
+    if (it != servos_.end()) return it->second;
+  }
+  plant::Servo designed = plant::design_servo(d);
+  const std::lock_guard<std::mutex> g(mutex_);
+  return servos_.try_emplace(k, designed).first->second;
 }
 
 // What loop_response reads of a plant (with its servo): the coefficients its linear plant
@@ -96,9 +125,14 @@ std::vector<double> ResponseCache::linear_part(const PlantConfig& cfg) {
 
 const rectification::LoopResponder& ResponseCache::responder(const PlantConfig& cfg, const std::string& key) {
   auto k = std::make_pair(key, linear_part(cfg));
-  auto it = responders_.find(k);
-  if (it == responders_.end()) it = responders_.emplace(k, std::make_unique<rectification::LoopResponder>(cfg)).first;
-  return *it->second;
+  {
+    const std::lock_guard<std::mutex> g(mutex_);
+    const auto it = responders_.find(k);
+    if (it != responders_.end()) return *it->second;
+  }
+  auto made = std::make_unique<rectification::LoopResponder>(cfg);
+  const std::lock_guard<std::mutex> g(mutex_);
+  return *responders_.try_emplace(std::move(k), std::move(made)).first->second;
 }
 
 }  // namespace vrelab::validation::internal

@@ -18,6 +18,7 @@
 // the same numbers, so the responses are bit for bit those loop_response gives.
 #include <map>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -42,8 +43,16 @@ class ResponseCache {
   // identified plant and one set of runs' physics (their sigma is not an input): the
   // diagnose() wrapper's second pass (the sigma scaled) asks for the same ones again. bind()
   // forgets everything when the plant differs from the one bound (exactly).
+  //
+  // Thread-safe: the effects' fits share one cache across threads (score_effects). Every entry
+  // is a function of its key alone, so a value computed by two threads at once is the same
+  // numbers and the first stored is kept; entries are never erased while bound, so a
+  // reference returned stays valid.
   void bind(const plant::PlantConfig& plant);
-  std::map<std::string, std::shared_ptr<const Table>> tables_;
+  // The table stored for `key` (nullptr: none).
+  std::shared_ptr<const Table> table(const std::string& key);
+  void store_table(const std::string& key, std::shared_ptr<const Table> t);
+  // Filled by the identification before any fit runs (one thread).
   Absorbed absorbed_;
 
   // (A response is computed for the first plant that asks for its key and frequency, as
@@ -78,8 +87,10 @@ class ResponseCache {
     rectification::RandomResponse response;
   };
   std::map<std::string, RandomEntry, std::less<>> random_;
+  std::map<std::string, std::shared_ptr<const Table>> tables_;
   plant::PlantConfig plant_;
   bool bound_ = false;
+  std::mutex mutex_;  // over every member, held for look-ups and insertions (computed without it)
 };
 
 }  // namespace vrelab::validation::internal

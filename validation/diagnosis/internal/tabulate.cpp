@@ -87,10 +87,10 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
     std::snprintf(buf, sizeof buf, "=%.17g", v);
     key += buf;
   }
-  const auto it = cache.tables_.find(key);
-  if (it != cache.tables_.end() && it->second->pred.size() == static_cast<Eigen::Index>(runs.size())) return *it->second;
+  if (const std::shared_ptr<const Table> known = cache.table(key); known && known->pred.size() == static_cast<Eigen::Index>(runs.size()))
+    return *known;
   auto t = std::make_shared<const Table>(tabulate_runs(nominal, runs, e, values, cache, absorbed));
-  cache.tables_[key] = t;
+  cache.store_table(key, t);
   return *t;
 }
 
