@@ -38,7 +38,7 @@ int run_diagnose(const DiagnoseOptions& o, std::ostream& out) {
   if (o.check && (!o.json_path.empty() || !o.report_dir.empty()))
     throw io::InputError("diagnose --check: reads and checks only; --json and --report need a diagnosis");
   if (o.threads < 0) throw io::InputError("diagnose --threads: must not be negative (0: all cores)");
-  const io::FolderDiagnosis f = o.check ? io::read_folder(o.dir, o.settings) : io::diagnose_folder(o.dir, o.settings, o.threads);
+  const io::FolderDiagnosis f = o.check ? io::read_folder(o.dir, o.settings) : io::diagnose_folder(o.dir, o.settings, o.threads, o.progress);
   out << program() << (o.check ? f.CheckReport() : f.FullReport());
   if (!o.json_path.empty()) io::write_atomic(o.json_path, io::json_text(io::to_json(f)));
   if (!o.report_dir.empty()) io::write_diagnosis_report(f, o.report_dir);

@@ -236,7 +236,7 @@ Command add_diagnose(CLI::App& app) {
   cmd->add_option("--threads", o.threads,
                   "Threads (default 0: all cores): one campaign's effects fitted in parallel; with --summary, "
                   "campaigns in parallel, one thread each (under mpirun 1 per rank). The results do not depend on it");
-  cmd->add_flag_callback("--no-progress", [&o] { o.progress = false; }, "With --summary: no progress bar");
+  cmd->add_flag_callback("--no-progress", [&o] { o.progress = false; }, "No progress bar (of the effects' fits; with --summary, of the campaigns)");
   cmd->add_option("--json", o.json_path, "Write the diagnosis as JSON")->check(kOutputFile);
   cmd->add_option("--report", o.report_dir, "Write report.md, report.html and diagnosis.json to this folder");
   cmd->add_flag("--check", o.check,

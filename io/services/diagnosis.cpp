@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include <chrono>
+#include <optional>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -84,13 +85,18 @@ FolderDiagnosis read_folder(const std::string& dir, const DiagnoseOverrides& o) 
   return f;
 }
 
-FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& o, int threads) {
+FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& o, int threads, bool progress) {
   if (threads < 0) throw InputError("diagnose: threads must not be negative (0: all cores)");
   FolderDiagnosis f = read_folder(dir, o);
   f.threads = core::thread_count(threads);
   const auto start = std::chrono::steady_clock::now();
   try {
-    f.diagnosis = validation::diagnose(f.campaign, f.settings, f.threads);
+    std::optional<core::Progress> bar;  // one per pass over the effects (a scaled sigma: two)
+    const validation::EffectsProgress tick = [&bar](std::size_t done, std::size_t total) {
+      if (done == 1) bar.emplace(std::cerr, "diagnose: the effects' fits", total);
+      bar->tick();
+    };
+    f.diagnosis = validation::diagnose(f.campaign, f.settings, f.threads, progress ? tick : validation::EffectsProgress{});
   } catch (const std::invalid_argument& e) {
     throw InputError(dir + ": " + e.what());
   }

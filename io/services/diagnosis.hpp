@@ -64,7 +64,10 @@ struct FolderDiagnosis {
 // The campaign read and checked, the settings resolved and validated; no diagnosis
 // (`diagnose --check`). InputError as diagnose_folder's.
 FolderDiagnosis read_folder(const std::string& dir, const DiagnoseOverrides& overrides = {});
-// threads: the effects' fits on this many threads (0: all cores; validation::diagnose).
-FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& overrides = {}, int threads = 1);
+// threads: the effects' fits on this many threads (0: all cores; validation::diagnose);
+// progress: a bar of the effects' fits on stderr (core::Progress: redrawn on a terminal, sparse
+// lines in a log, nothing for a diagnosis under a second).
+FolderDiagnosis diagnose_folder(const std::string& dir, const DiagnoseOverrides& overrides = {}, int threads = 1,
+                                bool progress = false);
 
 }  // namespace vrelab::io

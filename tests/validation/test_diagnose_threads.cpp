@@ -8,11 +8,13 @@
 // runs: their covariances through the loop shared by every effect that leaves the dynamics
 // alone), each on 1 and 3 threads (more threads than the machine's 2
 // cores: the effects interleave). Compared: io::to_json of the diagnosis as text. A few
-// seconds each in Release, a minute under the sanitizers: label "campaign".
+// seconds each in Release, a minute under the sanitizers: label "campaign". The three-thread
+// diagnosis also reports its progress (diagnose's EffectsProgress), checked here.
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "io/formats/lab_data.hpp"
@@ -38,10 +40,22 @@ void expect_same_on_threads(const std::string& folder, int keep_sine = -1) {
     c.runs = kept;
   }
   ASSERT_FALSE(c.runs.empty()) << folder;
-  const Diagnosis one = diagnose(c, {}, 1), three = diagnose(c, {}, 3);
+  // The progress told on three threads: 1, 2, ..., total, one call at a time (the calls are
+  // under the pool's lock), total the effects scored, once per pass over them.
+  std::vector<std::pair<std::size_t, std::size_t>> told;
+  const Diagnosis one = diagnose(c, {}, 1),
+                  three = diagnose(c, {}, 3, [&told](std::size_t done, std::size_t total) { told.emplace_back(done, total); });
   std::printf("  %s: %s\n", folder.c_str(), verdict_text(one).c_str());
   EXPECT_FALSE(one.effects.empty()) << folder;
   EXPECT_EQ(io::to_json(one, c).dump(), io::to_json(three, c).dump()) << folder;
+  ASSERT_FALSE(told.empty()) << folder;
+  const std::size_t total = told.front().second;
+  EXPECT_EQ(total, three.effects.size()) << folder;
+  EXPECT_EQ(told.size() % total, 0u) << folder;
+  for (std::size_t k = 0; k < told.size(); ++k) {
+    EXPECT_EQ(told[k].first, k % total + 1) << folder;
+    EXPECT_EQ(told[k].second, total) << folder;
+  }
 }
 
 }  // namespace

@@ -62,7 +62,8 @@ namespace {
 // One diagnosis of a campaign whose drift is removed, with its runs' sigma as given. cache: the
 // tables and what the static test takes up, shared by the wrapper's passes over the same
 // campaign (the runs' sigma may differ between them, nothing else).
-Diagnosis diagnose_once(const Campaign& c, const internal::StageOptions& o, internal::ResponseCache& cache, int threads) {
+Diagnosis diagnose_once(const Campaign& c, const internal::StageOptions& o, internal::ResponseCache& cache, int threads,
+                        const EffectsProgress& progress) {
   using namespace internal;
   Diagnosis d;
   note_measured_motion(c, d);  // the table-motion effects a reference channel measures
@@ -79,7 +80,7 @@ Diagnosis diagnose_once(const Campaign& c, const internal::StageOptions& o, inte
   Evidence ev;
   heldout_nominal(m, ev, d);
   const Scorer scorer(m, ev.folds);
-  score_effects(m, scorer, ev, d, threads);
+  score_effects(m, scorer, ev, d, threads, progress);
   // 4-5. The verdict (pairs, ambiguity) and the held-out shrinkage.
   const Chosen chosen = judge(m, ev, scorer, o.verdict, d);
   if (o.next_runs) suggest_next_runs(m.plant, c, o.simulation_rel_accuracy, d);  // for an ambiguous or unexplained gap
@@ -90,15 +91,15 @@ Diagnosis diagnose_once(const Campaign& c, const internal::StageOptions& o, inte
 
 }  // namespace
 
-Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s, int threads) {
+Diagnosis diagnose(const Campaign& c0, const DiagnoseSettings& s, int threads, const EffectsProgress& progress) {
   const internal::StageOptions o = internal::stage_options(s);
   Campaign c = c0;
   const Nuisance drift = remove_drift(c);  // the bias drift, removed first
   internal::ResponseCache cache;
-  Diagnosis d = diagnose_once(c, o, cache, threads);
+  Diagnosis d = diagnose_once(c, o, cache, threads, progress);
   // The stated sigma: scaled and judged again when the gaps say it is scatter.
   const Nuisance scale =
-      internal::sigma_scale(c, o.scatter, d, [&](const Campaign& scaled) { return diagnose_once(scaled, o, cache, threads); });
+      internal::sigma_scale(c, o.scatter, d, [&](const Campaign& scaled) { return diagnose_once(scaled, o, cache, threads, progress); });
   d.nuisances = {drift, scale};  // (a drift removed or a sigma scaled is said after the verdict: verdict_text)
   return d;
 }

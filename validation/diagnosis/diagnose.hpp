@@ -16,6 +16,7 @@
 // prediction's gradient in the coefficients, Sigma their covariance from the static test,
 // f_model the simulation's own relative accuracy). Fits and chi^2 use V.
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -255,9 +256,13 @@ struct Diagnosis {
 // removed from every run with a time. Fewer than 3 rest readings: not estimated, c unchanged.
 Nuisance remove_drift(Campaign& c);
 
+// Told after each effect's fits and folds (done of total; under a lock, one call at a time): a
+// progress display. A diagnosis whose stated sigma is scaled fits the effects twice.
+using EffectsProgress = std::function<void(std::size_t done, std::size_t total)>;
+
 // threads: the effects' fits and folds on this many threads (0: all cores); the diagnosis is
 // the same numbers whatever the count. A caller that diagnoses campaigns in parallel keeps 1.
-Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {}, int threads = 1);
+Diagnosis diagnose(const Campaign& c, const DiagnoseSettings& s = {}, int threads = 1, const EffectsProgress& progress = {});
 
 // The gap a hidden effect makes, as the diagnosis' nominal model sees it (blind's family size;
 // docs/blind.md, "Blind's measures"). `with` and `without` are one virtual-lab campaign

@@ -150,7 +150,8 @@ void heldout_nominal(const CampaignModel& m, Evidence& ev, Diagnosis& d) {
   }
 }
 
-void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, Diagnosis& d, int threads) {
+void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, Diagnosis& d, int threads,
+                   const EffectsProgress& progress) {
   const Data& data = m.data;
   const std::vector<int>& all = m.all;
   std::vector<const Effect*> effects;
@@ -186,6 +187,8 @@ void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, D
     sc.fit.at_bound = !std::isfinite(sp);
     sc.fit.parameters = fitted_parameters(e, mf);
     sc.all = std::move(mf);
+  }, [&, done = std::size_t{0}](std::size_t) mutable {
+    if (progress) progress(++done, order.size());
   });
   for (std::size_t i = 0; i < effects.size(); ++i) {
     ev.fitters[effects[i]->name] = std::move(fitters[i]);

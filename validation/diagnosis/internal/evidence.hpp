@@ -107,6 +107,8 @@ void heldout_nominal(const CampaignModel& m, Evidence& ev, Diagnosis& d);
 // The effects on `threads` threads (0: all cores), each effect's fits and folds on one: the
 // same numbers whatever the count (each is a function of the data and the effect alone; the
 // response cache they share keeps what is computed first, the same numbers by any thread).
-void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, Diagnosis& d, int threads = 1);
+// progress: told after each effect (diagnose's EffectsProgress).
+void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, Diagnosis& d, int threads = 1,
+                   const EffectsProgress& progress = {});
 
 }  // namespace vrelab::validation::internal
