@@ -73,18 +73,10 @@ void Scorer::score(const std::function<Fitted(const std::vector<int>&)>& fit_on,
       Ga << f.t.G, f.slopes;
       with = conditional_on(da, f.t.pred, Ga, train);
     }
-    const double fold = key;  // (a structured binding: clang 14 captures none)
-    const Likelihood without = [&] {
-      {
-        const std::lock_guard<std::mutex> g(nominal_heldout_lock_);
-        const auto known = nominal_heldout_.find(fold);
-        if (known != nominal_heldout_.end()) return known->second;
-      }
-      const Likelihood l = train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all)
-                                                       : conditional_on(data, nominal.pred, nominal.G, train);
-      const std::lock_guard<std::mutex> g(nominal_heldout_lock_);
-      return nominal_heldout_.try_emplace(fold, l).first->second;
-    }();
+    const Likelihood without = find_or_make(nominal_heldout_lock_, nominal_heldout_, key, [&] {
+      return train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all)
+                                        : conditional_on(data, nominal.pred, nominal.G, train);
+    });
     sc.fit.evidence += without.m2logl - with.m2logl;
     sc.fit.heldout_chi2 += with.chi2;
     const Eigen::VectorXd a = adjusted_residual(data, f.t.pred, f.t.G, train, test);

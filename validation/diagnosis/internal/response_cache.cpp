@@ -38,15 +38,9 @@ const rectification::RandomResponse& ResponseCache::random_response(const std::s
   k.append(reinterpret_cast<const char*>(&address), sizeof address);
   for (Eigen::Index i = 0; i < 9; ++i) put(turn(i));
   put(q.max_log_step), put(q.common_grid ? 1.0 : 0.0);
-  {
-    const std::lock_guard<std::mutex> g(mutex_);
-    const auto it = random_.find(k);
-    if (it != random_.end()) return it->second.response;
-  }
-  // Computed without the lock (h asks get() for the responses).
-  RandomEntry entry{p.measured, rectification::random_response(p, h, q, turn)};
-  const std::lock_guard<std::mutex> g(mutex_);
-  return random_.try_emplace(std::move(k), std::move(entry)).first->second.response;
+  // (h asks get() for the responses: made without the lock.)
+  return find_or_make(mutex_, random_, k, [&] { return RandomEntry{p.measured, rectification::random_response(p, h, q, turn)}; })
+      .response;
 }
 
 std::shared_ptr<const Table> ResponseCache::table(const std::string& key) {
@@ -90,15 +84,7 @@ ResponseCache::DynamicsKey ResponseCache::key(const plant::Dynamics& d) {
 }
 
 const plant::Servo& ResponseCache::servo(const plant::Dynamics& d) {
-  const DynamicsKey k = key(d);
-  {
-    const std::lock_guard<std::mutex> g(mutex_);
-    const auto it = servos_.find(k);
-    if (it != servos_.end()) return it->second;
-  }
-  plant::Servo designed = plant::design_servo(d);
-  const std::lock_guard<std::mutex> g(mutex_);
-  return servos_.try_emplace(k, designed).first->second;
+  return find_or_make(mutex_, servos_, key(d), [&] { return plant::design_servo(d); });
 }
 
 // What loop_response reads of a plant (with its servo): the coefficients its linear plant
@@ -124,15 +110,8 @@ std::vector<double> ResponseCache::linear_part(const PlantConfig& cfg) {
 }
 
 const rectification::LoopResponder& ResponseCache::responder(const PlantConfig& cfg, const std::string& key) {
-  auto k = std::make_pair(key, linear_part(cfg));
-  {
-    const std::lock_guard<std::mutex> g(mutex_);
-    const auto it = responders_.find(k);
-    if (it != responders_.end()) return *it->second;
-  }
-  auto made = std::make_unique<rectification::LoopResponder>(cfg);
-  const std::lock_guard<std::mutex> g(mutex_);
-  return *responders_.try_emplace(std::move(k), std::move(made)).first->second;
+  return *find_or_make(mutex_, responders_, std::make_pair(key, linear_part(cfg)),
+                       [&] { return std::make_unique<rectification::LoopResponder>(cfg); });
 }
 
 }  // namespace vrelab::validation::internal

@@ -37,6 +37,23 @@ namespace vrelab::validation::internal {
 // under the effect.
 using Absorbed = std::map<std::string, plant::Coefficients>;
 
+// The entry of `map` (a std::map shared by threads, guarded by `lock`) at `key`, made by
+// make() when missing, without the lock, so that other threads' look-ups go on meanwhile. Two
+// threads that make the same entry make the same value (every entry is a function of its key
+// alone): the first stored is kept. Entries are not erased while in use, so the reference
+// stays valid.
+template <class Map, class Key, class Make>
+const typename Map::mapped_type& find_or_make(std::mutex& lock, Map& map, const Key& key, Make&& make) {
+  {
+    const std::lock_guard<std::mutex> g(lock);
+    const auto it = map.find(key);
+    if (it != map.end()) return it->second;
+  }
+  typename Map::mapped_type value = make();
+  const std::lock_guard<std::mutex> g(lock);
+  return map.try_emplace(key, std::move(value)).first->second;
+}
+
 class ResponseCache {
  public:
   // The tables (tabulate) and what the static test takes up, per effect and value, for one
