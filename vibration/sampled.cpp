@@ -268,9 +268,12 @@ struct RandomExcitation::Cache {
   std::vector<double> w0, w1;
 };
 
-RandomExcitation::RandomExcitation(const RandomProfile& profile, double fs, std::uint64_t seed, std::size_t m)
-    : profile_(profile), fs_(fs), seed_(seed), m_(m), max_frequency_Hz_(0), cache_(std::make_unique<Cache>()) {
+RandomExcitation::RandomExcitation(const RandomProfile& profile, double fs, std::uint64_t seed, std::size_t m,
+                                   const Eigen::Matrix3d& turn)
+    : profile_(profile), fs_(fs), seed_(seed), m_(m), max_frequency_Hz_(0), turn_(turn), turned_(!turn.isIdentity(0)),
+      cache_(std::make_unique<Cache>()) {
   max_frequency_Hz_ = vibration::max_frequency_Hz(profile_);  // validates the profile
+  if (!turn_.allFinite()) throw std::invalid_argument("turn: not finite");
   if (m_ < 1024 || m_ % 2 != 0)
     throw std::invalid_argument("block_length = " + std::to_string(m_) + " must be even and >= 1024");
   double narrowest = std::numeric_limits<double>::infinity();
@@ -357,6 +360,12 @@ void RandomExcitation::samples_into(std::int64_t first, std::size_t count, Sampl
   out.sample_rate_Hz = fs_;
   std::lock_guard lock(cache_->mutex);
   stream_samples(profile_, fs_, seed_, m_, *cache_, first, count, out.samples_g);
+  if (!turned_) return;
+  auto& x = out.samples_g;
+  for (std::size_t n = 0; n < count; ++n) {
+    const Vec3 v = turn_ * Vec3(x[0][n], x[1][n], x[2][n]);
+    for (int a = 0; a < 3; ++a) x[a][n] = v[a];
+  }
 }
 
 Vec3 RandomExcitation::acceleration_g(double t) const {
@@ -392,12 +401,12 @@ Vec3 RandomExcitation::acceleration_g(double t) const {
     const auto i = static_cast<std::size_t>(n - (hi ? c_hi : c_lo) * h);
     for (int a = 0; a < 3; ++a) out[a] += w[k] * s[a][i];
   }
-  return out;
+  return turned_ ? Vec3(turn_ * out) : out;
 }
 
 std::string RandomExcitation::describe() const {
   return vibration::describe(profile_) + ", fs " + num(fs_) + " Hz, seed " + std::to_string(seed_) + ", blocks of " +
-         std::to_string(m_);
+         std::to_string(m_) + (turned_ ? ", turned" : "");
 }
 
 }  // namespace vrelab::vibration

@@ -76,10 +76,13 @@ class SampledExcitation final : public Excitation {
 class RandomExcitation final : public Excitation {
  public:
   struct Cache;
+  static constexpr std::size_t kDefaultBlockLength = 32768;
   // block_length M: even, >= 1024, and fine enough that fs/M is at most a quarter of the
   // narrowest table segment (otherwise std::invalid_argument naming block_length).
+  // turn: the motion in sensor axes is turn x the profile's, sample by sample (a fixture that
+  // holds the sensor turned: S' = turn S turn^T); finite, else std::invalid_argument naming turn.
   RandomExcitation(const RandomProfile& profile, double sample_rate_Hz, std::uint64_t seed,
-                   std::size_t block_length = 32768);
+                   std::size_t block_length = kDefaultBlockLength, const Eigen::Matrix3d& turn = Eigen::Matrix3d::Identity());
   ~RandomExcitation() override;
   Vec3 acceleration_g(double t_s) const override;
   double max_frequency_Hz() const override { return max_frequency_Hz_; }
@@ -106,6 +109,8 @@ class RandomExcitation final : public Excitation {
   std::uint64_t seed_;
   std::size_t m_;
   double max_frequency_Hz_;
+  Eigen::Matrix3d turn_;
+  bool turned_;  // turn_ is not the identity
   std::unique_ptr<Cache> cache_;
 };
 

@@ -130,4 +130,35 @@ TEST(RandomExcitation, InterpolantEqualsOneShotSplineAcrossStretches) {
   EXPECT_LT(RandomExcitation(p, 20000, 1, 32768).memory_bytes(), 4.5e6);
 }
 
+// A turned excitation (a fixture holding the sensor turned) is the unturned one's motion times
+// the matrix, sample by sample and between samples (the interpolant is linear in the samples):
+// to rounding (1e-14 g on samples of a few g). An axis at rest in the profile moves once
+// turned; the identity leaves the stream bit for bit as it was.
+TEST(RandomExcitation, ATurnedExcitationIsTheMatrixTimesTheUnturnedMotion) {
+  RandomProfile p;
+  p.psd[IA] = PsdTable{{PsdRow::level(20, 0.04), PsdRow::level(500, 0.04)}};
+  p.psd[PA] = PsdTable{{PsdRow::level(50, 0.01), PsdRow::level(400, 0.02)}};
+  p.coupling = AxisCoupling::independent;
+  const double fs = 4000;
+  Eigen::Matrix3d turn;
+  turn << 0.99, -0.1, 0.02, 0.1, 0.99, 0.0, -0.02, 0.0, 1.0;
+  const RandomExcitation plain(p, fs, 42, 1024), turned(p, fs, 42, 1024, turn), same(p, fs, 42, 1024, Eigen::Matrix3d::Identity());
+  const SampledSignal a = plain.samples(-700, 3000), b = turned.samples(-700, 3000), c = same.samples(-700, 3000);
+  double worst = 0, oa = 0;
+  for (std::size_t n = 0; n < a.size(); ++n) {
+    const Vec3 x(a.samples_g[IA][n], a.samples_g[PA][n], a.samples_g[OA][n]);
+    const Vec3 y(b.samples_g[IA][n], b.samples_g[PA][n], b.samples_g[OA][n]);
+    worst = std::max(worst, (y - turn * x).cwiseAbs().maxCoeff());
+    oa = std::max(oa, std::abs(y[OA]));
+    for (int k = 0; k < 3; ++k) ASSERT_EQ(c.samples_g[k][n], a.samples_g[k][n]);
+  }
+  for (double t : {-0.1, 0.0, 0.01234, 0.3, 0.49}) worst = std::max(worst, (turned.acceleration_g(t) - turn * plain.acceleration_g(t)).cwiseAbs().maxCoeff());
+  EXPECT_LT(worst, 1e-14);
+  EXPECT_GT(oa, 0.01);  // OA at rest in the profile, moved by the turn
+  EXPECT_NE(turned.describe().find("turned"), std::string::npos);
+  Eigen::Matrix3d bad = turn;
+  bad(1, 2) = NAN;
+  EXPECT_THROW(RandomExcitation(p, fs, 42, 1024, bad), std::invalid_argument);
+}
+
 }  // namespace test_vibration_sampled

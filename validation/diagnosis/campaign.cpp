@@ -82,22 +82,10 @@ VirtualLab truth_lab(const plant::PlantConfig& truth, const std::vector<HiddenEf
 
 // The design's random and sine-on-random runs appended to c.runs (a random run described by
 // its PSD); std::invalid_argument for what the virtual lab does not make.
-void add_random_runs(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden, const CampaignDesign& design,
-                     bool raw, Campaign& c) {
+void add_random_runs(const CampaignDesign& design, bool raw, Campaign& c) {
   if (design.random_runs.empty()) return;
   if (raw) throw std::invalid_argument("campaign: random_runs: raw records of random runs are not made (summaries only)");
   if (!(design.random_record_s > 0)) throw std::invalid_argument("campaign: random_record_s: must be positive");
-  // A hidden effect whose hypothesis turns a random part (TableMotion::random_turn): the truth
-  // hooks move the sine only, so the lab would not do what the hypothesis says.
-  for (const HiddenEffect& h : hidden) {
-    const Effect& e = *find_effect(h.name);
-    plant::PlantConfig p = truth;
-    TableMotion m;
-    e.apply(h.values(e), p, m);
-    if (!m.random_turn.isIdentity())
-      throw std::invalid_argument("campaign: random_runs: the virtual lab does not turn a random part by a hidden " + h.name +
-                                  " (the diagnosis' hypothesis does): hide it in a design of sine runs");
-  }
   for (const RandomRunDesign& rd : design.random_runs) {
     vibration::validate(rd.profile);
     RunRecord r;
@@ -118,13 +106,14 @@ void add_random_runs(const plant::PlantConfig& truth, const std::vector<HiddenEf
 }
 
 // A random or sine-on-random run on the ODE plant: the plant and acquisition effects as for a
-// sine run, the table-motion effects on the sine part only (a pure random run: none); the
-// random part synthesised at 8 x its top frequency from `seed`, measured over record_s in 8 blocks.
+// sine run, the table-motion effects on the sine part, the fixture's turn on the random part
+// too (VirtualLab::random_turn); the random part synthesised at 8 x its top frequency from `seed`, measured over record_s in 8 blocks.
 rectification::ShakeResult shake_random_run(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
                                             const RunRecord& r, double record_s, std::uint64_t seed) {
   const VirtualLab lab = truth_lab(truth, hidden, r.sine_part ? &r : nullptr);
   const double top_Hz = vibration::max_frequency_Hz(*r.random);
-  std::shared_ptr<const vibration::Excitation> motion = std::make_shared<vibration::RandomExcitation>(*r.random, 8 * top_Hz, seed);
+  std::shared_ptr<const vibration::Excitation> motion = std::make_shared<vibration::RandomExcitation>(
+      *r.random, 8 * top_Hz, seed, vibration::RandomExcitation::kDefaultBlockLength, lab.random_turn);
   if (r.sine_part)
     motion = std::make_shared<vibration::SumExcitation>(std::vector<std::shared_ptr<const vibration::Excitation>>{lab.excitation(), motion});
   rectification::ShakeSettings ss;
@@ -176,7 +165,7 @@ Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<Hi
   // Random and sine-on-random runs, after the sine runs (their noise draws come after the sine
   // runs': a design without them draws as before).
   const bool raw = design.raw_sample_rate_Hz > 0;
-  add_random_runs(truth, hidden, design, raw, c);
+  add_random_runs(design, raw, c);
   std::vector<double> noise(c.runs.size());
   for (double& x : noise) x = n01(rng);
   if (raw) c.raw.resize(c.runs.size());

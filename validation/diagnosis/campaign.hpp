@@ -75,10 +75,9 @@ struct CampaignDesign {
   // random_record_s of motion (after settling) in 8 blocks: its measured error is the ODE's
   // plus Gaussian noise of run_sigma_g, its sigma the blocks' and run_sigma_g in quadrature.
   // Plant and acquisition effects act on them as on sine runs; of the table-motion effects,
-  // the sine of a sine-on-random run takes them, the random part none (as the diagnosis'
-  // hypotheses, docs/data-format.md), so a hidden effect whose hypothesis turns a random part
-  // (mounting_misalignment) is refused beside random runs (std::invalid_argument). Summaries
-  // only: raw records of random runs are refused.
+  // the sine of a sine-on-random run takes them, the random part only the fixture's turn
+  // (VirtualLab::random_turn: mounting_misalignment), as the diagnosis' hypotheses do
+  // (docs/data-format.md). Summaries only: raw records of random runs are refused.
   std::vector<RandomRunDesign> random_runs;
   double random_record_s = 16.0;
 };

@@ -70,6 +70,9 @@ struct VirtualLab {
   Vec3 static_gravity_g = Vec3::Zero();
   std::vector<vibration::Harmonic> harmonics;
   std::optional<vibration::RockingSpec> rocking;
+  // A random part's motion in sensor axes: random_turn times the profile's, sample by sample
+  // (the fixture's turn; the shaker's other imperfections act on the sine only).
+  Eigen::Matrix3d random_turn = Eigen::Matrix3d::Identity();
 
   plant::PlantConfig run_plant() const;  // the instrument read by the run's acquisition
   std::shared_ptr<const vibration::Excitation> excitation() const;

@@ -40,11 +40,12 @@ Effect effect_mounting_misalignment() {
     // A random part turned alike, its cross-spectra and all (S' = R S R^T).
     m.random_turn = turn_matrix(a0, b0) * m.random_turn;
   };
-  // The table's motion in sensor axes turned by the rotation matrices (the static gravity is
-  // the run's stated orientation).
+  // The table's motion in sensor axes turned by the rotation matrices: the sine's phasors, a
+  // random part's samples (the static gravity is the run's stated orientation).
   e.truth = [](ParameterValues v, VirtualLab& lab) {
     if (v[0] == 0 && v[1] == 0) return;
     effects::set_phasors(lab.table, turn_matrix(v[0], v[1]).cast<std::complex<double>>() * effects::phasors(lab.table));
+    lab.random_turn = turn_matrix(v[0], v[1]) * lab.random_turn;
   };
   e.draw = [](std::mt19937_64& rng) {
     const double s = effects::random_sign(rng);
