@@ -67,8 +67,8 @@ namespace {
 // reads them back instead of running them again (a killed run resumes; --n may grow); a
 // line whose checksum fails (cut short, edited) is run again.
 std::string blind_header(const validation::BlindSettings& s) {
-  std::string text = fmt::format("# vrelab {} ({}) blind: campaigns diagnosed (index, result, checksum); seed {}",
-                                 kProgramVersion, kGitDescribe, s.seed);
+  std::string text = fmt::format("# vrelab {} ({}) blind: campaigns diagnosed (index, result, checksum); seed {}{}",
+                                 kProgramVersion, kGitDescribe, s.seed, s.mixed ? "; mixed designs" : "");
   core::for_each_field<validation::DiagnoseSettings>(
       [&](const auto& f) { text += fmt::format(" {} {}", f.name, core::format_value(s.diagnose.*f.member, 17)); });
   return text + "\n";

@@ -125,6 +125,14 @@ json campaign_row(const validation::BlindCampaign& k) {
   }
   json row = {{"index", k.index}, {"seed", k.seed},           {"category", k.category}, {"hidden", h},
               {"called", k.called}, {"simulate_s", k.simulate_s}, {"wall_s", k.wall_s}};
+  if (k.mixed) {  // its design (validation::blind_design): the runs of each kind
+    const validation::CampaignDesign d = validation::blind_design(k);
+    std::size_t sine_on = 0;
+    for (const auto& r : d.random_runs) sine_on += r.sine_part;
+    row["design"] = {{"sine_runs", d.frequencies_Hz.size() * d.amplitudes_g.size() * d.directions.size() * d.orientations_g.size()},
+                     {"random_runs", d.random_runs.size() - sine_on},
+                     {"sine_on_random_runs", sine_on}};
+  }
   if (k.category == "single" || k.category == "natural") {
     row["effect_gap_sigma"] = finite_or_null(k.effect_gap_sigma);  // the scored size
     row["effect_max_sigma"] = k.effect_max_sigma;                   // the largest run's size, beside
@@ -406,6 +414,8 @@ json to_json(const validation::BlindResult& r) {
           {"two_effect_explained_by_one_of_them", BlindScores::rate(s.two_by_one, s.two)},
           {"two_effect_explained_by_both", BlindScores::rate(s.two_by_both, s.two)},
           {"two_effect_campaigns", s.two},
+          {"at_limit_campaigns", s.at_limit},
+          {"at_limit_gap_found", BlindScores::rate(s.at_limit_found, s.at_limit)},
           {"family_size", "effect_gap_sigma: sqrt(g^T V^-1 g), the effect's gap as the nominal model sees it against the "
                           "diagnosis' covariance (static-test coefficient uncertainty included); scored when >= 5"},
           {"median_gap_shrinkage_noise_removed", s.median_gap_shrinkage},

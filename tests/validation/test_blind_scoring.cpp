@@ -287,6 +287,11 @@ TEST(BlindScoring, SinglesAreScoredByTheGapAsTheLabSeesItTheLargestRunSizeBeside
   EXPECT_EQ(sc.gap_shrinkage_campaigns, 2);
   EXPECT_DOUBLE_EQ(sc.by_max_run_sigma.median_shrinkage, 0.8);  // campaigns 9 (0.2), 11 (0.8)
   EXPECT_DOUBLE_EQ(sc.median_shrinkage, 0.8);                   // campaigns 10 (0.3), 11 (0.8)
+  // Detection at the limit: an expected chi^2 deviate of 40^2 / sqrt(2 x 168) = 87 (campaigns 6,
+  // 7 natural, 11 single) is >= 5; 8^2 / 18.33 = 3.5 (10) and 3^2 / 18.33 (9) are not. Of the
+  // three, 11 alone has its gap found.
+  EXPECT_EQ(sc.at_limit, 3);
+  EXPECT_EQ(sc.at_limit_found, 1);
   const std::string brief = r.BriefReport();
   EXPECT_NE(brief.find("shrinkage of the gap rms (the lab's noise removed; 2 single campaigns): 90 %"), std::string::npos) << brief;
   EXPECT_NE(brief.find("sized by the largest run, >= 5 sigma in some run: 1/2 = 50 %"), std::string::npos) << brief;
@@ -387,6 +392,71 @@ TEST(BlindScoring, TheIssuesCriteriaAreCountedFromTheFamilies) {
   EXPECT_FALSE(by["all families"].met());  // 3.0 % > 1 %
   EXPECT_EQ(by["drift"].n, 0);
   EXPECT_FALSE(by["drift"].met());  // no campaigns: nothing shown
+}
+
+// blind --mixed: each campaign on a design of its own, drawn from its seed in a stream apart
+// from its key's (the key is the sine draw's, campaign by campaign): 36 sine runs (3 of the
+// default's 7 frequencies x 1, 2, 4 g x IA, PA x two orientations), 5-8 random runs of 2-12 g
+// rms in all and 1-2 sine on random (2-6 g rms; a 1-3 g sine at 40-400 Hz along IA or PA),
+// 8 s records; over 48 campaigns every shape, both couplings and both orientations appear.
+// A sine campaign keeps the default design. The rms is summed over the axes' tables here
+// (vibration::rms_g of each), a path apart from the draw's scaling of one table.
+TEST(BlindMixed, EachCampaignsDesignIsDrawnFromItsSeedWithinItsRanges) {
+  const CampaignDesign sine = blind_design(blind_key(3, 11));
+  EXPECT_EQ(sine.frequencies_Hz.size() * sine.amplitudes_g.size() * sine.directions.size() * sine.orientations_g.size(), 168u);
+  EXPECT_TRUE(sine.random_runs.empty());
+  const std::vector<double> all_f = default_design().frequencies_Hz;
+  std::map<double, int> top_levels;  // a shape told by its top PSD level over its rms^2
+  int common = 0, independent = 0, up = 0, down = 0;
+  for (int i = 0; i < 48; ++i) {
+    const BlindCampaign k = blind_key(i, 11, true), ks = blind_key(i, 11);
+    ASSERT_TRUE(k.mixed);
+    EXPECT_EQ(k.category, ks.category) << i;
+    ASSERT_EQ(k.hidden.size(), ks.hidden.size()) << i;
+    for (std::size_t j = 0; j < k.hidden.size(); ++j) EXPECT_EQ(k.hidden[j].parameter, ks.hidden[j].parameter) << i;
+    const CampaignDesign d = blind_design(k), again = blind_design(k);
+    ASSERT_EQ(d.frequencies_Hz.size(), 3u);
+    for (double f : d.frequencies_Hz) EXPECT_NE(std::find(all_f.begin(), all_f.end(), f), all_f.end()) << f;
+    EXPECT_EQ(d.frequencies_Hz, again.frequencies_Hz);
+    EXPECT_EQ(d.amplitudes_g, (std::vector<double>{1, 2, 4}));
+    EXPECT_EQ(d.directions.size() * d.orientations_g.size(), 4u);
+    EXPECT_EQ(d.random_record_s, 8.0);
+    int random = 0, sine_on = 0;
+    ASSERT_EQ(d.random_runs.size(), again.random_runs.size());
+    for (const RandomRunDesign& r : d.random_runs) {
+      double ms = 0;
+      int axes = 0;
+      for (const auto& t : r.profile.psd)
+        if (t) ms += std::pow(vibration::rms_g(*t), 2), ++axes;
+      const double rms = std::sqrt(ms);
+      if (r.sine_part) {
+        ++sine_on;
+        EXPECT_TRUE(rms >= 2 - 1e-9 && rms <= 6 + 1e-9) << rms;
+        EXPECT_TRUE(r.amplitude_g >= 1 && r.amplitude_g <= 3) << r.amplitude_g;
+        EXPECT_TRUE(r.frequency_Hz >= 40 && r.frequency_Hz <= 400) << r.frequency_Hz;
+        EXPECT_TRUE(r.direction == Vec3::UnitX() || r.direction == Vec3::UnitY());
+      } else {
+        ++random;
+        EXPECT_TRUE(rms >= 2 - 1e-9 && rms <= 12 + 1e-9) << rms;
+      }
+      EXPECT_TRUE(axes == 1 || (axes == 2 && r.profile.psd[0].has_value())) << axes;
+      for (const auto& t : r.profile.psd)
+        if (t) {
+          double top = 0;
+          for (const auto& row : t->rows) top = std::max(top, *row.psd_g2_per_Hz);
+          ++top_levels[std::round(1e5 * top / std::pow(vibration::rms_g(*t), 2))];
+        }
+      (r.profile.coupling == vibration::AxisCoupling::common ? common : independent)++;
+      (r.orientation_g[0] > 0 ? up : down)++;
+    }
+    EXPECT_TRUE(random >= 5 && random <= 8) << random;
+    EXPECT_TRUE(sine_on >= 1 && sine_on <= 2) << sine_on;
+  }
+  EXPECT_EQ(top_levels.size(), 3u);  // GEVS, NAVMAT, flat
+  EXPECT_GT(common, 20);
+  EXPECT_GT(independent, 20);
+  EXPECT_GT(up, 20);
+  EXPECT_GT(down, 20);
 }
 
 }  // namespace test_blind_scoring

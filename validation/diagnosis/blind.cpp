@@ -1,6 +1,7 @@
 #include "validation/diagnosis/blind.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <numbers>
@@ -14,6 +15,7 @@
 #include "core/dispatch.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
+#include "validation/diagnosis/effects/common.hpp"
 
 namespace vrelab::validation {
 namespace {
@@ -51,9 +53,10 @@ std::vector<std::string> out_of_library_effects() {
 // Campaign i's key: its category and hidden effects, from its own seed. The mix, per 12:
 // 2 clean, 2 out of library (1 in odd twelves, which have 1 dynamics_off instead), 1 pair,
 // 1 sigma understated, 1 drift, 2 natural forms, 3 single.
-BlindCampaign draw_campaign(int i, std::uint64_t seed, const std::vector<std::string>& library) {
+BlindCampaign draw_campaign(int i, std::uint64_t seed, const std::vector<std::string>& library, bool mixed) {
   BlindCampaign k;
   k.index = i, k.seed = seed * 1000003u + static_cast<std::uint64_t>(i);
+  k.mixed = mixed;
   std::mt19937_64 rng(k.seed);
   const int slot = i % 12;
   if (slot < 2) {
@@ -127,7 +130,8 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
     std::mt19937_64 rng(k.seed + 17);
     const plant::PlantConfig truth = blind_truth(rng);
     std::vector<double> noise_g;  // each run's noise draw (the virtual lab's own)
-    Campaign camp = simulate_campaign(truth, k.hidden, default_design(), k.seed, 1, {}, &noise_g);
+    const CampaignDesign design = blind_design(k);
+    Campaign camp = simulate_campaign(truth, k.hidden, design, k.seed, 1, {}, &noise_g);
     if (k.category == "single" || k.category == "natural") {
       // The effect's size through the ODE (the virtual lab without the effect, the same seed:
       // the same noise draws, so the difference is the effect's alone), not through the
@@ -135,7 +139,7 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
       // the model under test. The scored size is the gap's significance as the nominal model
       // sees it (after what the static test's coefficient uncertainty absorbs; the nominal
       // model and the static test only); the largest run's size beside it.
-      const Campaign clean = simulate_campaign(truth, {}, default_design(), k.seed, 1);
+      const Campaign clean = simulate_campaign(truth, {}, design, k.seed, 1);
       for (std::size_t j = 0; j < camp.runs.size(); ++j)
         k.effect_max_sigma =
             std::max(k.effect_max_sigma, std::abs(camp.runs[j].measured_g - clean.runs[j].measured_g) / camp.runs[j].sigma_g);
@@ -343,6 +347,11 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
   note(k.category == "clean" && !d.gap_significant ? why + " (a nuisance flagged on a clean campaign)" : why);
 }
 
+// The number of shaker runs a design makes (sine, random and sine-on-random).
+std::size_t design_runs(const CampaignDesign& d) {
+  return d.frequencies_Hz.size() * d.amplitudes_g.size() * d.directions.size() * d.orientations_g.size() + d.random_runs.size();
+}
+
 // Scores one campaign against its key into r (counts, confusion, the wrong ones).
 // The held-out shrinkages 1 - after / before of the single campaigns: of the residuals' rms
 // (with the runs' noise) in g and in each run's sigma, of the gap's rms (noise removed), and of
@@ -358,6 +367,11 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
   const Diagnosis& d = k.diagnosis;
   const std::string& called = k.called;
   score_family(k, k.effect_gap_sigma, s.families, &r.wrong);
+  if ((k.category == "single" || k.category == "natural") && k.error.empty() &&
+      std::pow(k.effect_gap_sigma, 2) / std::sqrt(2.0 * static_cast<double>(design_runs(blind_design(k)))) >= 5) {
+    ++s.at_limit;
+    s.at_limit_found += d.gap_significant;
+  }
   score_family(k, k.effect_max_sigma, s.by_max_run_sigma.families, nullptr);
   if (k.category == "single" && k.error.empty()) {  // the single family by the largest run's size
     LargestRunSizeScores& o = s.by_max_run_sigma;
@@ -446,10 +460,75 @@ bool parameters_match(const HiddenEffect& truth, const Diagnosis& d, std::string
   return ok;
 }
 
-BlindCampaign blind_key(int index, std::uint64_t seed) {
+BlindCampaign blind_key(int index, std::uint64_t seed, bool mixed) {
   std::vector<std::string> library;
   for (const auto& e : effect_library()) library.push_back(e.name);
-  return draw_campaign(index, seed, library);
+  return draw_campaign(index, seed, library, mixed);
+}
+
+namespace {
+
+// A PSD shape scaled to `rms_g`: GEVS (GSFC-STD-7000A), NAVMAT P-9492 or flat, 20 Hz - 2 kHz.
+vibration::PsdTable shaped_psd(int shape, double rms_g) {
+  using vibration::PsdRow;
+  vibration::PsdTable t;
+  if (shape == 0) t.rows = {PsdRow::level(20, 0.026), PsdRow::level(50, 0.16), PsdRow::level(800, 0.16), PsdRow::level(2000, 0.026)};
+  else if (shape == 1) t.rows = {PsdRow::level(20, 0.01), PsdRow::level(80, 0.04), PsdRow::level(350, 0.04), PsdRow::level(2000, 0.007)};
+  else t.rows = {PsdRow::level(20, 0.02), PsdRow::level(2000, 0.02)};
+  const double k = std::pow(rms_g / vibration::rms_g(t), 2);
+  for (PsdRow& r : t.rows) *r.psd_g2_per_Hz *= k;
+  return t;
+}
+
+// A random part of `rms_g` in all (split evenly over its axes): a shape; one axis (IA twice as
+// likely as PA or OA) or IA with PA or with OA; common or independent phases.
+vibration::RandomProfile drawn_profile(std::mt19937_64& rng, double rms_g) {
+  const int shape = std::uniform_int_distribution<int>(0, 2)(rng);
+  const int axes = std::uniform_int_distribution<int>(0, 5)(rng);  // IA, IA, PA, OA, IA+PA, IA+OA
+  vibration::RandomProfile p;
+  if (axes <= 3) {
+    p.psd[static_cast<std::size_t>(axes <= 1 ? 0 : axes - 1)] = shaped_psd(shape, rms_g);
+  } else {
+    p.psd[0] = shaped_psd(shape, rms_g / std::sqrt(2.0));
+    p.psd[axes == 4 ? 1 : 2] = shaped_psd(shape, rms_g / std::sqrt(2.0));
+  }
+  p.coupling = effects::coin(rng) ? vibration::AxisCoupling::common : vibration::AxisCoupling::independent;
+  return p;
+}
+
+}  // namespace
+
+CampaignDesign blind_design(const BlindCampaign& k) {
+  CampaignDesign d = default_design();
+  if (!k.mixed) return d;
+  std::mt19937_64 rng(k.seed + 31);
+  std::vector<double> f = d.frequencies_Hz;
+  std::shuffle(f.begin(), f.end(), rng);
+  f.resize(3);
+  std::sort(f.begin(), f.end());
+  d.frequencies_Hz = f;
+  d.directions = {Vec3::UnitX(), Vec3::UnitY()};
+  const Vec3 up = d.orientations_g[0], down = d.orientations_g[1];
+  const auto orientation = [&] { return effects::coin(rng) ? up : down; };
+  const int n_random = std::uniform_int_distribution<int>(5, 8)(rng), n_sine_on = std::uniform_int_distribution<int>(1, 2)(rng);
+  for (int i = 0; i < n_random; ++i) {
+    RandomRunDesign r;
+    r.profile = drawn_profile(rng, effects::log_uniform(rng, 2, 12));
+    r.orientation_g = orientation();
+    d.random_runs.push_back(r);
+  }
+  for (int i = 0; i < n_sine_on; ++i) {
+    RandomRunDesign r;
+    r.profile = drawn_profile(rng, effects::log_uniform(rng, 2, 6));
+    r.orientation_g = orientation();
+    r.sine_part = true;
+    r.frequency_Hz = std::array{40.0, 100.0, 200.0, 400.0}[std::uniform_int_distribution<std::size_t>(0, 3)(rng)];
+    r.amplitude_g = std::uniform_real_distribution<double>(1, 3)(rng);
+    r.direction = effects::coin(rng) ? Vec3::UnitX() : Vec3::UnitY();
+    d.random_runs.push_back(r);
+  }
+  d.random_record_s = 8;
+  return d;
 }
 
 plant::PlantConfig blind_truth(std::mt19937_64& rng) {
@@ -641,7 +720,7 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
   r.threads = core::threads_per_process(settings.threads);
   r.ranks = core::process_count();
   for (const auto& e : effect_library()) r.library.push_back(e.name);
-  for (int i = 0; i < settings.n; ++i) r.campaigns.push_back(draw_campaign(i, settings.seed, r.library));
+  for (int i = 0; i < settings.n; ++i) r.campaigns.push_back(draw_campaign(i, settings.seed, r.library, settings.mixed));
   std::vector<std::size_t> todo;
   std::size_t finished = 0;
   for (int i = 0; i < settings.n; ++i) {
@@ -652,7 +731,7 @@ BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progre
         read_campaign_result(it->second, r.campaigns[static_cast<std::size_t>(i)]);
         got = true, ++finished;
       } catch (const OutdatedCampaignResult&) {  // diagnosed again (its key drawn afresh)
-        r.campaigns[static_cast<std::size_t>(i)] = draw_campaign(i, settings.seed, r.library);
+        r.campaigns[static_cast<std::size_t>(i)] = draw_campaign(i, settings.seed, r.library, settings.mixed);
       }
     }
     if (!got) todo.push_back(static_cast<std::size_t>(i));
@@ -713,6 +792,7 @@ std::vector<BlindCriterion> BlindResult::Criteria() const {
   add("out of library: unexplained", right("out_of_library"), 0.90, true);
   add("sigma understated: flagged, no effect called", right("sigma_understated"), 0.90, true);
   add("drift: reported as drift", right("drift"), 0.90, true);
+  add("detection at the limit (expected chi^2 deviate >= 5): gap found", {scores.at_limit_found, scores.at_limit}, 0.95, true);
   add("clean: false alarm (a gap or a nuisance flagged)", {scores.false_alarms, scores.clean}, 0.02, false);
   int confidently_wrong = 0, all = 0;
   for (const auto& [name, f] : scores.families) confidently_wrong += f.wrong, all += f.n;
@@ -737,8 +817,10 @@ std::string family_rows(const std::map<std::string, FamilyScore>& families, cons
 
 std::string BlindResult::BriefReport() const {
   const BlindScores& s = scores;
-  std::string t = fmt::format("blind --n {} --seed {}: {:.1f} s wall on {} threads{}\n", settings.n, settings.seed, wall_s, threads,
-                              ranks > 1 ? fmt::format(" x {} MPI ranks", ranks) : "");
+  std::string t = fmt::format("blind --n {} --seed {}{}: {:.1f} s wall on {} threads{}\n", settings.n, settings.seed,
+                              settings.mixed ? " --mixed" : "", wall_s, threads, ranks > 1 ? fmt::format(" x {} MPI ranks", ranks) : "");
+  if (settings.mixed)
+    t += "  every campaign on a mixed design of its own: 36 sine runs, 5-8 random and 1-2 sine-on-random runs (blind_design)\n";
   const LargestRunSizeScores& o = s.by_max_run_sigma;
   t += "  a single or natural effect is scored when its gap is >= 5 sigma as the nominal model sees it (after the static "
        "test's coefficient uncertainty: effect_gap_sigma)\n";

@@ -42,6 +42,7 @@ struct BlindSettings {
   int n = 40;
   std::uint64_t seed = 7;
   int threads = 0;
+  bool mixed = false;  // every campaign on a mixed sine, random and sine-on-random design (blind_design)
   DiagnoseSettings diagnose;
 
   // Each field once (core/settings_description.hpp).
@@ -52,6 +53,8 @@ struct BlindSettings {
     v(field("n", &S::n, "campaigns", core::at_least(1), "Number of campaigns"));
     v(field("seed", &S::seed, "", core::any_value(), "Seed of the draw"));
     v(field("threads", &S::threads, "threads", core::at_least(0), "Threads (0: all cores; under mpirun per rank, 0 = 1)"));
+    v(field("mixed", &S::mixed, "", core::any_value(),
+            "Every campaign on a design of its own that mixes sine, random and sine-on-random runs (docs/blind.md)"));
     v(field("diagnose", &S::diagnose, "", core::any_value(), "Each campaign's diagnosis"));
   }
   // False with `why` naming the field ("diagnose.x" for a diagnosis setting), its value and rule.
@@ -63,6 +66,7 @@ struct BlindCampaign {
   int index = 0;
   std::uint64_t seed = 0;
   std::string category;  // clean, single, two, out_of_library
+  bool mixed = false;    // its design: the default sine design, or a mixed one (blind_design)
   std::vector<HiddenEffect> hidden;
   double noise_scale = 1;     // the runs' scatter over their stated sigma (sigma_understated)
   double drift_g_per_h = 0;   // the bias drift (drift)
@@ -125,6 +129,10 @@ struct BlindScores {
   int clean = 0, false_alarms = 0;
   int out_of_library = 0, out_of_library_unexplained = 0;
   int two = 0, two_by_one = 0, two_by_both = 0;
+  // Detection at the limit: single and natural campaigns whose gap's expected chi^2 deviate,
+  // effect_gap_sigma^2 / sqrt(2 n) over the campaign's n runs (the mean rise of chi^2 over its
+  // n, in chi^2's own sigma), is >= 5; the gap found significant.
+  int at_limit = 0, at_limit_found = 0;
   // The held-out shrinkage 1 - rms_after / rms_before, median over the scored single family:
   // of the gap itself (the lab's noise removed: gap_rms_*_g), the measure, and of the
   // residuals as the diagnosis sees them (with each run's noise; in g and in each run's sigma).
@@ -191,7 +199,15 @@ using BlindProgress = std::function<void(std::size_t done, std::size_t total)>;
 
 // Campaign `index`'s key in a blind draw of `seed` (category, hidden effects with their natural
 // form, the nuisances' sizes): what run_blind simulates, without running it.
-BlindCampaign blind_key(int index, std::uint64_t seed);
+BlindCampaign blind_key(int index, std::uint64_t seed, bool mixed = false);
+
+// The design campaign k is simulated on: default_design(), or for a mixed campaign one drawn
+// from its seed (a stream of its own: the key is the sine draw's): 36 sine runs (3 of the
+// default's frequencies x 1, 2, 4 g x IA and PA x a_IA = +-0.71 g), 5-8 random runs (GEVS,
+// NAVMAT or flat 20 Hz - 2 kHz shapes at 2-12 g rms log-uniform; along IA, PA or OA, or IA
+// with PA or OA, common or independent; either orientation) and 1-2 sine-on-random runs (a
+// 1-3 g sine at 40-400 Hz along IA or PA on 2-6 g rms), each random record 8 s.
+CampaignDesign blind_design(const BlindCampaign& k);
 
 // A natural form's scoring: the diagnosis' top effect is the hidden one and each of its
 // parameters the data pinned is within 3 sigma of the truth (a phase's difference wrapped to

@@ -74,8 +74,10 @@ double nominal_gap_significance(const Campaign& with, const Campaign& without, c
     throw std::invalid_argument("nominal_gap_significance: the campaigns have different runs");
   for (std::size_t k = 0; k < with.runs.size(); ++k) {
     const RunRecord &a = with.runs[k], &b = without.runs[k];
+    // (A random run's sigma is its own record's scatter, which the effect changes a little.)
     if (a.frequency_Hz != b.frequency_Hz || a.amplitude_g != b.amplitude_g || a.direction != b.direction ||
-        a.orientation_g != b.orientation_g || a.sigma_g != b.sigma_g)
+        a.orientation_g != b.orientation_g || a.random.has_value() != b.random.has_value() ||
+        (!a.random && a.sigma_g != b.sigma_g))
       throw std::invalid_argument("nominal_gap_significance: run " + a.id + " differs between the campaigns");
   }
   const NominalView w = nominal_view(with, s), o = nominal_view(without, s);
