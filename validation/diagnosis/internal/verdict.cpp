@@ -54,6 +54,29 @@ const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer
   };
   const Effect& ea = *find_effect(best->fit.name);
   const EffectFitter& A = *fitters.at(ea.name);
+  // A's default form alone (its further parameters at their nominals, as a pair holds them) is
+  // A's rival before any pair: where the natural form's fits wander on the training runs (a
+  // phase into another valley), the nested form can predict the held-out runs better. Where it
+  // explains the gap it is chosen alone; otherwise a pair must beat it too.
+  const Scored* rival = best;
+  Scored a_default;
+  if (ea.parameters.size() > 1) {
+    scorer.score([&](const std::vector<int>& train) {
+      const auto [p, sp] = A.fit(data, train);
+      return fitted_at(A, p, sp);
+    }, a_default);
+    const double p = A.fit(data, all).first;
+    const double evidence = a_default.fit.evidence, chi2 = a_default.fit.heldout_chi2;
+    a_default.fit = best->fit;  // (reported as the natural form's fit; scored as the default form)
+    a_default.fit.evidence = evidence, a_default.fit.heldout_chi2 = chi2;
+    a_default.all = best->all;
+    if (std::isfinite(evidence) && std::isfinite(chi2) && explains_gap(a_default, rms(a_default.heldout))) {
+      pair_best = std::move(a_default);
+      chosen = {{&ea, ea.values_at(p)}};
+      return &pair_best;
+    }
+    if (std::isfinite(evidence) && evidence > best->fit.evidence) rival = &a_default;
+  }
   // The seconds ranked on the runs `idx` alone (each fold's training runs when scored): each
   // other effect fitted to what A (fitted on idx) leaves, by the drop of -2 ln L.
   std::map<std::vector<int>, std::vector<const Effect*>> ranked;
@@ -99,7 +122,7 @@ const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer
   // rms (a pair whose parameters the training runs leave loose can pass chi^2 without
   // predicting anything).
   if (!pair_best.fit.name.empty() &&
-      pair_best.fit.evidence > best->fit.evidence + o.threshold_sigma * o.threshold_sigma &&
+      pair_best.fit.evidence > rival->fit.evidence + o.threshold_sigma * o.threshold_sigma &&
       explains_gap(pair_best, rms(pair_best.heldout)) && rms(pair_best.heldout) <= 0.5 * d.rms_before_g) {
     best = &pair_best;
     chosen = {{find_effect(chosen_pair.a), find_effect(chosen_pair.a)->values_at(chosen_pair.pa)},
@@ -159,7 +182,8 @@ Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, c
   if (d.explained() && chosen.size() == 1) {
     std::vector<std::string> tied = {best->fit.name};
     for (const Scored& sc : scored)
-      if (&sc != best && best->fit.evidence - sc.fit.evidence < o.tie_evidence && explains_gap(sc, rms(sc.heldout)))
+      if (&sc != best && sc.fit.name != best->fit.name && best->fit.evidence - sc.fit.evidence < o.tie_evidence &&
+          explains_gap(sc, rms(sc.heldout)))
         tied.push_back(sc.fit.name);
     if (tied.size() > 1) {
       d.ambiguous_with = tied;
