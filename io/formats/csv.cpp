@@ -214,15 +214,24 @@ std::string read_series_csv(const std::string& path, const std::string& column_n
 }
 
 std::string read_series_csv(const std::string& path, const std::string& column_name,
-                            const std::function<void(double, double)>& sample, const ReferenceSink& reference) {
+                            const std::function<void(double, double)>& sample, const ReferenceSink& reference,
+                            const ChannelNames& names) {
   require_readable_file(path, "the series");
   std::ifstream in(path);
   if (!in) throw FormatError({.file = path}, "cannot open the series");
-  return read_series_csv(in, path, column_name, sample, reference);
+  return read_series_csv(in, path, column_name, sample, reference, names);
+}
+
+std::vector<std::string> with_vrelab_names(std::vector<std::string> header, const ChannelNames& names) {
+  for (const auto& [ours, theirs] : names)
+    for (std::string& h : header)
+      if (h == theirs) h = ours;
+  return header;
 }
 
 std::string read_series_csv(std::istream& in, const std::string& path, const std::string& column_name,
-                            const std::function<void(double, double)>& sample, const ReferenceSink& reference) {
+                            const std::function<void(double, double)>& sample, const ReferenceSink& reference,
+                            const ChannelNames& names) {
   std::string line, name;
   long line_no = 0;
   std::size_t column = 0;
@@ -242,7 +251,8 @@ std::string read_series_csv(std::istream& in, const std::string& path, const std
     const std::vector<std::string> f = split_csv_line(line, path, line_no, separator);
     if (header.empty()) {
       check_header_names(f, path, line_no);
-      header = f;
+      header = with_vrelab_names(f, names);
+      check_header_names(header, path, line_no);  // (a lab's name mapped onto a column vrelab's name already has)
       column = static_cast<std::size_t>(series_column(header, column_name, where));
       name = header[column];
       if (const auto it = std::find(header.begin(), header.end(), "time_s"); it != header.end())

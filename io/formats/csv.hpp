@@ -11,6 +11,7 @@
 #include <array>
 #include <functional>
 #include <iosfwd>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -51,6 +52,13 @@ std::string separator_name(char separator);
 // "<path>:<line>:<column>" naming the column: which of the two a reader took would be a guess.
 void check_header_names(const std::vector<std::string>& header, const std::string& path, long line_no);
 
+// The lab's own names for the columns and datasets of the files a run references (a
+// manifest's [names] table: vrelab's name -> the lab's; docs/data-format.md, "The lab's own
+// names"): a reader looks for the lab's name where it would look for vrelab's.
+using ChannelNames = std::map<std::string, std::string>;
+// The header with each lab's name that `names` maps put back to vrelab's name.
+std::vector<std::string> with_vrelab_names(std::vector<std::string> header, const ChannelNames& names);
+
 // The name in `names` closest to `name` (case-insensitive equality first, then edit
 // distance at most 3), or "" when none is close.
 std::string closest_name(const std::string& name, const std::vector<std::string>& names);
@@ -76,8 +84,9 @@ using ReferenceSink = std::function<void(double t_s, const std::array<double, 3>
 // The same from a stream (`path` only names it in messages): the in-memory entry point.
 std::string read_series_csv(std::istream& in, const std::string& path, const std::string& column,
                             const std::function<void(double t_s, double value)>& sample,
-                            const ReferenceSink& reference = {});
+                            const ReferenceSink& reference = {}, const ChannelNames& names = {});
 std::string read_series_csv(const std::string& path, const std::string& column,
-                            const std::function<void(double t_s, double value)>& sample, const ReferenceSink& reference);
+                            const std::function<void(double t_s, double value)>& sample, const ReferenceSink& reference,
+                            const ChannelNames& names = {});
 
 }  // namespace vrelab::io

@@ -133,9 +133,12 @@ void require_columns(const Csv& csv, const std::vector<std::string>& cols, const
 // the axes that move (a missing column: that axis at rest); breakpoints, straight lines on
 // log-log axes between them, each frequency and level within its physical range and each
 // table's rms at most kPsdMaxRms_g. Bad content throws FormatError at the file, line and column.
-vibration::RandomProfile psd_file(const std::string& path, const std::string& coupling) {
-  const Csv csv = read_csv(path, "the PSD file",
-                           {kMaxPsdRows, "rows of a PSD table", "the breakpoints of a PSD table are read in full"});
+vibration::RandomProfile psd_file(const std::string& path, const std::string& coupling, const ChannelNames& names) {
+  Csv csv = read_csv(path, "the PSD file", {kMaxPsdRows, "rows of a PSD table", "the breakpoints of a PSD table are read in full"});
+  csv.names = with_vrelab_names(csv.names, names);
+  check_header_names(csv.names, path, 0);  // (a lab's name mapped onto a column vrelab's name already has)
+  csv.column.clear();
+  for (std::size_t i = 0; i < csv.names.size(); ++i) csv.column[csv.names[i]] = i;
   require_columns(csv, {"frequency_Hz"});
   static const std::array<std::string, 3> cols{"psd_IA_g2_per_Hz", "psd_PA_g2_per_Hz", "psd_OA_g2_per_Hz"};
   vibration::RandomProfile p;
@@ -315,7 +318,7 @@ toml::table parse_manifest(const std::string& mpath) {
   } catch (const toml::parse_error& e) {
     throw FormatError({.file = mpath, .line = static_cast<long>(e.source().begin.line)}, std::string(e.description()));
   }
-  check_keys(root, "", {"campaign", "instrument", "dynamics", "identification", "files", "diagnose"}, mpath);
+  check_keys(root, "", {"campaign", "instrument", "dynamics", "identification", "files", "diagnose", "names"}, mpath);
   // What every campaign states (an empty manifest would otherwise run on defaults and fail
   // later, on the identification's rank): the format, the output unit, and the held
   // coefficients (a 1 g test cannot separate the common part of k_PP, k_OO and k2 from k0, so
@@ -396,6 +399,27 @@ void read_manifest_fixed(const toml::table& root, const std::string& mpath, vali
                             fmt::format("'{}' is not a coefficient of model (1) with a number", std::string(k.str())));
         c.fixed[i] = v.value<double>().value();
       }
+  }
+}
+
+// The manifest's [names]: vrelab's name of a column or dataset in the files the runs reference
+// = the lab's (a string; each of the lab's names once).
+void read_manifest_names(const toml::table& root, const std::string& mpath, LabManifest& m) {
+  auto* t = root["names"].as_table();
+  if (!t) return;
+  check_keys(*t, "names",
+             {"frequency_Hz", "psd_IA_g2_per_Hz", "psd_PA_g2_per_Hz", "psd_OA_g2_per_Hz", "time_s", "output_" + m.output_unit,
+              "ref_IA_g", "ref_PA_g", "ref_OA_g"},
+             mpath);
+  for (auto&& [k, v] : *t) {
+    const std::string key(k.str());
+    if (!v.is_string() || v.value<std::string>()->empty())
+      throw FormatError(toml_place(mpath, &v, "names", key), "expected the lab's name of the column or dataset (a string)");
+    const std::string theirs = *v.value<std::string>();
+    for (const auto& [other, name] : m.names)
+      if (name == theirs)
+        throw FormatError(toml_place(mpath, &v, "names", key), fmt::format("'{}' is already the lab's name of {}", theirs, other));
+    m.names[key] = theirs;
   }
 }
 
@@ -482,6 +506,7 @@ struct RunsTable {
   Csv csv;
   bool summaries = false, series = false;
   double K1 = 0;
+  ChannelNames names;  // the lab's names in the files the runs reference (the manifest's [names])
 };
 RunsTable read_runs_table(const std::string& path, const validation::Campaign& c) {
   RunsTable t;
@@ -516,8 +541,8 @@ struct RunRow {
 
 // The run's kind (optional column, default sine) and, for a random one, its PSD file; the
 // reason when the row is skipped.
-std::optional<std::string> read_run_kind(const RunRow& rr, const std::string& dir, VibrationKind& kind_out,
-                                         validation::RunRecord& r) {
+std::optional<std::string> read_run_kind(const RunRow& rr, const std::string& dir, const ChannelNames& names,
+                                         VibrationKind& kind_out, validation::RunRecord& r) {
   const std::string kind_text = rr.cell("kind");
   const auto kind = kind_text.empty() ? VibrationKind::sine : rectification::parse_vibration_kind(kind_text);
   if (!kind || kind == VibrationKind::swept_sine)
@@ -533,7 +558,7 @@ std::optional<std::string> read_run_kind(const RunRow& rr, const std::string& di
       return fmt::format("{}:{}: column psd: a {} run needs its PSD file", rr.csv.path, rr.row.first,
                          rectification::to_string(*kind));
     try {
-      r.random = psd_file((fs::path(dir) / rr.cell("psd")).string(), coupling);
+      r.random = psd_file((fs::path(dir) / rr.cell("psd")).string(), coupling, names);
     } catch (const FormatError& e) {
       return rr.label + ": " + e.what();
     }
@@ -603,7 +628,7 @@ std::optional<std::string> record_windows(RunRow& rr, const validation::RunRecor
 // A run's raw record measured over its windows, and the table's motion from its reference
 // channels; throws std::invalid_argument or FormatError for a record that cannot be used.
 void measure_record(const std::string& spath, const rectification::SeriesWindows& win, double on_to_s,
-                    const std::string& unit, validation::RunRecord& r) {
+                    const std::string& unit, const ChannelNames& names, validation::RunRecord& r) {
   win.validate();
   rectification::SeriesMeasurer meas(win);
   // Reference channels (docs/data-format.md, "Reference channels"): the table's motion
@@ -627,7 +652,7 @@ void measure_record(const std::string& spath, const rectification::SeriesWindows
         last_t = t;
         meas.add(t, u);
       },
-      reference);
+      reference, names);
   // Half-open windows, decided as `measure` does (rectification/measurement/series.hpp).
   if (!rectification::record_covers_window_end(rectification::used_on_to_s(win), last_t, first_dt))
     throw std::invalid_argument(fmt::format("{}: the record ends at {:g} s, before on_to_s = {:g} s", spath, last_t, on_to_s));
@@ -650,7 +675,7 @@ std::optional<std::string> read_run_record(RunRow& rr, const RunsTable& runs, co
   if (auto skip = record_windows(rr, r, runs.K1, win, &on_to_s)) return skip;
   const std::string spath = (fs::path(dir) / file).string();
   try {
-    measure_record(spath, win, on_to_s, unit, r);
+    measure_record(spath, win, on_to_s, unit, runs.names, r);
   } catch (const std::invalid_argument& e) {
     return rr.label + ": " + e.what();
   } catch (const FormatError& e) {
@@ -688,7 +713,7 @@ std::optional<std::string> read_run(const RunsTable& runs, const std::pair<int, 
   r.id = idc;
   r.where = fmt::format("{}:{}", rn.path, row.first);
   VibrationKind kind = VibrationKind::sine;
-  if (auto skip = read_run_kind(rr, dir, kind, r)) return skip;
+  if (auto skip = read_run_kind(rr, dir, runs.names, kind, r)) return skip;
   if (auto skip = read_run_motion(rr, kind, r)) return skip;
   if (auto skip = check_run(rr, r, earlier)) return skip;
   const std::string file = runs.series && rn.column.at("series") < row.second.size() ? row.second[rn.column.at("series")] : "";
@@ -714,9 +739,11 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
   read_manifest_dynamics(root, mpath, m, c.dynamics);
   read_manifest_fixed(root, mpath, c);
   if (auto* t = root["diagnose"].as_table()) read_diagnose_settings(*t, mpath, m);
+  read_manifest_names(root, mpath, m);
   const ManifestFiles files = read_manifest_files(root, mpath);
   read_static_readings((fs::path(dir) / files.static_file).string(), m.output_unit, c);
-  const RunsTable runs = read_runs_table((fs::path(dir) / files.runs_file).string(), c);
+  RunsTable runs = read_runs_table((fs::path(dir) / files.runs_file).string(), c);
+  runs.names = m.names;
   for (const auto& row : runs.csv.rows) {
     validation::RunRecord r;
     if (const auto skip = read_run(runs, row, dir, m.output_unit, c.runs, r)) c.skipped.push_back(*skip);
@@ -726,7 +753,9 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
   return c;
 }
 
-vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling) { return psd_file(path, coupling); }
+vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling, const ChannelNames& names) {
+  return psd_file(path, coupling, names);
+}
 
 namespace {
 // A random run's PSD file (read_psd_file reads it back): the axes' tables at their shared

@@ -21,6 +21,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "io/formats/csv.hpp"
 #include "validation/diagnosis/diagnose.hpp"
 #include "vibration/random.hpp"
 
@@ -34,6 +35,9 @@ struct LabManifest {
   // The optional [diagnose] table: DiagnoseSettings' fields by name (its Describe); defaults elsewhere.
   validation::DiagnoseSettings diagnose;
   bool diagnose_given = false;
+  // The optional [names] table: the lab's own names of the columns and datasets of the files
+  // the runs reference (PSD files, raw records; vrelab's name -> the lab's).
+  ChannelNames names;
 };
 
 validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest = nullptr);
@@ -41,7 +45,10 @@ validation::Campaign read_campaign(const std::string& dir, LabManifest* manifest
 // A random run's PSD file as read_campaign reads the file a run's `psd` cell names
 // (docs/data-format.md, "Random runs"); `coupling`: "common" or "independent". Bad content
 // (a frequency or level outside its range among it) throws FormatError at the file, line and column.
-vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling = "common");
+// `names`: the lab's own column names (frequency_Hz, psd_<axis>_g2_per_Hz -> a controller
+// export's "Frequency (Hz)", ...; LabManifest::names).
+vibration::RandomProfile read_psd_file(const std::string& path, const std::string& coupling = "common",
+                                       const ChannelNames& names = {});
 
 // Writes manifest.toml, static.csv and runs.csv (summaries). `raw_series`, when non-empty,
 // gives per run a recorded series already written under DIR (file name, rest and on

@@ -196,7 +196,8 @@ bool is_hdf5_path(const std::string& path) {
 }
 
 std::string read_series_hdf5(const std::string& path, const std::string& column,
-                             const std::function<void(double, double)>& sample, const ReferenceSink& reference) {
+                             const std::function<void(double, double)>& sample, const ReferenceSink& reference,
+                             const ChannelNames& lab_names) {
   silence_hdf5();
   require_readable_file(path, "the series");
   if (H5Fis_hdf5(path.c_str()) <= 0)
@@ -205,8 +206,21 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
   Id file(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), H5Fclose);
   if (!file.ok()) throw FormatError({.file = path}, with_reason("cannot open the HDF5 file"));
   const std::vector<std::string> names = root_names(file.get());
-  const auto has = [&](const std::string& n) { return std::find(names.begin(), names.end(), n) != names.end(); };
+  // vrelab's name of a dataset -> where it is in this file: the lab's path when the manifest
+  // maps it (in any group), else the name in the root group.
+  const auto lab = [&](const std::string& n) {
+    const auto it = lab_names.find(n);
+    return it == lab_names.end() ? n : it->second;
+  };
+  const auto has = [&](const std::string& n) {
+    if (!lab_names.count(n)) return std::find(names.begin(), names.end(), n) != names.end();
+    return H5Oexists_by_name(file.get(), lab(n).c_str(), H5P_DEFAULT) > 0;  // (a missing group on the way: < 0)
+  };
   const auto missing = [&](const std::string& n, const std::string& what) {
+    if (lab_names.count(n))
+      return FormatError({.file = path, .key = lab(n)},
+                         fmt::format("no dataset '{}' (the manifest's [names] {} = \"{}\"; {}; the root group has: {})", lab(n), n,
+                                     lab(n), what, joined(names)));
     std::string msg = fmt::format("no dataset '{}' ({}; the file has: {})", n, what, joined(names));
     if (const std::string close = closest_name(n, names); !close.empty())
       msg += fmt::format("; did you mean '{}' for '{}'?", n, close);
@@ -216,8 +230,11 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
   std::string out_name = column;
   if (out_name.empty()) {
     std::vector<std::string> outputs;
-    for (const auto& n : names)
+    for (const auto& [n, where] : lab_names)
       if (n.rfind("output_", 0) == 0) outputs.push_back(n);
+    if (outputs.empty())
+      for (const auto& n : names)
+        if (n.rfind("output_", 0) == 0) outputs.push_back(n);
     if (outputs.size() != 1)
       throw FormatError({.file = path},
                         outputs.empty() ? fmt::format("no dataset output_<unit> (the file has: {})", joined(names))
@@ -228,8 +245,8 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
   if (out_name == "time_s") throw FormatError({.file = path}, "the output dataset cannot be the time dataset");
   const std::string out_unit = out_name.rfind("output_", 0) == 0 ? out_name.substr(7) : "";
   std::vector<Channel> ch;
-  ch.push_back(open_channel(file.get(), path, "time_s", "s"));
-  ch.push_back(open_channel(file.get(), path, out_name, out_unit));
+  ch.push_back(open_channel(file.get(), path, lab("time_s"), "s"));
+  ch.push_back(open_channel(file.get(), path, lab(out_name), out_unit));
   // Reference channels, as read_series_csv finds them: ref_<axis>_g, else input_<axis>_g. Their
   // length is checked whether or not the caller reads them.
   static const std::array<const char*, 3> axes{"IA", "PA", "OA"};
@@ -240,7 +257,7 @@ std::string read_series_hdf5(const std::string& path, const std::string& column,
       const std::string n = prefix + axes[i] + "_g";
       if (present[i] || !has(n)) continue;
       present[i] = true, ref_index[i] = ch.size();
-      ch.push_back(open_channel(file.get(), path, n, "g"));
+      ch.push_back(open_channel(file.get(), path, lab(n), "g"));
     }
   const hsize_t n = ch[0].length;
   for (const Channel& c : ch)

@@ -25,10 +25,12 @@ inline constexpr std::size_t kHdf5BlockSamples = 65536;
 bool is_hdf5_path(const std::string& path);
 
 // `column`: the output dataset's name; empty: the one dataset whose name starts with
-// "output_" (several: FormatError naming them). Returns the output dataset's name.
+// "output_" (several: FormatError naming them). Returns the output dataset's name. `names`
+// maps a dataset vrelab names (time_s, output_<unit>, ref_<axis>_g) to the lab's path in the
+// file, in any group ("/daq/t"; ChannelNames).
 std::string read_series_hdf5(const std::string& path, const std::string& column,
                              const std::function<void(double t_s, double value)>& sample,
-                             const ReferenceSink& reference = {});
+                             const ReferenceSink& reference = {}, const ChannelNames& names = {});
 
 // Writes a record streaming: chunked datasets (kHdf5BlockSamples samples per chunk) grown as
 // samples come, to `path`.tmp.<pid>, renamed to `path` by commit(); a writer destroyed

@@ -13,9 +13,10 @@
 namespace vrelab::io {
 
 std::string read_series(const std::string& path, const std::string& column,
-                        const std::function<void(double t_s, double value)>& sample, const ReferenceSink& reference) {
-  if (is_hdf5_path(path)) return read_series_hdf5(path, column, sample, reference);
-  return read_series_csv(path, column, sample, reference);
+                        const std::function<void(double t_s, double value)>& sample, const ReferenceSink& reference,
+                        const ChannelNames& names) {
+  if (is_hdf5_path(path)) return read_series_hdf5(path, column, sample, reference, names);
+  return read_series_csv(path, column, sample, reference, names);
 }
 
 std::optional<StatedScaleFactor> stated_scale_factor(const std::string& path) {

@@ -15,8 +15,10 @@ namespace vrelab::io {
 // has reference channels; both check the same things (time strictly increasing, finite
 // samples, the output column/dataset present, every channel of one length) and throw
 // FormatError naming the file and the line or dataset. Returns the output column's name.
+// `names`: the lab's own names of the columns or datasets (ChannelNames, io/formats/csv.hpp).
 std::string read_series(const std::string& path, const std::string& column,
-                        const std::function<void(double t_s, double value)>& sample, const ReferenceSink& reference = {});
+                        const std::function<void(double t_s, double value)>& sample, const ReferenceSink& reference = {},
+                        const ChannelNames& names = {});
 
 // The scale factor a CSV series states in a comment line before its header, `K1 = <value>
 // <unit>/g` (as `vrelab shake --series` writes it: "# output in mA; K1 = 1.25 mA/g; ..."), or

@@ -149,6 +149,70 @@ TEST(LabData, SemicolonAndTabTablesReadAsTheirCommaTwin) {
       << c.skipped[0];
 }
 
+// A shaker controller's PSD export names its columns its own way ("Frequency (Hz)",
+// "Control IA (g^2/Hz)"): the manifest's [names] maps vrelab's names to them, and the campaign
+// reads as its vrelab-named twin (written back by the writer: the same bytes; each random
+// run's PSD rows equal). Without [names] those runs are skipped naming the missing column; a
+// key that is no such name, or one lab name given twice, is refused naming the key.
+TEST(LabData, ALabsOwnColumnNamesInTheManifestReadAsVrelabs) {
+  TempDir t;
+  const std::string plain_dir = (t.path / "plain").string(), lab_dir = (t.path / "lab").string();
+  fs::copy(std::string(VRELAB_CASES_DIR) + "/lab-random", plain_dir);
+  fs::copy(plain_dir, lab_dir);
+  for (const auto& f : fs::directory_iterator(lab_dir)) {
+    const std::string name = f.path().filename().string();
+    if (name == "runs.csv" || name == "static.csv" || f.path().extension() != ".csv") continue;
+    std::string text = read_file(f.path().string());
+    text = std::regex_replace(text, std::regex("frequency_Hz"), "Frequency (Hz)");
+    text = std::regex_replace(text, std::regex("psd_(IA|PA|OA)_g2_per_Hz"), "\"Control $1 (g^2/Hz)\"");
+    std::ofstream(f.path()) << text;
+  }
+  EXPECT_NE(read_file(lab_dir + "/gevs.csv").find("Frequency (Hz),\"Control IA (g^2/Hz)\""), std::string::npos);
+  io::LabManifest m;
+  const Campaign plain = io::read_campaign(plain_dir, &m);
+  ASSERT_TRUE(plain.skipped.empty());
+  const Campaign unnamed = io::read_campaign(lab_dir);
+  EXPECT_GE(unnamed.skipped.size(), 3u);
+  EXPECT_NE(unnamed.skipped.at(0).find("frequency_Hz"), std::string::npos) << unnamed.skipped.at(0);
+  const std::string manifest = read_file(lab_dir + "/manifest.toml");
+  std::ofstream(lab_dir + "/manifest.toml")
+      << manifest << "\n[names]\nfrequency_Hz = \"Frequency (Hz)\"\npsd_IA_g2_per_Hz = \"Control IA (g^2/Hz)\"\n"
+      << "psd_PA_g2_per_Hz = \"Control PA (g^2/Hz)\"\n";
+  io::LabManifest lm;
+  const Campaign named = io::read_campaign(lab_dir, &lm);
+  ASSERT_TRUE(named.skipped.empty()) << named.skipped.front();
+  EXPECT_EQ(lm.names.at("frequency_Hz"), "Frequency (Hz)");
+  ASSERT_EQ(named.runs.size(), plain.runs.size());
+  int random = 0;
+  for (std::size_t k = 0; k < plain.runs.size(); ++k) {
+    ASSERT_EQ(named.runs[k].random.has_value(), plain.runs[k].random.has_value());
+    if (!plain.runs[k].random) continue;
+    ++random;
+    for (std::size_t a = 0; a < 3; ++a) {
+      const auto &x = named.runs[k].random->psd[a], &y = plain.runs[k].random->psd[a];
+      ASSERT_EQ(x.has_value(), y.has_value());
+      if (!x) continue;
+      ASSERT_EQ(x->rows.size(), y->rows.size());
+      for (std::size_t i = 0; i < x->rows.size(); ++i) {
+        EXPECT_EQ(x->rows[i].frequency_Hz, y->rows[i].frequency_Hz);
+        EXPECT_EQ(*x->rows[i].psd_g2_per_Hz, *y->rows[i].psd_g2_per_Hz);
+      }
+    }
+  }
+  EXPECT_GE(random, 3);
+  const auto written = [&](const Campaign& c, const std::string& name) {
+    const std::string out = (t.path / name).string();
+    io::write_campaign(out, c, m);
+    return read_file(out + "/runs.csv");
+  };
+  EXPECT_EQ(written(named, "w-named"), written(plain, "w-plain"));
+  // Refused: an unknown key; one lab name twice.
+  std::ofstream(lab_dir + "/manifest.toml") << manifest << "\n[names]\nfrequency = \"Frequency (Hz)\"\n";
+  EXPECT_NE(error_of(lab_dir).find("[names] frequency: unknown key"), std::string::npos) << error_of(lab_dir);
+  std::ofstream(lab_dir + "/manifest.toml") << manifest << "\n[names]\nfrequency_Hz = \"F\"\ntime_s = \"F\"\n";
+  EXPECT_NE(error_of(lab_dir).find("already the lab's name of"), std::string::npos) << error_of(lab_dir);
+}
+
 TEST(LabData, RawRecordIsMeasuredAsTheSummaryWouldBe) {
   // A synthetic record: 0.88 mA at rest, then a 50 Hz sine of 1 mA with a 25 ug (x K1) offset.
   TempDir t;

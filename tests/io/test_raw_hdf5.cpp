@@ -16,6 +16,8 @@
 
 #include <unistd.h>
 
+#include <hdf5.h>
+
 #include <fmt/format.h>
 
 #include "io/formats/raw_hdf5.hpp"
@@ -81,6 +83,77 @@ TEST(RawHdf5, DeliversExactlyWhatTheCsvReaderDelivers) {
   const Captured c = capture(h5, "output_mA", false);
   EXPECT_EQ(c.u, a.u);
   EXPECT_TRUE(c.ref.empty());
+}
+
+// A DAQ's file keeps its channels where it keeps them (a group, its own names): the
+// manifest's [names] maps vrelab's names to those paths (io::ChannelNames) and the reader
+// delivers what it delivers from vrelab's layout, sample for sample. Unmapped, the file is
+// refused naming what it lacks; a mapped path that is not there is refused naming the
+// manifest's key and the path.
+TEST(RawHdf5, ALabsOwnDatasetPathsAreReadThroughTheManifestsNames) {
+  TempDir d;
+  const std::string ours = (d.path / "ours.h5").string(), theirs = (d.path / "theirs.h5").string();
+  for (const std::string& path : {ours, theirs}) {
+    io::Hdf5SeriesWriter w(path, "mA", {true, false, false}, "r", "test");
+    for (int i = 0; i <= 3000; ++i) {
+      const double t = -0.5 + i / 2000.0;
+      w.add(t, 0.9 + 0.2 * std::sin(2 * std::numbers::pi * 50 * t), {std::cos(2 * std::numbers::pi * 50 * t), 0, 0});
+    }
+    w.commit();
+  }
+  {  // theirs: the channels moved into the group /daq under the DAQ's names
+    const hid_t f = H5Fopen(theirs.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
+    ASSERT_GE(f, 0);
+    const hid_t g = H5Gcreate2(f, "/daq", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    ASSERT_GE(g, 0);
+    H5Gclose(g);
+    ASSERT_GE(H5Lmove(f, "time_s", f, "/daq/t", H5P_DEFAULT, H5P_DEFAULT), 0);
+    ASSERT_GE(H5Lmove(f, "output_mA", f, "/daq/ch0", H5P_DEFAULT, H5P_DEFAULT), 0);
+    ASSERT_GE(H5Lmove(f, "ref_IA_g", f, "/daq/accel_x", H5P_DEFAULT, H5P_DEFAULT), 0);
+    H5Fclose(f);
+  }
+  const io::ChannelNames names{{"time_s", "/daq/t"}, {"output_mA", "/daq/ch0"}, {"ref_IA_g", "/daq/accel_x"}};
+  Captured a = capture(ours), b;
+  io::ReferenceSink sink = [&b](double t, const std::array<double, 3>& g, const std::array<bool, 3>& p) {
+    b.rt.push_back(t), b.ref.push_back(g), b.present.push_back(p);
+  };
+  b.name = io::read_series(theirs, "", [&b](double t, double u) { b.t.push_back(t), b.u.push_back(u); }, sink, names);
+  ASSERT_EQ(a.t.size(), 3001u);
+  EXPECT_EQ(b.name, "output_mA");
+  EXPECT_EQ(b.t, a.t);
+  EXPECT_EQ(b.u, a.u);
+  EXPECT_EQ(b.ref, a.ref);
+  EXPECT_EQ(b.present, a.present);
+  {  // The same names in a CSV record: its header's names put back to vrelab's.
+    const std::string csv = (d.path / "theirs.csv").string();
+    std::ofstream out(csv);
+    out << "t,ch0,accel_x\n";
+    for (std::size_t i = 0; i < a.t.size(); ++i) out << fmt::format("{},{},{}\n", a.t[i], a.u[i], a.ref[i][0]);
+    out.close();
+    Captured c;
+    io::ReferenceSink csink = [&c](double t, const std::array<double, 3>& g, const std::array<bool, 3>& p) {
+      c.ref.push_back(g), c.present.push_back(p);
+      (void)t;
+    };
+    c.name = io::read_series(csv, "", [&c](double t, double u) { c.t.push_back(t), c.u.push_back(u); }, csink,
+                             {{"time_s", "t"}, {"output_mA", "ch0"}, {"ref_IA_g", "accel_x"}});
+    EXPECT_EQ(c.name, "output_mA");
+    EXPECT_EQ(c.t, a.t);
+    EXPECT_EQ(c.u, a.u);
+    EXPECT_EQ(c.ref, a.ref);
+  }
+  const auto error = [&](const io::ChannelNames& n) {
+    try {
+      io::read_series(theirs, "", [](double, double) {}, {}, n);
+    } catch (const io::FormatError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(read)");
+  };
+  EXPECT_NE(error({}).find("no dataset 'time_s'"), std::string::npos) << error({});
+  io::ChannelNames wrong = names;
+  wrong["time_s"] = "/acq/t";
+  EXPECT_NE(error(wrong).find("no dataset '/acq/t' (the manifest's [names] time_s = \"/acq/t\""), std::string::npos) << error(wrong);
 }
 
 TEST(RawHdf5, AWriterNotCommittedLeavesNoFile) {
