@@ -232,9 +232,10 @@ TEST(SettingsDescription, ABadKeyTypeOrRangeInTheManifestNamesFileLineAndKey) {
 
 TEST(SettingsDescription, BlindSettingsDescribeTheirFieldsAndNestTheDiagnosis) {
   validation::BlindSettings b;
-  b.n = 3, b.seed = 11, b.threads = 2, b.diagnose.structure_sigma = 2.5;
+  b.n = 3, b.seed = 11, b.threads = 2, b.mixed = true, b.diagnose.structure_sigma = 2.5;
   const nlohmann::json j = io::to_json(b);
-  EXPECT_EQ(j.size(), 4u);
+  EXPECT_EQ(j.size(), 5u);
+  EXPECT_EQ(j["mixed"], true);
   EXPECT_EQ(j["n"], 3);
   EXPECT_EQ(j["seed"], 11);
   EXPECT_EQ(j["threads"], 2);
