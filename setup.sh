@@ -13,7 +13,8 @@ packages=(build-essential cmake ninja-build git pkg-config
           libgtest-dev libbenchmark-dev python3-matplotlib
           python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest python3-venv python3-pip python3-setuptools python3-wheel
           libopenmpi-dev openmpi-bin
-          libboost-dev)
+          libboost-dev
+          chromium)  # headless: tests/cli/report_render.sh renders the HTML reports
 
 run_main=1
 [ "${1:-}" = "--no-run" ] && run_main=0

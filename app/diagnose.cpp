@@ -2,6 +2,7 @@
 // library function, prints its report and writes its results (io/services/diagnosis.hpp,
 // validation/diagnosis/blind.hpp, io/services/diagnosis_json.hpp).
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -12,6 +13,7 @@
 #include "core/dispatch.hpp"
 #include "core/progress.hpp"
 #include "io/services/batch.hpp"
+#include "io/services/blind_report.hpp"
 #include "io/services/diagnosis.hpp"
 #include "io/services/diagnosis_json.hpp"
 #include "io/services/diagnosis_report.hpp"
@@ -141,10 +143,13 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   if (!writer) return;
   io::write_atomic(o.out_dir + "/scores.json", io::json_text(io::to_json(r)));
   io::write_atomic(o.out_dir + "/confusion.csv", io::confusion_csv(r));
-  io::write_atomic(o.out_dir + "/report.html", io::blind_html(r));
   out << program() << r.FullReport();
   if (r.resumed > 0) out << fmt::format("  {} campaign(s) read back from {} (an earlier run)\n", r.resumed, done_path);
+  // The figure before the report, which embeds it; an old figure goes first so that a failed
+  // script leaves none for the report to show.
+  for (const char* f : {"/confusion.png", "/confusion.svg"}) std::filesystem::remove(o.out_dir + f);
   const std::string plot = io::run_plot_script("confusion.py", o.out_dir);
+  io::write_atomic(o.out_dir + "/report.html", io::blind_report(r, plot).html(o.out_dir));
   out << "Wrote " << o.out_dir << "/scores.json, report.html and confusion.csv"
       << (plot.empty() ? ", confusion.png/svg" : "; figure skipped: " + plot) << "\n";
 }

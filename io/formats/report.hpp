@@ -1,11 +1,14 @@
 #pragma once
 // io/formats/report.hpp -- a report written once, rendered as Markdown and as HTML.
 //
-// Takes: headings, paragraphs, tables (first row: the header), figures (a file stem in the
-//        report's folder: stem.png shown, stem.svg linked) and bullet lists, in order.
-// Gives: the same document as Markdown and as a self-contained HTML page (no scripts, no
-//        external resources; the figures are the files beside it). Text is plain: HTML
-//        special characters are escaped, nothing is interpreted as markup.
+// Takes: a summary (the verdict or headline and a few lines: always shown first, in a box),
+//        then headings, paragraphs, tables (first row: the header), figures (a file stem in the
+//        report's folder, stem.png/stem.svg as the plot scripts write them) and bullet lists, in
+//        order.
+// Gives: the same document as Markdown (figures linked) and as one HTML page that stands alone
+//        (one style for every command's report; no scripts, no external resources: each figure
+//        is read from the folder and embedded as a data URI, so the page can be mailed). Text
+//        is plain: HTML special characters are escaped, nothing is interpreted as markup.
 #include <string>
 #include <vector>
 
@@ -13,7 +16,11 @@ namespace vrelab::io {
 
 class Report {
  public:
+  // The summary box's colour: good (a clear result), bad (a problem to act on), plain.
+  enum class Tone { plain, good, bad };
+
   explicit Report(std::string title) : title_(std::move(title)) {}
+  void summary(const std::string& headline, const std::vector<std::string>& lines, Tone tone = Tone::plain);
   void heading(const std::string& text);  // a section (level 2)
   void paragraph(const std::string& text);
   void list(const std::vector<std::string>& items);
@@ -23,7 +30,9 @@ class Report {
   void figure(const std::string& stem, const std::string& caption, bool present, const std::string& missing_reason);
 
   std::string markdown() const;
-  std::string html() const;
+  // `dir`: the folder holding the figures, each embedded (its SVG, or its PNG when the SVG is
+  // missing or larger); a figure whose files are missing is said so.
+  std::string html(const std::string& dir) const;
 
  private:
   struct Block {
@@ -34,6 +43,9 @@ class Report {
     bool present = true;
   };
   std::string title_;
+  std::string headline_;
+  std::vector<std::string> summary_lines_;
+  Tone tone_ = Tone::plain;
   std::vector<Block> blocks_;
 };
 

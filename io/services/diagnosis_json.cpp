@@ -440,134 +440,41 @@ json to_json(const validation::BlindResult& r) {
           {"campaigns", rows}};
 }
 
-std::string confusion_csv(const validation::BlindResult& r) {
+ConfusionMatrix confusion_matrix(const validation::BlindResult& r) {
   // Columns: every verdict blind can call (ambiguous and error too); rows: clean, the library,
   // two, then every other truth the run met (natural forms, out-of-library effects by name,
   // the nuisance and dynamics families), so that no campaign is left out.
-  std::vector<std::string> called_names = {"clean"};
-  for (const auto& n : r.library) called_names.push_back(n);
-  for (const char* n : {"two_effects", "ambiguous", "unexplained", "error"}) called_names.push_back(n);  // two_effects: any "A + B"
-  std::string csv = "# rows: the hidden truth; columns: what diagnose called it (without the key)\ntruth";
-  for (const auto& n : called_names) csv += "," + n;
-  csv += "\n";
-  std::vector<std::string> truths = {"clean"};
-  for (const auto& n : r.library) truths.push_back(n);
-  truths.push_back("two");
+  ConfusionMatrix m;
+  m.called = {"clean"};
+  for (const auto& n : r.library) m.called.push_back(n);
+  for (const char* n : {"two_effects", "ambiguous", "unexplained", "error"}) m.called.push_back(n);  // two_effects: any "A + B"
+  m.truths = {"clean"};
+  for (const auto& n : r.library) m.truths.push_back(n);
+  m.truths.push_back("two");
   for (const auto& [t, row] : r.confusion)
-    if (std::find(truths.begin(), truths.end(), t) == truths.end()) truths.push_back(t);
-  for (const auto& t : truths) {
-    csv += t;
-    const auto row = r.confusion.find(t);
-    for (const auto& n : called_names) {
-      int count = 0;
-      if (row != r.confusion.end())
-        for (const auto& [called, k] : row->second)
-          if (called == n || (n == "two_effects" && called.find(" + ") != std::string::npos)) count += k;
-      csv += fmt::format(",{}", count);
-    }
+    if (std::find(m.truths.begin(), m.truths.end(), t) == m.truths.end()) m.truths.push_back(t);
+  for (const auto& t : m.truths) {
+    std::vector<int> counts(m.called.size(), 0);
+    if (const auto row = r.confusion.find(t); row != r.confusion.end())
+      for (const auto& [called, k] : row->second)
+        for (std::size_t j = 0; j < m.called.size(); ++j)
+          if (called == m.called[j] || (m.called[j] == "two_effects" && called.find(" + ") != std::string::npos)) counts[j] += k;
+    m.counts.push_back(counts);
+  }
+  return m;
+}
+
+std::string confusion_csv(const validation::BlindResult& r) {
+  const ConfusionMatrix m = confusion_matrix(r);
+  std::string csv = "# rows: the hidden truth; columns: what diagnose called it (without the key)\ntruth";
+  for (const auto& n : m.called) csv += "," + n;
+  csv += "\n";
+  for (std::size_t i = 0; i < m.truths.size(); ++i) {
+    csv += m.truths[i];
+    for (int k : m.counts[i]) csv += fmt::format(",{}", k);
     csv += "\n";
   }
   return csv;
-}
-
-namespace {
-std::string html_escape(const std::string& x) {
-  std::string o;
-  for (char ch : x) {
-    if (ch == '<') o += "&lt;";
-    else if (ch == '>') o += "&gt;";
-    else if (ch == '&') o += "&amp;";
-    else if (ch == '"') o += "&quot;";
-    else o += ch;
-  }
-  return o;
-}
-}  // namespace
-
-std::string blind_html(const validation::BlindResult& r) {
-  std::string h = "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>vrelab blind</title>\n"
-                  "<style>body{font-family:sans-serif;margin:2em}table{border-collapse:collapse;margin:1em 0}"
-                  "td,th{border:1px solid #999;padding:3px 8px;text-align:right}th{background:#eee}"
-                  "td.l,th.l{text-align:left}td.bad{background:#fcc}td.ok{background:#cfc}</style></head><body>\n";
-  h += fmt::format("<h1>blind --n {} --seed {}</h1>\n<p>{:.1f} s wall on {} threads. Each family scored apart: right; "
-                   "right physics, not the right effect; unexplained; no gap; confidently wrong (explained by an effect of "
-                   "another physics); ambiguous (the truth among them).</p>\n",
-                   r.settings.n, r.settings.seed, r.wall_s, r.threads);
-  h += "<h2>Rates against their targets</h2>\n<p>The 95 % interval is Clopper-Pearson's (exact binomial): what a run of this size "
-       "can tell. \"met\" compares the rate itself with the target.</p>\n<table><tr><th class=\"l\">criterion</th><th>k/n</th>"
-       "<th>rate</th><th>95 % interval</th><th>target</th><th></th></tr>\n";
-  for (const auto& c : r.Criteria())
-    h += c.n == 0 ? fmt::format("<tr><td class=\"l\">{}</td><td>0/0</td><td>&ndash;</td><td>&ndash;</td><td>{} {:.0f} %</td>"
-                                "<td>no campaigns</td></tr>\n",
-                                html_escape(c.name), c.at_least ? "&ge;" : "&le;", 100 * c.target)
-                  : fmt::format("<tr><td class=\"l\">{}</td><td>{}/{}</td><td>{:.1f} %</td><td>{:.1f} &ndash; {:.1f} %</td>"
-                                "<td>{} {:.0f} %</td><td class=\"{}\">{}</td></tr>\n",
-                                html_escape(c.name), c.k, c.n, 100 * c.rate(), 100 * c.ci95.lo, 100 * c.ci95.hi,
-                                c.at_least ? "&ge;" : "&le;", 100 * c.target, c.met() ? "ok" : "bad", c.met() ? "met" : "not met");
-  h += "</table>\n";
-  h += "<h2>Per family</h2>\n<table><tr><th class=\"l\">family</th><th>n</th><th>right</th><th>right physics</th>"
-       "<th>unexplained</th><th>no gap</th><th>confidently wrong</th><th>ambiguous</th><th>(right among)</th><th>error</th>"
-       "<th>right effect, a parameter beyond 3&sigma;</th></tr>\n";
-  for (const auto& [name, f] : r.scores.families)
-    h += fmt::format("<tr><td class=\"l\">{}</td><td>{}</td><td class=\"ok\">{}</td><td>{}</td><td>{}</td><td>{}</td>"
-                     "<td class=\"{}\">{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
-                     html_escape(name), f.n, f.right, f.family, f.unexplained, f.no_gap, f.wrong ? "bad" : "", f.wrong,
-                     f.ambiguous, f.right_among, f.error, f.parameters_off);
-  h += "</table>\n";
-  {
-    // The two family sizes and the two shrinkages side by side (docs/blind.md, "Blind's measures").
-    const validation::BlindScores& s = r.scores;
-    const validation::LargestRunSizeScores& o = s.by_max_run_sigma;
-    const auto fam = [](const std::map<std::string, validation::FamilyScore>& m, const std::string& name) {
-      const auto it = m.find(name);
-      return it == m.end() ? std::string("0/0") : fmt::format("{}/{}", it->second.right, it->second.n);
-    };
-    const auto n_of = [](const std::map<std::string, validation::FamilyScore>& m, const std::string& name) {
-      const auto it = m.find(name);
-      return it == m.end() ? 0 : it->second.n;
-    };
-    h += "<h2>Family size and shrinkage: the scored measures and the largest run's</h2>\n<p>A single or natural campaign is "
-         "scored when the gap its effect makes is &ge; 5&sigma; as the diagnosis' nominal model sees it: sqrt(g<sup>T</sup> "
-         "V<sup>-1</sup> g), g the nominal gap with the effect less without it (the virtual lab, the same noise draws), V the "
-         "diagnosis' covariance of the runs with the static test's coefficient uncertainty (<code>effect_gap_sigma</code>). "
-         "The largest run's size, beside: the largest |with - without| of any run over its &sigma; (<code>effect_max_sigma</code>). The "
-         "shrinkage of the gap is of the held-out residuals with each run's noise draw (and the lab log's drift and "
-         "scatter, less the drift line removed) taken out; the residuals' shrinkage beside keeps the noise.</p>\n";
-    h += "<table><tr><th class=\"l\">measure</th><th>scored (gap as the lab sees it)</th><th>largest run's size</th></tr>\n";
-    h += fmt::format("<tr><td class=\"l\">single, right effect</td><td>{}</td><td>{}</td></tr>\n", fam(s.families, "single"),
-                     fam(o.families, "single"));
-    h += fmt::format("<tr><td class=\"l\">natural, right effect (parameters within 3&sigma;)</td><td>{}</td><td>{}</td></tr>\n",
-                     fam(s.families, "natural"), fam(o.families, "natural"));
-    h += fmt::format("<tr><td class=\"l\">single / natural below 5&sigma; (not scored)</td><td>{} / {}</td><td>{} / {}</td></tr>\n",
-                     n_of(s.families, "single_below_5_sigma"), n_of(s.families, "natural_below_5_sigma"),
-                     n_of(o.families, "single_below_5_sigma"), n_of(o.families, "natural_below_5_sigma"));
-    h += fmt::format("<tr><td class=\"l\">median held-out shrinkage, single</td><td>{:.0f} % of the gap (noise removed; "
-                     "with the noise {:.0f} %)</td><td>{:.0f} % of the residuals with the noise</td></tr>\n</table>\n",
-                     100 * s.median_gap_shrinkage, 100 * s.median_shrinkage, 100 * o.median_shrinkage);
-  }
-  h += "<h2>Confusion matrix</h2>\n<p>Rows: the hidden truth; columns: what diagnose called it (without the key).</p>\n";
-  std::vector<std::string> called;
-  for (const auto& [t, row] : r.confusion)
-    for (const auto& [c, k] : row)
-      if (std::find(called.begin(), called.end(), c) == called.end()) called.push_back(c);
-  std::sort(called.begin(), called.end());
-  h += "<table><tr><th class=\"l\">truth \\ called</th>";
-  for (const auto& c : called) h += "<th>" + html_escape(c) + "</th>";
-  h += "</tr>\n";
-  for (const auto& [t, row] : r.confusion) {
-    h += "<tr><td class=\"l\">" + html_escape(t) + "</td>";
-    for (const auto& c : called) {
-      const auto it = row.find(c);
-      const int k = it == row.end() ? 0 : it->second;
-      h += fmt::format("<td class=\"{}\">{}</td>", k && c == t ? "ok" : "", k ? std::to_string(k) : "");
-    }
-    h += "</tr>\n";
-  }
-  h += "</table>\n<h2>Every miss, with its why</h2>\n<ul>\n";
-  for (const auto& w : r.wrong) h += "<li>" + html_escape(w) + "</li>\n";
-  if (r.wrong.empty()) h += "<li>none</li>\n";
-  h += "</ul>\n</body></html>\n";
-  return h;
 }
 
 }  // namespace vrelab::io

@@ -8,6 +8,7 @@
 //   to_json(BlindResult)       `blind`'s scores.json: settings, scores, confusion, campaigns
 //   confusion_csv(BlindResult) `blind`'s confusion.csv: rows the truth, columns what was called
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -30,8 +31,13 @@ nlohmann::json to_json(const rectification::MotionDeparture& m);
 nlohmann::json motion_summary_json(const validation::Diagnosis& d, const validation::Campaign& c);
 std::string motion_summary_text(const validation::Diagnosis& d, const validation::Campaign& c);
 nlohmann::json to_json(const validation::BlindResult& r);
+// Blind's confusion matrix: counts[i][j] campaigns of truth truths[i] called called[j]; every
+// campaign in one cell (confusion_csv writes it; the report shows it).
+struct ConfusionMatrix {
+  std::vector<std::string> called, truths;
+  std::vector<std::vector<int>> counts;
+};
+ConfusionMatrix confusion_matrix(const validation::BlindResult& r);
 std::string confusion_csv(const validation::BlindResult& r);
-// `blind --out`'s report.html: the per-family table, the confusion matrix, every miss with why.
-std::string blind_html(const validation::BlindResult& r);
 
 }  // namespace vrelab::io

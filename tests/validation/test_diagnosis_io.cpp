@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/formats/case_file.hpp"
+#include "io/services/blind_report.hpp"
 #include "io/services/diagnosis_json.hpp"
 #include "io/formats/lab_data.hpp"
 #include "support/files.hpp"
@@ -90,23 +91,46 @@ TEST(Blind, ConfusionCsvCountsPairVerdictsAsTwoEffects) {
   EXPECT_EQ(j["seed"], 11);
 }
 
-// blind --out's report.html: each family's row with its counts, the confusion matrix's cells,
-// every miss, the text escaped (a verdict or a note may hold < and &).
+// blind --out's report.html: the targets in the summary box first, each family's row with its
+// rate and interval ("n/a" for an empty one), the confusion figure embedded and the matrix's
+// cells (every campaign, the out-of-library one too), every miss, the text escaped (a verdict
+// or a note may hold < and &).
 TEST(Blind, HtmlReportHasTheFamiliesTheConfusionAndEveryMissEscaped) {
+  TempDir dir;
+  std::ofstream(dir.path / "confusion.png", std::ios::binary) << "\x89PNG";
   validation::BlindResult r;
   r.settings.n = 5, r.settings.seed = 8;
+  r.library = {"mechanical_mode"};
   validation::FamilyScore f;
   f.n = 4, f.right = 2, f.family = 1, f.wrong = 1;
   r.scores.families["single"] = f;
+  r.scores.families["out_of_library"].n = 1;
+  r.scores.families["out_of_library"].unexplained = 1;
   r.confusion["mechanical_mode"]["mechanical_mode"] = 2;
   r.confusion["mechanical_mode"]["unexplained"] = 1;
+  r.confusion["mechanical_mode"]["ambiguous"] = 1;
+  r.confusion["clipping (out of library)"]["mechanical_mode"] = 1;
   r.wrong = {"[single] campaign 3: mode <1 kHz & more"};
-  const std::string h = io::blind_html(r);
-  EXPECT_NE(h.find("<td class=\"l\">single</td><td>4</td><td class=\"ok\">2</td><td>1</td><td>0</td><td>0</td><td class=\"bad\">1</td>"),
+  const std::string h = io::blind_report(r, "").html(dir.path.string());
+  EXPECT_LT(h.find("<section class=\"summary bad\">"), h.find("<h2>")) << h;
+  EXPECT_NE(h.find("<p class=\"headline\">0 of 3 targets met (5 more have no campaign in this run); 1 of 5 campaigns confidently wrong.</p>"), std::string::npos) << h;
+  EXPECT_NE(h.find("<tr><td>one library effect (gap &gt;= 5 sigma)</td><td class=\"n\">4</td><td class=\"n\">2/4</td><td class=\"n\">50 %</td>"
+                   "<td class=\"n\">7 - 93 %</td><td class=\"n\">1</td><td class=\"n\">0</td><td class=\"n\">0</td>"
+                   "<td class=\"n\">1</td><td class=\"n\">0 (0)</td><td class=\"n\">0</td><td class=\"n\">0</td></tr>"),
             std::string::npos) << h;
-  EXPECT_NE(h.find("<td class=\"l\">mechanical_mode</td><td class=\"ok\">2</td><td class=\"\">1</td>"), std::string::npos) << h;
+  EXPECT_NE(h.find("<tr><td>a bias drift</td><td class=\"n\">0</td><td class=\"n\">n/a</td><td class=\"n\">n/a</td><td class=\"n\">n/a</td>"), std::string::npos) << h;
+  EXPECT_EQ(h.find("0/0 0.0 %"), std::string::npos);
+  EXPECT_NE(h.find("<img src=\"data:image/png;base64,iVBORw==\""), std::string::npos) << h;
+  EXPECT_NE(h.find("<tr><th>hidden \\ called (campaigns)</th><th class=\"n\">mechanical_mode</th><th class=\"n\">ambiguous</th>"
+                   "<th class=\"n\">unexplained</th></tr>"),
+            std::string::npos) << h;
+  EXPECT_NE(h.find("<tr><td>mechanical_mode</td><td class=\"n\">2</td><td class=\"n\">1</td><td class=\"n\">1</td></tr>"), std::string::npos) << h;
+  EXPECT_NE(h.find("<tr><td>clipping (out of library)</td><td class=\"n\">1</td><td class=\"n\"></td><td class=\"n\"></td></tr>"), std::string::npos) << h;
   EXPECT_NE(h.find("<li>[single] campaign 3: mode &lt;1 kHz &amp; more</li>"), std::string::npos) << h;
   EXPECT_EQ(h.find("<1 kHz"), std::string::npos);
+  // Without the figure, the report says why.
+  EXPECT_NE(io::blind_report(r, "no matplotlib").html(dir.path.string()).find("Figure confusion not drawn: no matplotlib."),
+            std::string::npos);
 }
 
 namespace {

@@ -371,21 +371,35 @@ TEST(Reproduce, BadReproduceTableIsNamedWithFileLineAndKey) {
 }
 
 TEST(Report, MarkdownAndHtmlCarryTheSameContentAndHtmlIsEscaped) {
+  TempDir d;
+  std::ofstream(d.path / "drawn.png", std::ios::binary) << "\x89PNG";  // embedded, base64: iVBORw==
   io::Report r("title <x>");
   r.heading("Section & more");
   r.paragraph("|a_IA| < |w_IA|");
   r.table({{"h1", "h|2"}, {"1", "<2>"}});
   r.list({"one", "two & three"});
   r.figure("fig", "caption", false, "no matplotlib");
-  const std::string md = r.markdown(), html = r.html();
-  EXPECT_NE(md.find("# title <x>"), std::string::npos);
+  r.figure("drawn", "drawn caption", true, "");
+  r.figure("lost", "lost caption", true, "");
+  r.summary("Verdict: <none>", {"a & b"}, io::Report::Tone::bad);  // shown first wherever it is given
+  const std::string md = r.markdown(), html = r.html(d.path.string());
+  EXPECT_NE(md.find("# title <x>\n\n> **Verdict: <none>**\n>\n> - a & b\n"), std::string::npos) << md;
   EXPECT_NE(md.find("| h1 | h\\|2 |\n| --- | --- |\n| 1 | <2> |"), std::string::npos) << md;
   EXPECT_NE(md.find("- two & three"), std::string::npos);
   EXPECT_NE(md.find("not drawn: no matplotlib"), std::string::npos);
+  EXPECT_NE(html.find("<h1>title &lt;x&gt;</h1>\n<section class=\"summary bad\">\n<p class=\"headline\">Verdict: &lt;none&gt;</p>\n"
+                      "<ul>\n<li>a &amp; b</li>"),
+            std::string::npos) << html;
   EXPECT_NE(html.find("<h2>Section &amp; more</h2>"), std::string::npos);
   EXPECT_NE(html.find("<p>|a_IA| &lt; |w_IA|</p>"), std::string::npos);
-  EXPECT_NE(html.find("<td>&lt;2&gt;</td>"), std::string::npos);
+  EXPECT_NE(html.find("<tr><td class=\"n\">1</td><td>&lt;2&gt;</td></tr>"), std::string::npos) << html;  // numbers right-aligned
   EXPECT_EQ(html.find("<x>"), std::string::npos);
+  // Figures embedded: the page names no other file.
+  EXPECT_NE(html.find("<img src=\"data:image/png;base64,iVBORw==\" alt=\"drawn caption\">"), std::string::npos) << html;
+  EXPECT_NE(html.find("Figure lost not drawn: its file is missing."), std::string::npos) << html;
+  EXPECT_NE(html.find("Figure fig not drawn: no matplotlib."), std::string::npos) << html;
+  EXPECT_EQ(html.find("href="), std::string::npos);
+  EXPECT_EQ(html.find(".png\""), std::string::npos);
   EXPECT_NE(html.find("</html>"), std::string::npos);
 }
 

@@ -65,7 +65,8 @@ def gap_map(d, out):
     n = len(groups)
     cols = min(n, 3)
     rows = (n + cols - 1) // cols
-    fig, grid = plt.subplots(rows, cols, figsize=(3.6 * cols + 0.8, 3.2 * rows + 0.8), sharex=True, sharey=True,
+    # Panels and type large enough to read in a mailed report at page width.
+    fig, grid = plt.subplots(rows, cols, figsize=(4.6 * cols + 1.0, 3.9 * rows + 1.3), sharex=True, sharey=True,
                              squeeze=False)
     axes = [ax for row in grid for ax in row]
     for ax in axes[n:]:
@@ -86,21 +87,23 @@ def gap_map(d, out):
         ax.axhline(0, color="0.4", lw=0.6)
         plain_log_ticks(ax, [r["frequency_Hz"] for r in runs])
         symlog_y(ax, 1.0)
-        ax.set_title(f"vibration along {name}  ({len(rs)} run{'s' if len(rs) > 1 else ''})", fontsize=9)
-        ax.set_xlabel("frequency (Hz)")
+        ax.set_title(f"vibration along {name}  ({len(rs)} run{'s' if len(rs) > 1 else ''})", fontsize=12)
+        ax.set_xlabel("frequency (Hz)", fontsize=11)
+        ax.tick_params(labelsize=10)
         ax.xaxis.set_tick_params(labelbottom=True)
         ax.grid(alpha=0.3, which="major")
     handles = {}
     for ax in axes[:n]:
         for h, lab in zip(*ax.get_legend_handles_labels()):
             handles.setdefault(lab, h)
-    fig.legend(handles.values(), handles.keys(), fontsize=8, loc="lower center", ncol=min(6, len(handles)),
-               frameon=False)
+    fig.legend(handles.values(), handles.keys(), fontsize=11, loc="lower center", ncol=min(4, len(handles)),
+               frameon=False, markerscale=1.4)
     for row in grid:
-        row[0].set_ylabel(f"gap z = (measured − predicted) / σ\n(±{sig:g} σ dashed)")
+        row[0].set_ylabel(f"gap z = (measured − predicted) / σ\n(±{sig:g} σ dashed)", fontsize=11)
     name = d.get("campaign") or d.get("data")
-    fig.suptitle(f"Gap map: {d['verdict']}\n{name}", fontsize=9)
-    fig.tight_layout(rect=(0, 0.08 / rows, 1, 1))
+    fig.suptitle(f"Gap map: {d['verdict']}\n{name}", fontsize=13)
+    legend_rows = (len(handles) + 3) // 4
+    fig.tight_layout(rect=(0, 0.07 * legend_rows / rows, 1, 1))
     savefig_atomic(fig, f"{out}/gap_map.png", dpi=150)
     savefig_atomic(fig, f"{out}/gap_map.svg")
     plt.close(fig)
@@ -130,8 +133,8 @@ def residuals(d, out):
     ax.axhline(0, color="0.4", lw=0.6)
     symlog_y(ax, min(sigma))
     ax.set_ylabel("held-out gap, measured − predicted (µg)")
-    ax.set_title("Held-out gap before and after the chosen effect", fontsize=10)
-    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1))
+    ax.set_title("Held-out gap before and after the chosen effect", fontsize=12)
+    ax.legend(fontsize=10, loc="upper left", bbox_to_anchor=(1.01, 1))
     ax.grid(alpha=0.3, which="major")
     fig.tight_layout()
     savefig_atomic(fig, f"{out}/residuals.png", dpi=150)
