@@ -10,7 +10,7 @@ cd "$(dirname "$0")"
 
 packages=(build-essential cmake ninja-build git pkg-config
           libeigen3-dev libtomlplusplus-dev libcli11-dev nlohmann-json3-dev libfmt-dev libfftw3-dev libsundials-dev libhdf5-dev
-          libgtest-dev libbenchmark-dev python3-matplotlib
+          libgtest-dev libbenchmark-dev python3-matplotlib python3-pandas
           python3-dev python3-numpy pybind11-dev python3-pybind11 python3-pytest python3-venv python3-pip python3-setuptools python3-wheel
           libopenmpi-dev openmpi-bin
           libboost-dev

@@ -1,14 +1,15 @@
 """The paper's confirmation figure from Python: one run on the virtual shaker under the
 confirmation condition of cases/paper.toml (2 g along IA at 20 Hz, IA at 45 deg), its raw
 output, and the running integral of the deviation from rest against eq. (3).
-    /usr/bin/python3 examples/confirmation.py   # -> out/confirmation.png"""
+    /usr/bin/python3 examples/confirmation.py   # from any folder: -> out/confirmation.png there"""
 import os, tomllib
 import matplotlib; matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 import vrelab
 
-case = tomllib.load(open("cases/paper.toml", "rb"))
+CASES = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "cases")   # the repository's, not the CWD's
+case = tomllib.load(open(os.path.join(CASES, "paper.toml"), "rb"))
 case["orientation"] = {"a_g": [0.7071067811865476, 0.7071067811865476, 0.0]}   # IA at 45 deg
 case["vibration"] = {"type": "sine", "amplitude_g": [2.0, 0.0, 0.0], "frequency_Hz": 20.0}
 r = vrelab.shake(vrelab.load_case(case, "paper confirmation"), series=True)

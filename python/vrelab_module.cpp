@@ -13,6 +13,7 @@
 #include <Python.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -384,6 +385,120 @@ py::list diagnose_settings_description() {
   return out;
 }
 
+// ---------------------------------------------------------------- predict's frequency_Hz, amplitude_g
+
+// predict(case, frequency_Hz=, amplitude_g=) sets the sine of the case's [vibration] (a "sine"
+// or "sine_on_random"): refuses any other vibration, naming the case.
+void require_sine(const io::Case& c) {
+  if (!c.vibration)
+    throw io::InputError(c.path + ": predict's frequency_Hz and amplitude_g set the sine of a [vibration] table; the case has none");
+  const auto type = c.vibration->type;
+  if (type != rectification::VibrationKind::sine && type != rectification::VibrationKind::sine_on_random)
+    throw io::InputError(c.path + ": predict's frequency_Hz and amplitude_g set a \"sine\" or \"sine_on_random\" [vibration]'s sine, not a \"" +
+                         rectification::to_string(type) + "\"");
+}
+
+// A number as the case reader's messages write it (printf's %g).
+std::string g_text(double x) {
+  std::ostringstream s;
+  s << x;
+  return s.str();
+}
+
+// Sets `s`'s frequency (Hz, finite, as the case file's frequency_Hz: >= 0 for a sine, > 0 for
+// a sine on random) and amplitude (g, the peak along the case's direction: its amplitude vector
+// scaled to this length, phases kept; 0 to 1000 g as the case file's). `index`: the element of
+// predict's arrays, named in messages ("frequency_Hz[3]").
+void set_sine(const io::Case& c, vibration::SineVibration& s, std::optional<double> frequency_Hz, std::optional<double> amplitude_g,
+              std::optional<std::size_t> index) {
+  const auto at = [&] {  // built for a message only
+    std::string text;
+    if (index) text.append("[").append(std::to_string(*index)).append("]");
+    return text;
+  };
+  if (frequency_Hz) {
+    const bool sine = c.vibration->type == rectification::VibrationKind::sine;
+    if (!(std::isfinite(*frequency_Hz) && (*frequency_Hz > 0 || (sine && *frequency_Hz == 0))))
+      throw io::InputError(c.path + ": predict(): frequency_Hz" + at() + " must be a finite number " + (sine ? ">= 0" : "> 0") +
+                           " Hz, got " + g_text(*frequency_Hz));
+    s.frequency_Hz = *frequency_Hz;
+  }
+  if (amplitude_g) {
+    if (!(*amplitude_g >= 0 && *amplitude_g <= io::kAmplitudeRange.max))
+      throw io::InputError(c.path + ": predict(): amplitude_g" + at() + " must be between 0 and " + g_text(io::kAmplitudeRange.max) +
+                           " g (the case files' limit), got " + g_text(*amplitude_g));
+    const double norm = s.amplitude_g.norm();
+    if (!(norm > 0))
+      throw io::InputError(c.path + ": predict(): amplitude_g scales the case's [vibration] amplitude_g, which is zero: no direction to scale");
+    s.amplitude_g *= *amplitude_g / norm;
+  }
+}
+
+// The case with its sine set (the scalar call): its content records the values too, so that
+// to_dict() is the JSON of a case file holding them.
+io::Case with_sine(io::Case c, std::optional<double> frequency_Hz, std::optional<double> amplitude_g) {
+  if (!frequency_Hz && !amplitude_g) return c;
+  require_sine(c);
+  vibration::SineVibration& s = c.vibration->sine;
+  set_sine(c, s, frequency_Hz, amplitude_g, std::nullopt);
+  if (frequency_Hz) c.content["vibration"]["frequency_Hz"] = s.frequency_Hz;
+  if (amplitude_g) c.content["vibration"]["amplitude_g"] = {s.amplitude_g[0], s.amplitude_g[1], s.amplitude_g[2]};
+  return c;
+}
+
+// predict over arrays: element i is io::predict of the case with frequency_Hz[i] and
+// amplitude_g[i] set by set_sine, as the scalar call sets them (not given: the case's own), so
+// each element equals the scalar call's number exactly. The arrays given have one length (the
+// package broadcasts them). Runs with the GIL released; Ctrl-C stops it between elements.
+py::dict predict_arrays(const io::Case& c, bool frequency_dependent, const std::optional<std::vector<double>>& frequency_Hz,
+                        const std::optional<std::vector<double>>& amplitude_g) {
+  require_sine(c);
+  if (!frequency_Hz && !amplitude_g) throw std::invalid_argument("predict(): neither frequency_Hz nor amplitude_g given");
+  const std::size_t n = frequency_Hz ? frequency_Hz->size() : amplitude_g->size();
+  if (frequency_Hz && amplitude_g && amplitude_g->size() != n)
+    throw std::invalid_argument("predict(): frequency_Hz and amplitude_g differ in length");
+  struct Columns {
+    std::vector<double> f_Hz, a_g, total_g, printed_g, omitted_g, at_frequency_g;
+    std::array<std::vector<double>, rectification::kNumTerms> terms, at_frequency_terms;
+  } out;
+  interruptible([&] {
+    io::Case w = c;
+    for (std::size_t i = 0; i < n; ++i) {
+      core::throw_if_cancelled();
+      w.vibration->sine = c.vibration->sine;
+      set_sine(c, w.vibration->sine, frequency_Hz ? std::optional((*frequency_Hz)[i]) : std::nullopt,
+               amplitude_g ? std::optional((*amplitude_g)[i]) : std::nullopt, i);
+      const io::PredictStudy s = io::predict(w, frequency_dependent);
+      out.f_Hz.push_back(w.vibration->sine.frequency_Hz);
+      out.a_g.push_back(amplitude_g ? (*amplitude_g)[i] : w.vibration->sine.amplitude_g.norm());
+      out.total_g.push_back(s.terms.total_g());
+      out.printed_g.push_back(s.printed_g.value_or(std::nan("")));
+      out.omitted_g.push_back(s.terms.omitted_by_paper_g());
+      for (std::size_t t = 0; t < out.terms.size(); ++t) out.terms[t].push_back(s.terms.g[t]);
+      if (s.at_frequency) {
+        out.at_frequency_g.push_back(s.at_frequency->total_g());
+        for (std::size_t t = 0; t < out.terms.size(); ++t) out.at_frequency_terms[t].push_back(s.at_frequency->terms.g[t]);
+      }
+    }
+    return 0;
+  });
+  const auto terms = [](const std::array<std::vector<double>, rectification::kNumTerms>& a) {
+    py::dict d;
+    for (int t = 0; t < rectification::kNumTerms; ++t) d[py::str(std::string(rectification::term_name(t)))] = array(a[static_cast<std::size_t>(t)]);
+    return d;
+  };
+  py::dict d;
+  d["frequency_Hz"] = array(out.f_Hz);
+  d["amplitude_g"] = array(out.a_g);
+  d["total_g"] = array(out.total_g);
+  d["terms"] = terms(out.terms);
+  d["printed_g"] = array(out.printed_g);
+  d["omitted_by_paper_g"] = array(out.omitted_g);
+  d["frequency_dependent_g"] = frequency_dependent ? py::object(array(out.at_frequency_g)) : py::object(py::none());
+  d["frequency_terms"] = frequency_dependent ? py::object(terms(out.at_frequency_terms)) : py::object(py::none());
+  return d;
+}
+
 }  // namespace
 
 PYBIND11_MODULE(_core, m) {
@@ -508,13 +623,23 @@ PYBIND11_MODULE(_core, m) {
       .def("to_dict", [](const PredictResult& r) { return to_py(io::predict_json(r.c, r.s)); }, "`vrelab predict --json` as a dict.");
 
   m.def(
-      "predict", [](const io::Case& c, bool frequency_dependent) { return PredictResult{c, io::predict(c, frequency_dependent)}; },
-      py::arg("case"), py::arg("frequency_dependent") = false,
-      "predict(case, frequency_dependent=False) -> PredictResult\n\n"
+      "predict",
+      [](const io::Case& c, bool frequency_dependent, std::optional<double> frequency_Hz, std::optional<double> amplitude_g) {
+        io::Case w = with_sine(c, frequency_Hz, amplitude_g);
+        io::PredictStudy s = io::predict(w, frequency_dependent);
+        return PredictResult{std::move(w), std::move(s)};
+      },
+      py::arg("case"), py::arg("frequency_dependent") = false, py::kw_only(), py::arg("frequency_Hz") = py::none(),
+      py::arg("amplitude_g") = py::none(),
+      "predict(case, frequency_dependent=False, *, frequency_Hz=None, amplitude_g=None) -> PredictResult\n\n"
       "The vibration error implied by model (1): eq. (3) corrected, per term and total (g), for the case's "
       "[vibration] (sine: amplitude g peak, frequency Hz; random: rms g or PSD g^2/Hz; sine on random); with "
       "frequency_dependent=True also through the plant's dynamics at frequency_Hz. Same as `vrelab predict CASE "
-      "[--frequency-dependent]`.");
+      "[--frequency-dependent]`. frequency_Hz (Hz) and amplitude_g (g peak along the case's direction: its "
+      "amplitude_g vector scaled to this length) set a \"sine\" or \"sine_on_random\" [vibration]'s sine, as a case "
+      "file holding them would.");
+  m.def("_predict_arrays", &predict_arrays, py::arg("case"), py::arg("frequency_dependent"), py::arg("frequency_Hz"),
+        py::arg("amplitude_g"));
   m.def(
       "predict_total_g", [](const io::Case& c) { return io::predict_terms(c).total_g(); }, py::arg("case"),
       "Eq. (3) corrected for the case's vibration, total only (g): the library call io::predict_terms, without a "

@@ -10,6 +10,8 @@ to_dict() equal to the CLI's JSON for the same case.
     r = vrelab.shake(case, series=True)
     r.measured_g, r.sigma_g, r.predicted_g                # g
     r.series["time_s"], r.series["output_mA"]              # NumPy arrays
+    vrelab.predict(case, True, frequency_Hz=[5.0, 50.0, 500.0]).frequency_dependent_g  # NumPy, one call
+    vrelab.diagnose("cases/lab-example").runs_frame()     # pandas (runs_columns(): NumPy)
 
 Errors: vrelab.InputError (a ValueError; the CLI's exit code 2, same message) and
 vrelab.SolverError (the ODE solver failed; .call, .t_s). Units: README "Units".
@@ -17,6 +19,8 @@ vrelab.SolverError (the ODE solver failed; .call, .t_s). Units: README "Units".
 import functools
 import os
 import tempfile
+
+import numpy as np
 
 from ._core import (  # noqa: F401
     Case,
@@ -36,12 +40,15 @@ from ._core import (  # noqa: F401
     git_describe,
     identify,
     limits,
-    predict,
     predict_total_g,
     reproduce,
     shake,
 )
 from . import _core
+from . import tables
+from .tables import PredictArrays
+
+tables.attach(_core)  # runs_frame(), effects_frame(), coefficients_frame(), ... on the result classes
 
 
 def _find_plot_scripts():
@@ -100,7 +107,7 @@ for _name, _fields in _REPR_FIELDS.items():
     setattr(getattr(_core, _name), "__repr__", _make_repr(_name, _fields))
 
 __all__ = [
-    "Case", "InputError", "SolverError", "load_case", "case_toml", "identify", "predict", "shake",
+    "Case", "InputError", "SolverError", "load_case", "case_toml", "identify", "predict", "PredictArrays", "shake",
     "sweep", "frequency", "campaign", "diagnose", "diagnose_data", "check_campaign", "diagnose_settings",
     "reproduce", "limits", "__version__",
 ]
@@ -177,7 +184,33 @@ def _wrap(fn):
 
 
 identify = _wrap(_core.identify)
-predict = _wrap(_core.predict)
+
+
+def predict(case: "vrelab.Case | str | os.PathLike | dict", frequency_dependent: bool = False, *,
+            frequency_Hz=None, amplitude_g=None) -> "PredictResult | PredictArrays":
+    c = load_case(case)
+    if frequency_Hz is None and amplitude_g is None:  # the case as it is (no np.ndim: a microsecond a call)
+        return _core.predict(c, frequency_dependent)
+    if np.ndim(frequency_Hz) == 0 and np.ndim(amplitude_g) == 0:
+        return _core.predict(c, frequency_dependent, frequency_Hz=frequency_Hz, amplitude_g=amplitude_g)
+    given = {k: np.asarray(v, dtype=float) for k, v in (("frequency_Hz", frequency_Hz), ("amplitude_g", amplitude_g))
+             if v is not None}
+    shape = np.broadcast_shapes(*(v.shape for v in given.values()))
+    flat = {k: np.broadcast_to(v, shape).ravel().tolist() for k, v in given.items()}
+    return PredictArrays(_core._predict_arrays(c, frequency_dependent, flat.get("frequency_Hz"), flat.get("amplitude_g")), shape)
+
+
+predict.__doc__ = _core.predict.__doc__ + """
+
+Arrays: frequency_Hz and amplitude_g may be arrays (any shape; a scalar or None beside an array
+is broadcast, None keeping the case's value); the result is then a vrelab.PredictArrays whose
+attributes (total_g, terms, printed_g, frequency_dependent_g, ...) are NumPy arrays of the
+broadcast shape, each element the number of the scalar call with that element's values, in one
+call (the loop runs in C++ with the GIL released; Ctrl-C stops it). A bad element raises
+vrelab.InputError naming its index in the flattened broadcast (frequency_Hz[3]).
+
+case: a vrelab.Case, a case file path (str or os.PathLike) or a dict of tables
+(vrelab.load_case). Bad input raises vrelab.InputError (a ValueError) with the CLI's message."""
 predict_total_g = _wrap(_core.predict_total_g)
 shake = _wrap(_core.shake)
 frequency = _wrap(_core.frequency)
@@ -203,8 +236,8 @@ class SweepResult:
         self.columns = columns
 
     def frame(self):
-        import pandas  # optional
-        return pandas.DataFrame(self.columns)
+        """.columns as a pandas DataFrame (integer columns stay int64)."""
+        return tables.frame(self.columns, "SweepResult.frame()", "SweepResult.columns")
 
     def report(self):
         return self.run.report()
@@ -215,11 +248,12 @@ class SweepResult:
                 "columns": {k: v.tolist() for k, v in self.columns.items()}}
 
 
-def _read_csv_columns(path):
-    """The columns of a CSV file ('#' lines are comments) as NumPy arrays (float where every
-    value parses, else str)."""
+def _read_csv_columns(path, ints=(), text=()):
+    """The columns of a CSV file ('#' lines are comments) as NumPy arrays: those named in
+    `ints` int64 and in `text` str (a sweep's index and steps; its checksum, 8 hex digits,
+    some of them all decimal), every other float64 where every value is a number, else str.
+    By name, not by the values: a frequency written 5 stays a float."""
     import csv
-    import numpy as np
     with open(path, newline="") as f:
         rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
     if not rows:
@@ -228,11 +262,20 @@ def _read_csv_columns(path):
     cols = {}
     for i, name in enumerate(head):
         values = [r[i] if i < len(r) else "" for r in body]
-        try:
-            cols[name] = np.array([float(v) for v in values], dtype=float)
-        except ValueError:
+        if name in ints:
+            cols[name] = np.array([int(v) for v in values], dtype=np.int64)
+        elif name in text:
             cols[name] = np.array(values, dtype=str)
+        else:
+            try:
+                cols[name] = np.array([float(v) for v in values], dtype=np.float64)
+            except ValueError:
+                cols[name] = np.array(values, dtype=str)
     return cols
+
+
+# The sweep CSV's columns that are not floats (docs/json-output.md, "vrelab sweep").
+_SWEEP_COLUMNS = {"ints": ("index", "steps"), "text": ("checksum",)}
 
 
 def sweep(case, out=None, restart=False, threads=-1, progress=False):
@@ -249,9 +292,9 @@ def sweep(case, out=None, restart=False, threads=-1, progress=False):
         with tempfile.TemporaryDirectory(prefix="vrelab-sweep-") as d:
             path = os.path.join(d, "sweep.csv")
             run = _core._sweep(c, path, True, threads, progress)
-            return SweepResult(run, _read_csv_columns(path))
+            return SweepResult(run, _read_csv_columns(path, **_SWEEP_COLUMNS))
     run = _core._sweep(c, os.fspath(out), restart, threads, progress)
-    return SweepResult(run, _read_csv_columns(os.fspath(out)))
+    return SweepResult(run, _read_csv_columns(os.fspath(out), **_SWEEP_COLUMNS))
 
 
 def campaign(case, out_dir, key=None, seed=None, raw_format="csv"):

@@ -55,12 +55,6 @@ def case(name):
     return os.path.join(CASES, name)
 
 
-@pytest.fixture(scope="module")
-def lab_example():
-    """vrelab.diagnose of cases/lab-example, once for the tests that read it (~3 s of CPU each)."""
-    return vrelab.diagnose(case("lab-example"))
-
-
 def test_version_is_the_programs():
     out = cli("--version").stdout
     assert vrelab.__version__ in out and vrelab.git_describe in out
@@ -85,12 +79,14 @@ def test_results_print_their_headline_not_an_address(lab_example):
 
 def test_signatures_are_what_the_calls_take():
     import inspect
-    for fn, params in ((vrelab.predict, ["case", "frequency_dependent"]), (vrelab.identify, ["case", "monte_carlo", "seed"]),
+    for fn, params in ((vrelab.predict, ["case", "frequency_dependent", "frequency_Hz", "amplitude_g"]),
+                       (vrelab.identify, ["case", "monte_carlo", "seed"]),
                        (vrelab.shake, ["case", "series", "seed"]), (vrelab.frequency, ["case"])):
         sig = inspect.signature(fn)
         assert list(sig.parameters) == params, (fn.__name__, sig)
     sig = inspect.signature(vrelab.predict)
     assert sig.parameters["frequency_dependent"].default is False
+    assert [sig.parameters[p].kind for p in ("frequency_Hz", "amplitude_g")] == [inspect.Parameter.KEYWORD_ONLY] * 2
     # The signature's names are the call's keywords: bound and called, the same result.
     bound = sig.bind(case("shake-sine.toml"), frequency_dependent=True)
     assert vrelab.predict(*bound.args, **bound.kwargs).frequency_dependent_g is not None
@@ -223,6 +219,14 @@ def test_sweep_columns(tmp_path):
     # both frequencies; the ODE (k2 in the loop, |H|^2 = 1 - O((f / 500 Hz)^2) <= 4e-4 off) within 1 %.
     np.testing.assert_allclose(cols["predicted_eq3_g"], [7.5e-6, 7.5e-6], rtol=1e-12)
     np.testing.assert_allclose(cols["measured_g"], [7.5e-6, 7.5e-6], rtol=1e-2)
+    # Integer columns stay integers (index, steps), the checksum text; so in the DataFrame.
+    assert cols["index"].dtype == np.int64 and list(cols["index"]) == [0, 1]
+    assert cols["steps"].dtype == np.int64 and cols["frequency_Hz"].dtype == np.float64
+    assert cols["checksum"].dtype.kind == "U" and all(len(c) == 8 for c in cols["checksum"])
+    pytest.importorskip("pandas")
+    frame = r.frame()
+    assert list(frame.columns) == list(cols)
+    assert all(frame[k].dtype == (object if v.dtype.kind == "U" else v.dtype) for k, v in cols.items())
 
 
 # ---- errors
