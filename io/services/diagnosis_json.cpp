@@ -36,6 +36,8 @@ json parameters_json(const validation::EffectFit& e) {
               {"at_bound", q.at_bound},
               {"range", json::array({finite_or_null(q.lower), finite_or_null(q.upper)})}};
     if (!q.sign_identifiable) p["sign_identifiable"] = false;  // the value is a magnitude
+    if (const auto ds = validation::datasheet_form(q.value, q.sigma, q.unit))  // IEEE Std 1293's units beside the model's
+      p["datasheet"] = {{"value", ds->value}, {"sigma", finite_or_null(ds->sigma)}, {"unit", ds->unit}};
     ps.push_back(std::move(p));
   }
   return ps;

@@ -71,10 +71,16 @@ void which_effect(Report& rep, const validation::Diagnosis& d) {
                 "runs it was not fitted to (held out, summed over folds; larger is better). A sigma 'not pinned': the "
                 "runs do not determine the parameter.");
   std::vector<std::vector<std::string>> rows = {
-      {"effect", "parameter", "unit", "value", "sigma", "evidence (held-out chi^2 drop)", "held-out chi^2"}};
-  for (const auto& e : d.effects)
+      {"effect", "parameter", "unit", "value", "sigma", "datasheet (IEEE Std 1293 units)", "evidence (held-out chi^2 drop)",
+       "held-out chi^2"}};
+  for (const auto& e : d.effects) {
+    const auto ds = validation::datasheet_form(e.value, e.sigma, e.unit);
     rows.push_back({e.name, e.parameter, e.unit, fmt::format("{:.5g}", e.value), sigma_text(e.sigma, e.at_bound),
+                    ds ? fmt::format("{:.4g} {} (sigma {})", ds->value, ds->unit,
+                                     std::isfinite(ds->sigma) ? fmt::format("{:.2g}", ds->sigma) : "not pinned")
+                       : "",
                     fmt::format("{:.1f}", e.evidence), fmt::format("{:.1f}", e.heldout_chi2)});
+  }
   rep.table(rows);
   if (!d.pairs.empty()) {
     rep.paragraph(fmt::format("No one effect explains the gap; the best with the two most promising seconds (ranked on "

@@ -19,6 +19,7 @@
 #include "support/files.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "validation/diagnosis/diagnose.hpp"
+#include "validation/diagnosis/diagnosis_text.hpp"
 
 namespace test_diagnosis_io {
 
@@ -217,6 +218,29 @@ TEST(DiagnosisJson, RunVrcIsErrorOverTheSineAndRandomPartsMeanSquareInMicroGPerG
   EXPECT_EQ(kinds[0], 10);
   EXPECT_GE(kinds[1], 4);
   EXPECT_GE(kinds[2], 1);
+}
+
+// The datasheet form of a coefficient (IEEE Std 1293's units): the term it makes, in ug from the
+// datasheet value, equals the model's in g x 1e6 at any amplitude: k5 = 3e-8 /g^4 at 2 g rectifies
+// k5 a^5 = 9.6e-7 g, and 0.03 ug/g^5 x 2^5 g^5 = 0.96 ug; k_PP = 2e-6 /g: 2 ug/g^2; an angle per g
+// 4e-7 rad/g: 0.4 urad/g. A ratio, a frequency, 1/rad or a phase has no datasheet form; a sigma
+// the runs do not pin stays not a number.
+TEST(DatasheetForm, ACoefficientsTermInUgIsTheModelsInGTimesAMillion) {
+  const auto k5 = validation::datasheet_form(3e-8, 1e-9, "1/g^4");
+  ASSERT_TRUE(k5.has_value());
+  EXPECT_EQ(k5->unit, "ug/g^5");
+  EXPECT_NEAR(k5->value * std::pow(2.0, 5), 0.96, 1e-12);
+  EXPECT_NEAR(k5->sigma, 1e-3, 1e-15);
+  const auto kpp = validation::datasheet_form(2e-6, INFINITY, "1/g");
+  ASSERT_TRUE(kpp.has_value());
+  EXPECT_EQ(kpp->unit, "ug/g^2");
+  EXPECT_NEAR(kpp->value, 2.0, 1e-12);
+  EXPECT_TRUE(std::isnan(kpp->sigma));
+  const auto rocking = validation::datasheet_form(4e-7, 1e-8, "rad/g");
+  ASSERT_TRUE(rocking.has_value());
+  EXPECT_EQ(rocking->unit, "urad/g");
+  EXPECT_NEAR(rocking->value, 0.4, 1e-12);
+  for (const char* u : {"1", "Hz", "1/rad", "rad", "deg", "1/g^x", "1/g^"}) EXPECT_FALSE(validation::datasheet_form(1, 1, u)) << u;
 }
 
 }  // namespace test_diagnosis_io

@@ -64,8 +64,12 @@ std::string Diagnosis::FullReport(double wall_s) const {
   t += "Verdict: " + verdict_text(d) + "\n";
   t += fmt::format("  {:<26}{:>16}{:>12}{:>12}{:>14}\n", "effect", "parameter", "sigma", "evidence", "held-out chi2");
   for (const auto& e : d.effects) {
-    t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}{:>12.1f}{:>14.1f}  {} ({})\n", e.name, e.value, e.sigma, e.evidence,
-                     e.heldout_chi2, e.parameter, e.unit);
+    const std::optional<DatasheetValue> ds = datasheet_form(e.value, e.sigma, e.unit);
+    t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}{:>12.1f}{:>14.1f}  {} ({}{})\n", e.name, e.value, e.sigma, e.evidence,
+                     e.heldout_chi2, e.parameter, e.unit,
+                     !ds ? ""
+                     : std::isfinite(ds->sigma) ? fmt::format("; datasheet {:.4g} +- {:.2g} {}", ds->value, ds->sigma, ds->unit)
+                                                : fmt::format("; datasheet {:.4g} {}, not pinned", ds->value, ds->unit));
     // The natural form's further parameters: fitted with sigma, chosen, or held at nominal.
     for (std::size_t j = 1; j < e.parameters.size(); ++j) {
       const auto& q = e.parameters[j];

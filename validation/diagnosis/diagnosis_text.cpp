@@ -1,6 +1,8 @@
 // validation/diagnosis/diagnosis_text.cpp -- a diagnosis' typed results in words.
 #include "validation/diagnosis/diagnosis_text.hpp"
 
+#include <cmath>
+
 #include <cstdio>
 #include <stdexcept>
 
@@ -72,6 +74,18 @@ ChosenEffects chosen_from_text(const std::string& text) {
   if (c.names[0].empty() || c.names[1].empty() || c.names[1].find(kPairJoin) != std::string::npos)
     throw std::invalid_argument("not one effect or a pair: \"" + text + "\"");
   return c;
+}
+
+std::optional<DatasheetValue> datasheet_form(double value, double sigma, const std::string& unit) {
+  const double s = std::isfinite(sigma) ? 1e6 * sigma : NAN;
+  if (unit == "1/g") return DatasheetValue{1e6 * value, s, "ug/g^2"};
+  if (unit == "rad/g") return DatasheetValue{1e6 * value, s, "urad/g"};
+  if (unit.rfind("1/g^", 0) == 0) {
+    const std::string n = unit.substr(4);
+    if (n.empty() || n.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+    return DatasheetValue{1e6 * value, s, "ug/g^" + std::to_string(std::stoi(n) + 1)};
+  }
+  return std::nullopt;
 }
 
 }  // namespace vrelab::validation
