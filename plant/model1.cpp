@@ -4,6 +4,17 @@
 
 namespace vrelab::plant {
 
+std::optional<std::pair<std::string, double>> datasheet_unit(std::string_view u) {
+  if (u == "g") return std::pair<std::string, double>{"ug", 1e6};
+  if (u == "1") return std::pair<std::string, double>{"ug/g", 1e6};
+  if (u == "1/g") return std::pair<std::string, double>{"ug/g^2", 1e6};
+  if (u == "rad") return std::pair<std::string, double>{"urad", 1e6};
+  if (u == "rad/g") return std::pair<std::string, double>{"urad/g", 1e6};
+  if (u.substr(0, 4) == "1/g^" && u.size() > 4 && u.find_first_not_of("0123456789", 4) == std::string_view::npos)
+    return std::pair<std::string, double>{"ug/g^" + std::to_string(std::stoi(std::string(u.substr(4))) + 1), 1e6};
+  return std::nullopt;
+}
+
 const std::array<CoefficientInfo, kNumCoefficients>& coefficient_info() {
   static const std::array<CoefficientInfo, kNumCoefficients> info{{
       {"K1", "out/g", "scale factor (sensitivity)"},

@@ -16,7 +16,9 @@
 // k3 in 1/g^2, k4 in 1/g^3, delta_* in rad, the cross terms k_IP..k_OO in 1/g.
 #include <array>
 #include <optional>
+#include <string>
 #include <string_view>
+#include <utility>
 
 #include <Eigen/Core>
 
@@ -45,6 +47,11 @@ struct CoefficientInfo {
 const std::array<CoefficientInfo, kNumCoefficients>& coefficient_info();
 std::optional<Coef> coefficient_from_name(std::string_view name);
 inline std::string_view coefficient_name(int i) { return coefficient_info()[i].name; }
+
+// A coefficient's unit in a datasheet's form (IEEE Std 1293): model (1)'s g-based units times
+// 1e6 -- g as ug, 1 as ug/g, 1/g^n as ug/g^(n+1), rad as urad, rad/g as urad/g -- {unit,
+// factor}; nullopt for any other unit (out/g, the scale factor, stays as it is).
+std::optional<std::pair<std::string, double>> datasheet_unit(std::string_view model_unit);
 
 struct Coefficients {
   std::array<double, kNumCoefficients> v{};

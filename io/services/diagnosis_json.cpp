@@ -131,7 +131,7 @@ json campaign_row(const validation::BlindCampaign& k) {
     const validation::CampaignDesign d = validation::blind_design(k);
     std::size_t sine_on = 0;
     for (const auto& r : d.random_runs) sine_on += r.sine_part;
-    row["design"] = {{"sine_runs", d.frequencies_Hz.size() * d.amplitudes_g.size() * d.directions.size() * d.orientations_g.size()},
+    row["design"] = {{"sine_runs", d.sine_runs()},
                      {"random_runs", d.random_runs.size() - sine_on},
                      {"sine_on_random_runs", sine_on}};
   }

@@ -136,14 +136,7 @@ std::string identify_table(const Case& c, const validation::StaticTestReport& r)
 // units times 1e6 (k0 in ug, k2 in ug/g^2, k3 in ug/g^3, a misalignment in urad); the scale
 // factor as it is. {unit, factor}.
 std::pair<std::string, double> datasheet_unit(int i, const Case& c) {
-  const std::string u(plant::coefficient_info()[i].unit);
-  if (u == "g") return {"ug", 1e6};
-  if (u == "1") return {"ug/g", 1e6};
-  if (u == "1/g") return {"ug/g^2", 1e6};
-  if (u == "1/g^2") return {"ug/g^3", 1e6};
-  if (u == "1/g^3") return {"ug/g^4", 1e6};
-  if (u == "rad") return {"urad", 1e6};
-  return {unit_of(i, c), 1.0};
+  return plant::datasheet_unit(plant::coefficient_info()[i].unit).value_or(std::pair<std::string, double>{unit_of(i, c), 1.0});
 }
 
 // Least squares' estimates in datasheet units, and every other method's estimate that departs

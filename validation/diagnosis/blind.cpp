@@ -347,11 +347,6 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
   note(k.category == "clean" && !d.gap_significant ? why + " (a nuisance flagged on a clean campaign)" : why);
 }
 
-// The number of shaker runs a design makes (sine, random and sine-on-random).
-std::size_t design_runs(const CampaignDesign& d) {
-  return d.frequencies_Hz.size() * d.amplitudes_g.size() * d.directions.size() * d.orientations_g.size() + d.random_runs.size();
-}
-
 // Scores one campaign against its key into r (counts, confusion, the wrong ones).
 // The held-out shrinkages 1 - after / before of the single campaigns: of the residuals' rms
 // (with the runs' noise) in g and in each run's sigma, of the gap's rms (noise removed), and of
@@ -367,8 +362,9 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
   const Diagnosis& d = k.diagnosis;
   const std::string& called = k.called;
   score_family(k, k.effect_gap_sigma, s.families, &r.wrong);
+  const CampaignDesign design = blind_design(k);  // (the expected chi^2 deviate is over its runs)
   if ((k.category == "single" || k.category == "natural") && k.error.empty() &&
-      std::pow(k.effect_gap_sigma, 2) / std::sqrt(2.0 * static_cast<double>(design_runs(blind_design(k)))) >= 5) {
+      std::pow(k.effect_gap_sigma, 2) / std::sqrt(2.0 * static_cast<double>(design.sine_runs() + design.random_runs.size())) >= 5) {
     ++s.at_limit;
     s.at_limit_found += d.gap_significant;
   }

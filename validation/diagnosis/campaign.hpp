@@ -14,6 +14,7 @@
 //        the truth's without its hidden effects. Nothing of the truth is in the Campaign.
 // The truth is built by each effect's truth hook (plant modules and shaker decorators), not
 // by the hypothesis the diagnosis fits (docs/effects.md, "Truth and hypothesis").
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <random>
@@ -80,6 +81,10 @@ struct CampaignDesign {
   // (docs/data-format.md). Summaries only: raw records of random runs are refused.
   std::vector<RandomRunDesign> random_runs;
   double random_record_s = 16.0;
+  // The sine runs the grid makes (frequencies x amplitudes x directions x orientations).
+  std::size_t sine_runs() const {
+    return frequencies_Hz.size() * amplitudes_g.size() * directions.size() * orientations_g.size();
+  }
 };
 
 // The default design (docs/data-format.md): 7 frequencies 10 Hz - 1.5 kHz x 1, 2, 4 g x

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "plant/model1.hpp"
+
 namespace vrelab::validation {
 
 namespace {
@@ -77,15 +79,11 @@ ChosenEffects chosen_from_text(const std::string& text) {
 }
 
 std::optional<DatasheetValue> datasheet_form(double value, double sigma, const std::string& unit) {
-  const double s = std::isfinite(sigma) ? 1e6 * sigma : NAN;
-  if (unit == "1/g") return DatasheetValue{1e6 * value, s, "ug/g^2"};
-  if (unit == "rad/g") return DatasheetValue{1e6 * value, s, "urad/g"};
-  if (unit.rfind("1/g^", 0) == 0) {
-    const std::string n = unit.substr(4);
-    if (n.empty() || n.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
-    return DatasheetValue{1e6 * value, s, "ug/g^" + std::to_string(std::stoi(n) + 1)};
-  }
-  return std::nullopt;
+  // An effect's parameter in 1 or rad is a ratio or a phase, not a coefficient: no datasheet form.
+  if (unit == "1" || unit == "rad") return std::nullopt;
+  const auto u = plant::datasheet_unit(unit);
+  if (!u) return std::nullopt;
+  return DatasheetValue{u->second * value, std::isfinite(sigma) ? u->second * sigma : NAN, u->first};
 }
 
 }  // namespace vrelab::validation
