@@ -413,6 +413,7 @@ json to_json(const validation::BlindResult& r) {
           {"clean_campaigns", s.clean},
           {"unexplained_recognition", BlindScores::rate(s.out_of_library_unexplained, s.out_of_library)},
           {"out_of_library_campaigns", s.out_of_library},
+          {"out_of_library_below_5_sigma", s.out_of_library_small},
           {"two_effect_explained_by_one_of_them", BlindScores::rate(s.two_by_one, s.two)},
           {"two_effect_explained_by_both", BlindScores::rate(s.two_by_both, s.two)},
           {"two_effect_campaigns", s.two},

@@ -65,6 +65,15 @@ class Effect {
   virtual double extra_damping_per_s(double /*theta_amplitude_rad*/, double /*plant_angle_gain_rad_per_s2_per_g*/) const {
     return 0.0;
   }
+  // The statistical linearisation's damping beyond the nominal, 1/s, for an angle
+  // theta = Theta sin(phi) + G, phi uniform and G zero-mean Gaussian independent of it
+  // (random and sine-on-random motion, rectification::random_linearised): the sine's angle and
+  // rate amplitudes, G's and its rate's standard deviations.
+  virtual double extra_damping_on_random_per_s(double /*theta_amplitude_rad*/, double /*rate_amplitude_rad_per_s*/,
+                                               double /*sigma_rad*/, double /*sigma_rate_rad_per_s*/,
+                                               double /*plant_angle_gain_rad_per_s2_per_g*/) const {
+    return 0.0;
+  }
   // The bytes that say which effect this is, its class and parameters, for the prediction's
   // cache of a run's balance (rectification::film_balance_key): two effects with the same key
   // act alike. nullopt: no such key, and the cache tells the effect by its address.

@@ -21,6 +21,19 @@ class SqueezeFilmDamping final : public Effect {
   // does for theta = Theta sin(wt), relative to c0: 2 <f(Theta sin phi) cos^2 phi>_phi,
   // f = c / c0 (1 + 3 x^2 / 8 + O(x^4), x = Theta / theta_gap).
   double damping_factor(double theta_amplitude_rad) const;
+  // Under random motion (statistical linearisation): the damping c_eq that dissipates as much
+  // as the film, E[c(theta) theta'^2] / E[theta'^2], relative to c0, for
+  // theta = Theta sin(phi) + G, theta' = W cos(phi) + G' (phi uniform; G, G' zero-mean
+  // Gaussian, independent of phi and of each other, as a stationary process and its rate are
+  // at one instant): E[f(Theta sin phi + G) (W^2 cos^2 phi + s'^2)] / (W^2 / 2 + s'^2).
+  // G = 0 gives damping_factor(Theta) (by another quadrature); Theta = 0 gives E[f(G)].
+  double damping_factor_on_random(double theta_amplitude_rad, double rate_amplitude_rad_per_s, double sigma_rad,
+                                  double sigma_rate_rad_per_s) const;
+  double extra_damping_on_random_per_s(double theta_amplitude_rad, double rate_amplitude_rad_per_s, double sigma_rad,
+                                       double sigma_rate_rad_per_s, double plant_angle_gain_rad_per_s2_per_g) const override {
+    return c0_per_s(plant_angle_gain_rad_per_s2_per_g) *
+           (damping_factor_on_random(theta_amplitude_rad, rate_amplitude_rad_per_s, sigma_rad, sigma_rate_rad_per_s) - 1);
+  }
   double gap_angle_rad() const { return gap_rad_; }
   // Its own c0 and b as constructed (what makes two films the same film).
   double c0_own_per_s() const { return c0_; }

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <map>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -246,6 +247,9 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
         // H_y X, its cross-spectrum with z is H_y S H_z^H; a real signal's covariance is the
         // real part of the one-sided cross-spectrum's integral.
         out.covariance += weight * (hm * s * hm.adjoint()).real();
+        const double w = 2 * std::numbers::pi * f;
+        out.angle_rate_variance_rad2_per_s2 +=
+            weight * w * w * (hm.row(RandomResponse::kAngle) * s * hm.row(RandomResponse::kAngle).adjoint())(0, 0).real();
         out.input_covariance_g2 += weight * s.real();
       }
     }
@@ -255,6 +259,94 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
 
 RandomResponse random_response(const PlantConfig& plant, const vibration::RandomProfile& p, const RandomQuadrature& q) {
   return random_response(p, [&plant](double f) { return loop_response(plant, f); }, q);
+}
+
+PlantConfig random_linearised(const PlantConfig& config, const vibration::RandomProfile& p, const RandomQuadrature& q,
+                              const Eigen::Matrix3d& turn, const std::optional<vibration::SineVibration>& sine) {
+  if (std::none_of(config.effects.begin(), config.effects.end(), [](const auto& e) { return e->amplitude_dependent_damping(); }))
+    return config;
+  std::vector<const plant::Effect*> films;
+  PlantConfig out = config;
+  out.effects.clear();
+  for (const auto& e : config.effects) {
+    if (e->amplitude_dependent_damping()) films.push_back(e.get());
+    else out.effects.push_back(e);
+  }
+  if (!out.servo) out.servo = plant::design_servo(config.dynamics);  // the electronics do not change
+  const Dynamics& d0 = config.dynamics;
+  const double two_wp = 2 * 2 * std::numbers::pi * d0.pendulum_frequency_Hz, zeta0 = d0.pendulum_damping_ratio;
+  // The loop at zeta0 and at 2 zeta0: Theta(zeta) = Theta(zeta0) / (1 + x (rho - 1)),
+  // x = (zeta - zeta0) / zeta0, rho = Theta(zeta0) / Theta(2 zeta0), the same for every input
+  // axis (the damping is one rank-one change of the angle's denominator).
+  PlantConfig twice = out;
+  twice.dynamics.pendulum_damping_ratio = 2 * zeta0;
+  const LoopResponder at0(out, false), at2(twice, false);
+  std::map<double, std::pair<LoopResponse, std::complex<double>>> memo;
+  const auto nominal = [&](double f) -> const std::pair<LoopResponse, std::complex<double>>& {
+    auto it = memo.find(f);
+    if (it == memo.end()) {
+      const LoopResponse r0 = at0(f), r2 = at2(f);
+      std::size_t j = 0;
+      for (std::size_t i = 1; i < 3; ++i)
+        if (std::abs(r0.angle_rad[i]) > std::abs(r0.angle_rad[j])) j = i;
+      const std::complex<double> rho = r2.angle_rad[j] != 0.0 ? r0.angle_rad[j] / r2.angle_rad[j] : 1.0;
+      it = memo.emplace(f, std::make_pair(r0, rho)).first;
+    }
+    return it->second;
+  };
+  const auto extra_at = [&](double zeta) {  // the films' damping ratio beyond zeta0 at the angle of damping zeta
+    const double x = (zeta - zeta0) / zeta0;
+    const ResponseAt h = [&](double f) {
+      const auto& entry = nominal(f);
+      LoopResponse s = entry.first;
+      for (auto& a : s.angle_rad) a /= 1.0 + x * (entry.second - 1.0);
+      return s;
+    };
+    const RandomResponse rr = random_response(p, h, q, turn);
+    double theta = 0, rate = 0;
+    if (sine) {
+      const LoopResponse hs = h(sine->frequency_Hz);
+      std::complex<double> t = 0;
+      for (std::size_t i = 0; i < 3; ++i) t += hs.angle_rad[i] * std::polar(sine->amplitude_g[i], sine->phase_rad[i]);
+      theta = std::abs(t), rate = 2 * std::numbers::pi * sine->frequency_Hz * theta;
+    }
+    const double sigma = std::sqrt(std::max(0.0, rr.covariance(RandomResponse::kAngle, RandomResponse::kAngle)));
+    const double sigma_rate = std::sqrt(std::max(0.0, rr.angle_rate_variance_rad2_per_s2));
+    double extra = 0;
+    for (const auto* f : films)
+      extra += f->extra_damping_on_random_per_s(theta, rate, sigma, sigma_rate, d0.angle_gain_rad_per_s2_per_g);
+    return extra / two_wp;
+  };
+  // g(zeta) = zeta0 + extra(zeta) - zeta falls with zeta (more damping, less angle, less
+  // film); g(zeta0) >= 0, and the film's law is held at 0.95 theta_gap, so the extra is
+  // bounded and g < 0 far enough out: bracket by doubling, then regula falsi.
+  double lo = zeta0, g_lo = extra_at(zeta0);
+  out.dynamics.pendulum_damping_ratio = zeta0;
+  if (!(g_lo > 0)) return out;
+  double hi = zeta0 + 2 * g_lo, g_hi = zeta0 + extra_at(hi) - hi;
+  for (int k = 0; g_hi > 0; ++k) {
+    if (k == 60 || !std::isfinite(g_hi)) throw std::runtime_error("random_linearised: the squeeze film's equivalent damping has no bracket");
+    lo = hi, g_lo = g_hi, hi = zeta0 + 2 * (hi - zeta0), g_hi = zeta0 + extra_at(hi) - hi;
+  }
+  int side = 0;
+  for (int it = 0; it < 200; ++it) {
+    const double z = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
+    const double gz = zeta0 + extra_at(z) - z;
+    if (std::abs(gz) < 1e-10 * z || hi - lo < 1e-10 * z) {
+      out.dynamics.pendulum_damping_ratio = z;
+      return out;
+    }
+    if (gz > 0) {
+      lo = z, g_lo = gz;
+      if (side == 1) g_hi *= 0.5;  // Illinois: the end that stays is halved
+      side = 1;
+    } else {
+      hi = z, g_hi = gz;
+      if (side == -1) g_lo *= 0.5;
+      side = -1;
+    }
+  }
+  throw std::runtime_error("random_linearised: the squeeze film's equivalent damping did not converge");
 }
 
 FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const RandomResponse& rr,

@@ -29,8 +29,9 @@
 // Sine on random (independent): each term's joint expectation, the random one averaged over
 // the sine's phase (eq3.hpp sine_on_random_rectification) with the sine through the loop at
 // its frequency; the angle's second moments add.
-// Not modelled for random motion: a squeeze film's amplitude-dependent damping (the nominal
-// damping is used), clipping beyond the current's Gaussian (range limit of I).
+// A squeeze film's amplitude-dependent damping: by statistical linearisation
+// (random_linearised below), the film's harmonics and the angle's departure from a Gaussian
+// left out. Not modelled: clipping beyond the current's Gaussian (range limit of I).
 #include <optional>
 
 #include <Eigen/Dense>
@@ -47,6 +48,7 @@ struct RandomResponse {
   enum Index : int { kF_IA = 0, kF_PA = 1, kF_OA = 2, kCurrent = 3, kAngle = 4 };
   Eigen::Matrix<double, 5, 5> covariance = Eigen::Matrix<double, 5, 5>::Zero();
   Eigen::Matrix3d input_covariance_g2 = Eigen::Matrix3d::Zero();  // of the case's motion x
+  double angle_rate_variance_rad2_per_s2 = 0;  // of Theta' (the statistical linearisation's weight)
   double dc_gain = 1;
   double from_Hz = 0, to_Hz = 0;
   int frequencies = 0;  // loop responses evaluated
@@ -78,6 +80,20 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
                                const RandomQuadrature& q = {}, const Eigen::Matrix3d& turn = Eigen::Matrix3d::Identity());
 RandomResponse random_response(const plant::PlantConfig& plant, const vibration::RandomProfile& p,
                                const RandomQuadrature& q = {});
+
+// An amplitude-dependent damping (plant::SqueezeFilmDamping) under random or sine-on-random
+// motion replaced by its statistical linearisation, as amplitude_linearised does for a sine:
+// the damping 2 zeta w_p plus each film's c0 (damping_factor_on_random - 1) at the angle the
+// plant so damped has (its sine amplitude at the sine's frequency, its random part's standard
+// deviation and rate's from random_response over q and turn), a fixed point found to 1e-10
+// by regula falsi (Illinois); the servo held as designed for the nominal damping. The
+// damping enters the plant's linear part as a rank-one term, so the angle at damping zeta is
+// the nominal one over 1 + (zeta - zeta0) D(f), D from the loop at zeta0 and 2 zeta0: two
+// loop responses per frequency, whatever the iterations. Without such an effect the plant is
+// returned as it is.
+plant::PlantConfig random_linearised(const plant::PlantConfig& plant, const vibration::RandomProfile& p,
+                                     const RandomQuadrature& q, const Eigen::Matrix3d& turn,
+                                     const std::optional<vibration::SineVibration>& sine);
 
 // Random only (sine == nullopt), or sine on random (the sine's loop response at its frequency).
 FrequencyPrediction random_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,

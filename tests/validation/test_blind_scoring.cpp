@@ -297,6 +297,38 @@ TEST(BlindScoring, SinglesAreScoredByTheGapAsTheLabSeesItTheLargestRunSizeBeside
   EXPECT_NE(brief.find("sized by the largest run, >= 5 sigma in some run: 1/2 = 50 %"), std::string::npos) << brief;
 }
 
+// Out-of-library campaigns are sized as single ones are: one whose gap the design leaves
+// below 5 sigma (a proof-mass torsion without OA runs) has nothing to call unexplained and is
+// reported apart, not scored; one at 40 sigma called "no significant gap" is a miss.
+TEST(BlindScoring, OutOfLibraryCampaignsAreScoredFromFiveSigma) {
+  BlindSettings s;
+  s.n = 12, s.seed = 9103, s.threads = 1;
+  std::map<int, std::string> done;
+  for (int i = 0; i < s.n; ++i) {
+    BlindCampaign k = blind_key(i, s.seed);
+    EffectFit e;
+    e.name = "pickoff_nonlinearity";
+    k.diagnosis.effects = {e};
+    k.top = e.name;
+    k.called = "clean";
+    k.diagnosis.verdict = Verdict::no_significant_gap;
+    k.effect_max_sigma = 40, k.effect_gap_sigma = k.category == "out_of_library" && i == 2 ? 3 : 40;
+    done[i] = campaign_result_text(k);
+  }
+  ASSERT_EQ(blind_key(2, s.seed).category, "out_of_library");
+  ASSERT_EQ(blind_key(8, s.seed).category, "out_of_library");
+  const BlindResult r = run_blind(s, {}, done, {});
+  EXPECT_EQ(r.scores.out_of_library, 1);
+  EXPECT_EQ(r.scores.out_of_library_unexplained, 0);
+  EXPECT_EQ(r.scores.out_of_library_small, 1);
+  EXPECT_EQ(r.scores.families.at("out_of_library").no_gap, 1);
+  EXPECT_EQ(r.scores.families.at("out_of_library_below_5_sigma").n, 1);
+  const auto small = std::find_if(r.wrong.begin(), r.wrong.end(), [](const std::string& w) { return w.find("not scored") != std::string::npos && w.find("out of library") != std::string::npos; });
+  EXPECT_NE(small, r.wrong.end());
+  EXPECT_NE(r.BriefReport().find("out-of-library called unexplained: 0/1 (gap >= 5 sigma; 1 below, not scored)"), std::string::npos)
+      << r.BriefReport();
+}
+
 // Two-effect campaigns are scored by the set of effects an "explained" verdict chose, in
 // either order: both chosen (written B then A), one of them alone, and one of them with a third
 // effect (neither). The results go through the results file's lines as a resumed run reads them.

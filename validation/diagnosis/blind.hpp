@@ -127,7 +127,8 @@ struct BlindScores {
   int single_top_right = 0;          // ... ranked first whatever the verdict
   int small = 0, small_right = 0;    // single effects with a gap below 5 sigma (not scored); called right anyway
   int clean = 0, false_alarms = 0;
-  int out_of_library = 0, out_of_library_unexplained = 0;
+  int out_of_library = 0, out_of_library_unexplained = 0;  // scored: the gap >= 5 sigma in the campaign's design
+  int out_of_library_small = 0;                              // its gap below 5 sigma (not scored)
   int two = 0, two_by_one = 0, two_by_both = 0;
   // Detection at the limit: single and natural campaigns whose gap's expected chi^2 deviate,
   // effect_gap_sigma^2 / sqrt(2 n) over the campaign's n runs (the mean rise of chi^2 over its

@@ -95,6 +95,14 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
 }
 
 namespace {
+// A squeeze film's amplitude-dependent damping replaced by its describing function (a sine or
+// periodic run) or its statistical linearisation (a random or sine-on-random run).
+PlantConfig linearised(const PlantConfig& cfg, const RunRecord& r, const TableMotion& m) {
+  if (!r.random) return rectification::amplitude_linearised(cfg, m.sine);
+  return rectification::random_linearised(cfg, run_random(r), kRandomRunQuadrature, m.random_turn,
+                                          r.sine_part ? std::optional(m.sine) : std::nullopt);
+}
+
 Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e,
                     const std::vector<double>& values, ResponseCache& cache, const Absorbed& absorbed) {
   const double p = values.empty() ? 0.0 : values.front();
@@ -124,7 +132,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     const std::string film_key = r.random ? std::string() : rectification::film_balance_key(with_films, m.sine, motion);
     const auto memo = film_key.empty() ? film_memo.end() : film_memo.find(film_key);
     if (memo != film_memo.end()) cfg = memo->second.first;
-    else if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
+    else cfg = linearised(cfg, r, m);
     // The loop responses depend on the effect's value and, for an amplitude-dependent one,
     // on the run: the key says both.
     // (The name, a NUL and the numbers' bytes: the same numbers give the same key, as their
@@ -210,6 +218,7 @@ using internal::apply_effect;
 using internal::measured_sine;
 using internal::run_input;
 using internal::run_random;
+using internal::linearised;
 using internal::kRandomRunQuadrature;
 
 TableMotion table_motion(const RunRecord& r) {
@@ -267,7 +276,7 @@ double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effe
   TableMotion m = table_motion(r);
   apply_effect(e, values, r, cfg, m);
   const PlantConfig with_films = cfg;
-  if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
+  cfg = linearised(cfg, r, m);
   std::map<double, rectification::LoopResponse> responses;
   std::optional<PlantConfig> loop_cfg;  // cfg with its servo designed once (ResponseCache)
   const rectification::ResponseAt h = [&](double f) {
