@@ -306,6 +306,55 @@ TEST(EffectFitter, AnOptimumBeyondTheRangeEndsOnItsEdge) {
   EXPECT_EQ(fp[0].upper, upper);
 }
 
+// A linear effect that changes the coefficients' gradient (an input-placed nonlinearity: the
+// loop's k2 sees the current, the input's the motion): G(p) = G0 + p (G1 - G0), the residual
+// the signature plus what the coefficients' error makes through G1 (the truth at p = 1). The
+// fitter brackets the optimum from the likelihood at the nominal covariance (G0 = 0 here,
+// which judges the G1 part as signal): that estimate falls well short of the optimum (checked
+// below with the bracket's own rule), and the scan must grow its bracket until the optimum
+// lies inside. The reference: -2 ln L on a fine scan of the physical range (the likelihood
+// itself has its own tests); the fit within one of its steps, interior (sigma finite).
+TEST(EffectFitter, ALinearEffectsBracketGrowsToTheOptimum) {
+  const Eigen::Index n = 24;
+  Eigen::VectorXd s(n), f0(n);
+  Eigen::MatrixXd G0 = Eigen::MatrixXd::Zero(n, 2), G1(n, 2);
+  Data d;
+  d.sigma2 = Eigen::VectorXd::Constant(n, 1e-4);
+  d.Sigma = Eigen::Matrix2d::Identity();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double x = static_cast<double>(k) / static_cast<double>(n - 1);
+    f0(k) = 0, s(k) = 1 + x, G1(k, 0) = 1, G1(k, 1) = x * x;
+  }
+  const Eigen::Vector2d dc(-1.2, -0.8);  // the coefficients' error, about one sigma of Sigma
+  d.measured = s + G1 * dc;
+  const Table t0{f0, G0}, t1{f0 + s, G1};
+  const EffectFitter::TableAt model = [&](const std::vector<double>& v) {
+    return v.front() == 0 ? t0 : t1;  // (the fitter interpolates a linear effect itself)
+  };
+  EffectParameter q("fraction", "1");
+  q.nominal = 0, q.linear = true, q.unit_value = 1, q.lower = -0.5, q.upper = 1.5;
+  const Effect e = effect_of({q});
+  std::vector<int> all;
+  for (Eigen::Index k = 0; k < n; ++k) all.push_back(static_cast<int>(k));
+  // The bracket's first estimate (the fitter's rule: u0 +- 3 |u0| + 20 su at the nominal V).
+  const Eigen::VectorXd w = d.sigma2.cwiseInverse();
+  const double info = s.dot(w.asDiagonal() * s), u0 = s.dot(w.asDiagonal() * d.measured) / info;
+  const double first_hi = u0 + 3 * std::abs(u0) + 20 / std::sqrt(info);
+  double best = 0, lbest = INFINITY;
+  for (int k = 0; k <= 20000; ++k) {
+    const double p = q.lower + (q.upper - q.lower) * k / 20000.0;
+    const double l = likelihood(d, f0 + p * s, G0 + p * (G1 - G0), all).m2logl;
+    if (l < lbest) best = p, lbest = l;
+  }
+  std::printf("  first bracket ends at %.3f; the optimum %.4f\n", first_hi, best);
+  ASSERT_LT(first_hi, best - 0.1);
+  ASSERT_LT(best, q.upper - 0.1);
+  const EffectFitter fitter(e, t0, model);
+  const auto [value, sigma] = fitter.fit(d, all);
+  EXPECT_NEAR(value, best, 2 * (q.upper - q.lower) / 20000.0);
+  EXPECT_TRUE(std::isfinite(sigma));
+}
+
 // Held parameters (EffectFitter::unpinned): a further parameter whose slope is twice the
 // first's (in its span: the whitened Jacobian has rank 1) is held at its nominal, and the
 // result is the one-parameter fit (no covariance, the first parameter's GLS value). Likewise a

@@ -332,6 +332,22 @@ std::pair<double, double> EffectFitter::fit_first_uncached(const Data& d, const 
   }
   std::vector<double> ls;
   for (double x : xs) ls.push_back(L(x));
+  // A linear effect's bracket comes from the likelihood at the nominal covariance; where the
+  // effect changes the coefficients' gradient a lot (an input-placed nonlinearity: the loop's
+  // k2 sees the current, the input's the motion), that estimate falls short and the scan's
+  // best is its end. The bracket then grows on that side (doubling, up to the physical range)
+  // until the best lies inside it.
+  for (int grow = 0; e_.fitted().linear && grow < 8; ++grow) {
+    const std::size_t b = static_cast<std::size_t>(std::min_element(ls.begin(), ls.end()) - ls.begin());
+    const double lo = xs.front(), hi = xs.back(), width = hi - lo;
+    double nlo = lo, nhi = hi;
+    if (b == 0 && lo > e_.fitted().lower) nlo = std::max(e_.fitted().lower, lo - width);
+    else if (b + 1 == xs.size() && hi < e_.fitted().upper) nhi = std::min(e_.fitted().upper, hi + width);
+    else break;
+    xs.clear(), ls.clear();
+    for (int k = 0; k <= 60; ++k) xs.push_back(nlo + (nhi - nlo) * k / 60.0);
+    for (double x : xs) ls.push_back(L(x));
+  }
   // Refinement in [x_{b-1}, x_{b+1}] by successive parabolic interpolation (safeguarded by
   // golden steps): where the prediction is near linear in p across a grid step, -2 ln L is
   // near quadratic and a step or two lands on the minimum.
