@@ -88,7 +88,7 @@ double film_law(double theta, double gap) {
   return 1 / (y * std::sqrt(y));
 }
 
-// E[f(u + G)], G ~ N(0, sigma^2): 8-point Gauss-Legendre on pieces no wider than sigma / 2
+// E[f(u + G)], G ~ N(0, sigma^2): 8-point Gauss-Legendre on pieces no wider than sigma
 // over u +- 8 sigma, cut where the law is held (|theta| = 0.95 theta_gap, a kink) and at
 // 0.6, 0.8 and 0.9 theta_gap, where the law nears its pole at theta_gap (each piece then at
 // least its own width from the pole: the rule's error ~1e-11); the mass beyond 8 sigma
@@ -109,7 +109,7 @@ double gaussian_mean_law(double u, double sigma, double gap) {
   double sum = 0;
   for (int i = 0; i < n; ++i) {
     const double a = cuts[static_cast<std::size_t>(i)], b = cuts[static_cast<std::size_t>(i + 1)];
-    const int pieces = std::max(1, static_cast<int>(std::ceil((b - a) / 0.5)));
+    const int pieces = std::max(1, static_cast<int>(std::ceil(b - a)));
     const double h = (b - a) / pieces;
     for (int m = 0; m < pieces; ++m)
       for (std::size_t j = 0; j < x.size(); ++j) {

@@ -93,19 +93,23 @@ LoopResponse LoopResponder::operator()(double frequency_Hz) const {
   return out;
 }
 
-PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::SineVibration& v) {
+PlantConfig without_films(const PlantConfig& config) {
   if (std::none_of(config.effects.begin(), config.effects.end(), [](const auto& e) { return e->amplitude_dependent_damping(); }))
-    return config;  // (without a film: not copied twice on the way)
-  std::vector<const Effect*> films;  // amplitude-dependent damping (squeeze films)
+    return config;
   PlantConfig out = config;
   out.effects.clear();
-  for (const auto& e : config.effects) {
-    if (e->amplitude_dependent_damping()) films.push_back(e.get());
-    else out.effects.push_back(e);
-  }
-  if (films.empty()) return config;
-  // The servo stays the one built for the nominal damping (the electronics do not change).
+  for (const auto& e : config.effects)
+    if (!e->amplitude_dependent_damping()) out.effects.push_back(e);
   if (!out.servo) out.servo = plant::design_servo(config.dynamics);
+  return out;
+}
+
+PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::SineVibration& v) {
+  std::vector<const Effect*> films;  // amplitude-dependent damping (squeeze films)
+  for (const auto& e : config.effects)
+    if (e->amplitude_dependent_damping()) films.push_back(e.get());
+  if (films.empty()) return config;
+  PlantConfig out = without_films(config);
   // The damping the loop sees: 2 zeta w_p + sum of each film's c0 (describing function - 1).
   const Dynamics& d0 = config.dynamics;
   const double two_wp = 2 * 2 * std::numbers::pi * d0.pendulum_frequency_Hz;

@@ -65,6 +65,9 @@ FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& pl
 // damping. The harmonics the film makes are left out (their rectification is of
 // higher order). Without such an effect the plant is returned as it is.
 plant::PlantConfig amplitude_linearised(const plant::PlantConfig& plant, const vibration::SineVibration& v);
+// The plant with its amplitude-dependent dampings (films) removed, the servo designed for its
+// nominal damping (the electronics do not change with the film); the plant itself without one.
+plant::PlantConfig without_films(const plant::PlantConfig& plant);
 
 // The linear plant's response at one frequency (what the prediction filters through):
 // the rebalance current and the pendulum angle per g of vibration on each sensor axis, and

@@ -4,7 +4,7 @@
 #include <array>
 #include <cmath>
 #include <complex>
-#include <map>
+#include <functional>
 #include <numbers>
 #include <stdexcept>
 #include <string>
@@ -181,8 +181,28 @@ Eigen::Matrix3d cross_spectrum_g2_per_Hz(const vibration::RandomProfile& p, doub
   return cross_spectral_matrix_g2_per_Hz(p, f).real();
 }
 
-RandomResponse random_response(const vibration::RandomProfile& p, const ResponseAt& response, const RandomQuadrature& q,
-                               const Eigen::Matrix3d& turn) {
+namespace {
+// rho - 1, rho = Theta(zeta0) / Theta(2 zeta0) on the axis the angle answers most (the same
+// ratio on every axis: damped_response); 0 where the angle does not answer.
+std::complex<double> rho_minus_one(const LoopResponse& at_zeta0, const LoopResponse& at_twice) {
+  std::size_t j = 0;
+  for (std::size_t i = 1; i < 3; ++i)
+    if (std::abs(at_zeta0.angle_rad[i]) > std::abs(at_zeta0.angle_rad[j])) j = i;
+  return at_twice.angle_rad[j] != 0.0 ? at_zeta0.angle_rad[j] / at_twice.angle_rad[j] - 1.0 : 0.0;
+}
+}  // namespace
+
+namespace {
+// One quadrature point of a random part through the loop: its frequency, its weight (df), the
+// responses' transfer to each input axis (rows: F_IA, F_PA, F_OA, I, Theta) and the input's
+// cross-spectral density (turned).
+using ResponseRows = Eigen::Matrix<std::complex<double>, 5, 3>;
+using PointVisitor = std::function<void(double f, double weight, const ResponseRows& hm, const Eigen::Matrix3cd& s)>;
+
+// Visits the quadrature points of random_response (the band's knots, the pieces, the rule) in
+// order, skipping those where the input has no power; returns the band (from, to).
+std::pair<double, double> for_each_point(const vibration::RandomProfile& p, const ResponseAt& response, const RandomQuadrature& q,
+                                         const Eigen::Matrix3d& turn, const PointVisitor& visit, double& dc_gain) {
   if (!turn.allFinite()) throw std::invalid_argument("random_response: turn must be finite");
   const bool turned = !turn.isIdentity(0.0);
   const PreparedTables tables = prepared_tables(p);
@@ -202,14 +222,12 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
   }
   std::sort(knots.begin(), knots.end());
   knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
-  RandomResponse out;
-  out.from_Hz = knots.front();
-  out.to_Hz = knots.back();
+  const double from_Hz = knots.front(), to_Hz = knots.back();
   if (q.common_grid && !p.measured) {  // the global grid exp(k h), cut at the band's ends only
-    const double h = q.max_log_step, l0 = std::log(out.from_Hz), l1 = std::log(out.to_Hz);
-    knots = {out.from_Hz};
+    const double h = q.max_log_step, l0 = std::log(from_Hz), l1 = std::log(to_Hz);
+    knots = {from_Hz};
     for (double k = std::floor(l0 / h) + 1; k * h < l1; ++k) knots.push_back(std::exp(k * h));
-    knots.push_back(out.to_Hz);
+    knots.push_back(to_Hz);
   }
   for (std::size_t k = 0; k + 1 < knots.size(); ++k) {
     const double l0 = std::log(knots[k]), l1 = std::log(knots[k + 1]);
@@ -233,27 +251,79 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
         if (turned) s = turn * s * turn.transpose();
         if (s.isZero(0.0)) continue;
         const LoopResponse r = response(f);
-        ++out.frequencies;
-        out.dc_gain = r.dc_gain;
         // Rows: the responses' transfer to each input axis.
-        Eigen::Matrix<std::complex<double>, 5, 3> hm = Eigen::Matrix<std::complex<double>, 5, 3>::Zero();
+        ResponseRows hm = ResponseRows::Zero();
         for (int j = 0; j < 3; ++j) {
           const auto sj = static_cast<std::size_t>(j);
           hm(j, j) = r.mechanical[sj];
           hm(RandomResponse::kCurrent, j) = r.current[sj];
           hm(RandomResponse::kAngle, j) = r.angle_rad[sj];
         }
+        visit(f, weight, hm, s);
+        dc_gain = r.dc_gain;
+      }
+    }
+  }
+  return {from_Hz, to_Hz};
+}
+
+}  // namespace
+
+RandomResponse random_response(const vibration::RandomProfile& p, const ResponseAt& response, const RandomQuadrature& q,
+                               const Eigen::Matrix3d& turn) {
+  RandomResponse out;
+  const auto band = for_each_point(
+      p, response, q, turn,
+      [&out](double, double weight, const ResponseRows& hm, const Eigen::Matrix3cd& s) {
+        ++out.frequencies;
         // C_yz = integral Re(sum_ij H_yi S_ij conj(H_zj)) df: the response y's spectrum row
         // H_y X, its cross-spectrum with z is H_y S H_z^H; a real signal's covariance is the
         // real part of the one-sided cross-spectrum's integral.
         out.covariance += weight * (hm * s * hm.adjoint()).real();
-        const double w = 2 * std::numbers::pi * f;
-        out.angle_rate_variance_rad2_per_s2 +=
-            weight * w * w * (hm.row(RandomResponse::kAngle) * s * hm.row(RandomResponse::kAngle).adjoint())(0, 0).real();
         out.input_covariance_g2 += weight * s.real();
-      }
+      },
+      out.dc_gain);
+  out.from_Hz = band.first, out.to_Hz = band.second;
+  return out;
+}
+
+DampedRandomSpectrum damped_random_spectrum(const vibration::RandomProfile& p, const ResponseAt& at_zeta0, const ResponseAt& at_twice,
+                                            const RandomQuadrature& q, const Eigen::Matrix3d& turn) {
+  DampedRandomSpectrum out;
+  RandomResponse& r = out.at_zeta0;
+  const auto band = for_each_point(
+      p, at_zeta0, q, turn,
+      [&](double f, double weight, const ResponseRows& hm, const Eigen::Matrix3cd& s) {
+        ++r.frequencies;
+        const Eigen::Matrix<std::complex<double>, 5, 5> m = weight * (hm * s * hm.adjoint());
+        r.covariance += m.real();
+        r.input_covariance_g2 += weight * s.real();
+        out.frequency_Hz.push_back(f);
+        out.loop_rows.push_back(m.bottomRows<2>());
+        out.rho_minus_1.push_back(rho_minus_one(at_zeta0(f), at_twice(f)));
+      },
+      r.dc_gain);
+  r.from_Hz = band.first, r.to_Hz = band.second;
+  return out;
+}
+
+RandomResponse random_response_at_damping(const DampedRandomSpectrum& s, double x) {
+  RandomResponse out = s.at_zeta0;
+  auto& c = out.covariance;
+  c.bottomRows<2>().setZero();
+  c.rightCols<2>().setZero();
+  // The current's and the angle's rows scale by 1 / (1 + x (rho - 1)) (damped_response): their
+  // entries with the base's motion once, with each other twice (its modulus squared).
+  for (std::size_t k = 0; k < s.frequency_Hz.size(); ++k) {
+    const std::complex<double> sc = 1.0 / (1.0 + x * s.rho_minus_1[k]);
+    const auto& rows = s.loop_rows[k];
+    for (int a = 0; a < 2; ++a) {
+      for (int j = 0; j < 3; ++j) c(3 + a, j) += (sc * rows(a, j)).real();
+      for (int b = 0; b < 2; ++b) c(3 + a, 3 + b) += std::norm(sc) * rows(a, 3 + b).real();
     }
   }
+  for (int a = 3; a < 5; ++a)
+    for (int j = 0; j < 3; ++j) c(j, a) = c(a, j);
   return out;
 }
 
@@ -261,81 +331,67 @@ RandomResponse random_response(const PlantConfig& plant, const vibration::Random
   return random_response(p, [&plant](double f) { return loop_response(plant, f); }, q);
 }
 
-PlantConfig random_linearised(const PlantConfig& config, const vibration::RandomProfile& p, const RandomQuadrature& q,
-                              const Eigen::Matrix3d& turn, const std::optional<vibration::SineVibration>& sine) {
-  if (std::none_of(config.effects.begin(), config.effects.end(), [](const auto& e) { return e->amplitude_dependent_damping(); }))
-    return config;
+LoopResponse damped_response(const LoopResponse& at_zeta0, const LoopResponse& at_twice, double x) {
+  const std::complex<double> scale = 1.0 / (1.0 + x * rho_minus_one(at_zeta0, at_twice));
+  LoopResponse out = at_zeta0;
+  for (std::size_t i = 0; i < 3; ++i) out.angle_rad[i] *= scale, out.current[i] *= scale;
+  return out;
+}
+
+double random_linearised_damping(const PlantConfig& config, const DampedRandomSpectrum& spectrum,
+                                 const std::optional<vibration::SineVibration>& sine, const ResponseAt& at_zeta0,
+                                 const ResponseAt& at_twice) {
   std::vector<const plant::Effect*> films;
-  PlantConfig out = config;
-  out.effects.clear();
-  for (const auto& e : config.effects) {
+  for (const auto& e : config.effects)
     if (e->amplitude_dependent_damping()) films.push_back(e.get());
-    else out.effects.push_back(e);
-  }
-  if (!out.servo) out.servo = plant::design_servo(config.dynamics);  // the electronics do not change
   const Dynamics& d0 = config.dynamics;
-  const double two_wp = 2 * 2 * std::numbers::pi * d0.pendulum_frequency_Hz, zeta0 = d0.pendulum_damping_ratio;
-  // The loop at zeta0 and at 2 zeta0: Theta(zeta) = Theta(zeta0) / (1 + x (rho - 1)),
-  // x = (zeta - zeta0) / zeta0, rho = Theta(zeta0) / Theta(2 zeta0), the same for every input
-  // axis (the damping is one rank-one change of the angle's denominator).
-  PlantConfig twice = out;
-  twice.dynamics.pendulum_damping_ratio = 2 * zeta0;
-  const LoopResponder at0(out, false), at2(twice, false);
-  std::map<double, std::pair<LoopResponse, std::complex<double>>> memo;
-  const auto nominal = [&](double f) -> const std::pair<LoopResponse, std::complex<double>>& {
-    auto it = memo.find(f);
-    if (it == memo.end()) {
-      const LoopResponse r0 = at0(f), r2 = at2(f);
-      std::size_t j = 0;
-      for (std::size_t i = 1; i < 3; ++i)
-        if (std::abs(r0.angle_rad[i]) > std::abs(r0.angle_rad[j])) j = i;
-      const std::complex<double> rho = r2.angle_rad[j] != 0.0 ? r0.angle_rad[j] / r2.angle_rad[j] : 1.0;
-      it = memo.emplace(f, std::make_pair(r0, rho)).first;
-    }
-    return it->second;
-  };
+  const double zeta0 = d0.pendulum_damping_ratio;
+  if (films.empty()) return zeta0;
+  const double two_wp = 2 * 2 * std::numbers::pi * d0.pendulum_frequency_Hz;
+  // The angle's spectrum at zeta0, point by point: at x = zeta / zeta0 - 1 a point's variance
+  // is its share at zeta0 over |1 + x (rho - 1)|^2 (damped_response), its rate's (2 pi f)^2
+  // times that.
+  const std::vector<double>& freq = spectrum.frequency_Hz;
+  const std::vector<std::complex<double>>& rho_minus_1 = spectrum.rho_minus_1;
+  std::vector<double> angle_var;
+  for (const auto& rows : spectrum.loop_rows) angle_var.push_back(rows(1, 4).real());
+  std::complex<double> sine_theta0 = 0, sine_rho_minus_1 = 0;
+  if (sine) {
+    const LoopResponse r0 = at_zeta0(sine->frequency_Hz);
+    for (std::size_t i = 0; i < 3; ++i) sine_theta0 += r0.angle_rad[i] * std::polar(sine->amplitude_g[i], sine->phase_rad[i]);
+    sine_rho_minus_1 = rho_minus_one(r0, at_twice(sine->frequency_Hz));
+  }
   const auto extra_at = [&](double zeta) {  // the films' damping ratio beyond zeta0 at the angle of damping zeta
     const double x = (zeta - zeta0) / zeta0;
-    const ResponseAt h = [&](double f) {
-      const auto& entry = nominal(f);
-      LoopResponse s = entry.first;
-      for (auto& a : s.angle_rad) a /= 1.0 + x * (entry.second - 1.0);
-      return s;
-    };
-    const RandomResponse rr = random_response(p, h, q, turn);
-    double theta = 0, rate = 0;
-    if (sine) {
-      const LoopResponse hs = h(sine->frequency_Hz);
-      std::complex<double> t = 0;
-      for (std::size_t i = 0; i < 3; ++i) t += hs.angle_rad[i] * std::polar(sine->amplitude_g[i], sine->phase_rad[i]);
-      theta = std::abs(t), rate = 2 * std::numbers::pi * sine->frequency_Hz * theta;
+    double var = 0, rate_var = 0;
+    for (std::size_t k = 0; k < freq.size(); ++k) {
+      const double v = angle_var[k] / std::norm(1.0 + x * rho_minus_1[k]), w = 2 * std::numbers::pi * freq[k];
+      var += v, rate_var += w * w * v;
     }
-    const double sigma = std::sqrt(std::max(0.0, rr.covariance(RandomResponse::kAngle, RandomResponse::kAngle)));
-    const double sigma_rate = std::sqrt(std::max(0.0, rr.angle_rate_variance_rad2_per_s2));
+    const double theta = sine ? std::abs(sine_theta0 / (1.0 + x * sine_rho_minus_1)) : 0.0;
+    const double rate = sine ? 2 * std::numbers::pi * sine->frequency_Hz * theta : 0.0;
     double extra = 0;
     for (const auto* f : films)
-      extra += f->extra_damping_on_random_per_s(theta, rate, sigma, sigma_rate, d0.angle_gain_rad_per_s2_per_g);
+      extra += f->extra_damping_on_random_per_s(theta, rate, std::sqrt(std::max(0.0, var)), std::sqrt(std::max(0.0, rate_var)),
+                                                d0.angle_gain_rad_per_s2_per_g);
     return extra / two_wp;
   };
   // g(zeta) = zeta0 + extra(zeta) - zeta falls with zeta (more damping, less angle, less
   // film); g(zeta0) >= 0, and the film's law is held at 0.95 theta_gap, so the extra is
   // bounded and g < 0 far enough out: bracket by doubling, then regula falsi.
   double lo = zeta0, g_lo = extra_at(zeta0);
-  out.dynamics.pendulum_damping_ratio = zeta0;
-  if (!(g_lo > 0)) return out;
+  if (!(g_lo > 0)) return zeta0;
   double hi = zeta0 + 2 * g_lo, g_hi = zeta0 + extra_at(hi) - hi;
   for (int k = 0; g_hi > 0; ++k) {
-    if (k == 60 || !std::isfinite(g_hi)) throw std::runtime_error("random_linearised: the squeeze film's equivalent damping has no bracket");
+    if (k == 60 || !std::isfinite(g_hi))
+      throw std::runtime_error("random_linearised_damping: the squeeze film's equivalent damping has no bracket");
     lo = hi, g_lo = g_hi, hi = zeta0 + 2 * (hi - zeta0), g_hi = zeta0 + extra_at(hi) - hi;
   }
   int side = 0;
   for (int it = 0; it < 200; ++it) {
     const double z = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
     const double gz = zeta0 + extra_at(z) - z;
-    if (std::abs(gz) < 1e-10 * z || hi - lo < 1e-10 * z) {
-      out.dynamics.pendulum_damping_ratio = z;
-      return out;
-    }
+    if (std::abs(gz) < 1e-10 * z || hi - lo < 1e-10 * z) return z;
     if (gz > 0) {
       lo = z, g_lo = gz;
       if (side == 1) g_hi *= 0.5;  // Illinois: the end that stays is halved
@@ -346,7 +402,7 @@ PlantConfig random_linearised(const PlantConfig& config, const vibration::Random
       side = -1;
     }
   }
-  throw std::runtime_error("random_linearised: the squeeze film's equivalent damping did not converge");
+  throw std::runtime_error("random_linearised_damping: the squeeze film's equivalent damping did not converge");
 }
 
 FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const RandomResponse& rr,

@@ -30,7 +30,7 @@
 // the sine's phase (eq3.hpp sine_on_random_rectification) with the sine through the loop at
 // its frequency; the angle's second moments add.
 // A squeeze film's amplitude-dependent damping: by statistical linearisation
-// (random_linearised below), the film's harmonics and the angle's departure from a Gaussian
+// (random_linearised_damping below), the film's harmonics and the angle's departure from a Gaussian
 // left out. Not modelled: clipping beyond the current's Gaussian (range limit of I).
 #include <optional>
 
@@ -48,7 +48,6 @@ struct RandomResponse {
   enum Index : int { kF_IA = 0, kF_PA = 1, kF_OA = 2, kCurrent = 3, kAngle = 4 };
   Eigen::Matrix<double, 5, 5> covariance = Eigen::Matrix<double, 5, 5>::Zero();
   Eigen::Matrix3d input_covariance_g2 = Eigen::Matrix3d::Zero();  // of the case's motion x
-  double angle_rate_variance_rad2_per_s2 = 0;  // of Theta' (the statistical linearisation's weight)
   double dc_gain = 1;
   double from_Hz = 0, to_Hz = 0;
   int frequencies = 0;  // loop responses evaluated
@@ -81,19 +80,40 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
 RandomResponse random_response(const plant::PlantConfig& plant, const vibration::RandomProfile& p,
                                const RandomQuadrature& q = {});
 
+// A random part through the loop at damping zeta0 (at_zeta0) kept so that its covariances at
+// any other damping follow without a loop response (random_response_at_damping): per
+// quadrature point, the current's and the angle's rows of w H S H^H (the point's share of the
+// covariance, complex) and rho - 1 (damped_response, from at_twice).
+struct DampedRandomSpectrum {
+  RandomResponse at_zeta0;  // random_response(p, at_zeta0, q, turn)
+  std::vector<double> frequency_Hz;
+  std::vector<Eigen::Matrix<std::complex<double>, 2, 5>> loop_rows;
+  std::vector<std::complex<double>> rho_minus_1;
+};
+DampedRandomSpectrum damped_random_spectrum(const vibration::RandomProfile& p, const ResponseAt& at_zeta0, const ResponseAt& at_twice,
+                                            const RandomQuadrature& q, const Eigen::Matrix3d& turn);
+// The covariances at the damping ratio zeta0 (1 + x): random_response with damped_response's
+// responses, without them (the same up to rounding).
+RandomResponse random_response_at_damping(const DampedRandomSpectrum& spectrum, double x);
+
 // An amplitude-dependent damping (plant::SqueezeFilmDamping) under random or sine-on-random
 // motion replaced by its statistical linearisation, as amplitude_linearised does for a sine:
-// the damping 2 zeta w_p plus each film's c0 (damping_factor_on_random - 1) at the angle the
-// plant so damped has (its sine amplitude at the sine's frequency, its random part's standard
-// deviation and rate's from random_response over q and turn), a fixed point found to 1e-10
-// by regula falsi (Illinois); the servo held as designed for the nominal damping. The
-// damping enters the plant's linear part as a rank-one term, so the angle at damping zeta is
-// the nominal one over 1 + (zeta - zeta0) D(f), D from the loop at zeta0 and 2 zeta0: two
-// loop responses per frequency, whatever the iterations. Without such an effect the plant is
-// returned as it is.
-plant::PlantConfig random_linearised(const plant::PlantConfig& plant, const vibration::RandomProfile& p,
-                                     const RandomQuadrature& q, const Eigen::Matrix3d& turn,
-                                     const std::optional<vibration::SineVibration>& sine);
+// the damping ratio 2 zeta w_p plus each film's c0 (damping_factor_on_random - 1) at the angle
+// the plant so damped has (its sine amplitude at the sine's frequency, its random part's
+// standard deviation and rate's), a fixed point found to 1e-10 by regula falsi (Illinois).
+// Returned: that damping ratio (the plant's own without a film).
+// at_zeta0, at_twice: the loop's responses of without_films(plant) and of the same with its
+// damping doubled; spectrum: the random part through them (damped_random_spectrum). No
+// iteration needs a loop response: the angle's spectrum at zeta0 is reweighted.
+double random_linearised_damping(const plant::PlantConfig& plant, const DampedRandomSpectrum& spectrum,
+                                 const std::optional<vibration::SineVibration>& sine, const ResponseAt& at_zeta0,
+                                 const ResponseAt& at_twice);
+// The loop's response at the damping ratio zeta0 (1 + x) from those at zeta0 and 2 zeta0 (the
+// plant otherwise the same): the damping is a rank-one term of the plant's linear part, on the
+// angle's equation, so the angle and what the loop makes of it (the current) are the ones at
+// zeta0 over 1 + x (rho - 1), rho = Theta(zeta0) / Theta(2 zeta0) (the same ratio for every
+// input axis), and the base's motion and the DC gain are unchanged.
+LoopResponse damped_response(const LoopResponse& at_zeta0, const LoopResponse& at_twice, double x);
 
 // Random only (sine == nullopt), or sine on random (the sine's loop response at its frequency).
 FrequencyPrediction random_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,

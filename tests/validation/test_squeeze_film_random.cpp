@@ -1,11 +1,12 @@
 // A squeeze film under random motion: its statistical linearisation
-// (plant::SqueezeFilmDamping::damping_factor_on_random, rectification::random_linearised).
+// (plant::SqueezeFilmDamping::damping_factor_on_random, rectification::random_linearised_damping).
 //  - The factor against sums written here: without a random part it is the describing
 //    function (damping_factor, another quadrature of the same integral), without a sine the
 //    Gaussian mean E[f(G)], and for both a 2-D midpoint sum over the phase and G.
-//  - The damping random_linearised returns is its own fixed point when the angle is computed
-//    afresh (random_response of the plant so damped, its own loop responses): this checks the
-//    rank-one shortcut it iterates on (the angle at any damping from the loop at two).
+//  - The rank-one shortcut (rectification::damped_response: the loop at any damping from the
+//    loop at two) against the loop linearised at that damping; the damping
+//    random_linearised_damping returns is its own fixed point when the angle is computed afresh
+//    (random_response of the plant so damped, its own loop responses).
 //  - The hypothesis against the ODE on random motion (label campaign): a film whose gap is
 //    twice the angle's rms under 8 g rms along IA moves the paper-like instrument's
 //    rectification by ~15 sigma of a 16 s record; the prediction through the
@@ -79,6 +80,32 @@ TEST(SqueezeFilmRandom, TheFactorIsTheDescribingFunctionWithoutNoiseAndTheGaussi
   EXPECT_EQ(film.damping_factor_on_random(0, 0, 0, 0), 1.0);
 }
 
+// The rank-one shortcut: the loop's response at another damping from those at zeta0 and
+// 2 zeta0 (damped_response) against the loop linearised at that damping, on every output and
+// axis, over the band, the servo held. Exact up to rounding: 1e-9 of the largest response
+// of each kind.
+TEST(SqueezeFilmRandom, TheDampedResponseIsTheLoopAtThatDamping) {
+  plant::PlantConfig base = test::paper_like_plant();
+  base.servo = plant::design_servo(base.dynamics);  // the electronics held (as without_films does)
+  plant::PlantConfig twice = base, other = base;
+  twice.dynamics.pendulum_damping_ratio *= 2;
+  other.dynamics.pendulum_damping_ratio *= 3.7;
+  const rectification::LoopResponder at0(base), at2(twice), at(other);
+  for (double f : {5.0, 60.0, 400.0, 1300.0, 4000.0}) {
+    const rectification::LoopResponse want = at(f), got = rectification::damped_response(at0(f), at2(f), 2.7);
+    double angle = 0, current = 0;
+    for (std::size_t i = 0; i < 3; ++i) angle = std::max(angle, std::abs(want.angle_rad[i])), current = std::max(current, std::abs(want.current[i]));
+    for (std::size_t i = 0; i < 3; ++i) {
+      EXPECT_LT(std::abs(got.angle_rad[i] - want.angle_rad[i]), 1e-9 * angle) << f << " Hz, axis " << i;
+      EXPECT_LT(std::abs(got.current[i] - want.current[i]), 1e-9 * current) << f << " Hz, axis " << i;
+      EXPECT_EQ(got.mechanical[i], want.mechanical[i]);
+    }
+    EXPECT_NEAR(got.dc_gain, want.dc_gain, 1e-8);  // (no damping at DC; each plant's is solved to ~1e-9)
+  }
+}
+
+// The damping random_linearised_damping returns is its own fixed point when the angle is
+// computed afresh: random_response of the plant so damped, its own loop (no shortcut).
 TEST(SqueezeFilmRandom, TheLinearisedDampingIsItsOwnFixedPoint) {
   plant::PlantConfig cfg = test::paper_like_plant();
   const plant::Dynamics& d = cfg.dynamics;
@@ -90,20 +117,38 @@ TEST(SqueezeFilmRandom, TheLinearisedDampingIsItsOwnFixedPoint) {
   const double sigma0 = std::sqrt(rectification::random_response(cfg, p).covariance(4, 4));
   cfg.effects.push_back(std::make_shared<plant::SqueezeFilmDamping>(2.0 * sigma0, c0, d.angle_gain_rad_per_s2_per_g));
   const auto film = std::dynamic_pointer_cast<const plant::SqueezeFilmDamping>(cfg.effects.back());
+  const plant::PlantConfig base = rectification::without_films(cfg);
+  ASSERT_TRUE(base.effects.empty());
+  plant::PlantConfig twice = base;
+  twice.dynamics.pendulum_damping_ratio *= 2;
+  const rectification::LoopResponder at0(base), at2(twice);
   vibration::SineVibration sine;
   sine.amplitude_g = {2, 0, 0}, sine.frequency_Hz = 180;
   for (const bool with_sine : {false, true}) {
     const std::optional<vibration::SineVibration> s = with_sine ? std::optional(sine) : std::nullopt;
-    const plant::PlantConfig lin = rectification::random_linearised(cfg, p, {}, Eigen::Matrix3d::Identity(), s);
-    ASSERT_TRUE(lin.effects.empty());
-    const double zeta = lin.dynamics.pendulum_damping_ratio;
+    const rectification::ResponseAt h0 = [&](double f) { return at0(f); }, h2 = [&](double f) { return at2(f); };
+    const rectification::DampedRandomSpectrum spectrum = rectification::damped_random_spectrum(p, h0, h2, {}, Eigen::Matrix3d::Identity());
+    const double zeta = rectification::random_linearised_damping(cfg, spectrum, s, h0, h2);
     EXPECT_GT(zeta, 1.2 * d.pendulum_damping_ratio);  // the film matters at this gap
-    // The angle afresh: the plant so damped, its own responses (no shortcut).
+    plant::PlantConfig lin = base;
+    lin.dynamics.pendulum_damping_ratio = zeta;
+    // The covariances afresh against the spectrum reweighted (random_response_at_damping).
     const rectification::RandomResponse rr = rectification::random_response(lin, p);
+    const rectification::RandomResponse reweighted = rectification::random_response_at_damping(spectrum, zeta / d.pendulum_damping_ratio - 1);
+    for (int a = 0; a < 5; ++a)
+      for (int b = 0; b < 5; ++b)
+        EXPECT_NEAR(reweighted.covariance(a, b), rr.covariance(a, b), 1e-9 * std::sqrt(rr.covariance(a, a) * rr.covariance(b, b))) << a << b;
+    // The angle's rate: the angle's responses times j 2 pi f, through the same quadrature.
+    const rectification::RandomResponse rate = rectification::random_response(p, [&](double f) {
+      rectification::LoopResponse h = rectification::loop_response(lin, f);
+      for (auto& a : h.angle_rad) a *= std::complex<double>(0, 2 * std::numbers::pi * f);
+      return h;
+    });
+    const double var = rr.covariance(4, 4), rate_var = rate.covariance(4, 4);
     double theta = 0;
     if (with_sine) theta = std::abs(rectification::loop_response(lin, sine.frequency_Hz).angle_rad[0]) * 2;
-    const double factor = film->damping_factor_on_random(theta, 2 * std::numbers::pi * sine.frequency_Hz * theta,
-                                                         std::sqrt(rr.covariance(4, 4)), std::sqrt(rr.angle_rate_variance_rad2_per_s2));
+    const double factor =
+        film->damping_factor_on_random(theta, 2 * std::numbers::pi * sine.frequency_Hz * theta, std::sqrt(var), std::sqrt(rate_var));
     const double want = d.pendulum_damping_ratio * factor;  // zeta0 + c0 (factor - 1) / (2 w_p), c0 = 2 zeta0 w_p
     std::printf("  %s: zeta %.6g (nominal %.6g), fixed point %.6g\n", with_sine ? "sine on random" : "random", zeta,
                 d.pendulum_damping_ratio, want);

@@ -17,10 +17,8 @@ void ResponseCache::bind(const PlantConfig& plant) {
   tables_.clear(), absorbed_.clear(), cache_.clear(), responders_.clear(), random_.clear();
 }
 
-const rectification::RandomResponse& ResponseCache::random_response(const std::string& key, const vibration::RandomProfile& p,
-                                                                    const Eigen::Matrix3d& turn,
-                                                                    const rectification::RandomQuadrature& q,
-                                                                    const rectification::ResponseAt& h) {
+std::string ResponseCache::random_key(const std::string& key, const vibration::RandomProfile& p, const Eigen::Matrix3d& turn,
+                                      const rectification::RandomQuadrature& q) {
   std::string k = key;
   k += '\0';
   const auto put = [&k](double x) { k.append(reinterpret_cast<const char*>(&x), sizeof x); };
@@ -38,9 +36,25 @@ const rectification::RandomResponse& ResponseCache::random_response(const std::s
   k.append(reinterpret_cast<const char*>(&address), sizeof address);
   for (Eigen::Index i = 0; i < 9; ++i) put(turn(i));
   put(q.max_log_step), put(q.common_grid ? 1.0 : 0.0);
+  return k;
+}
+
+const rectification::RandomResponse& ResponseCache::random_response(const std::string& key, const vibration::RandomProfile& p,
+                                                                    const Eigen::Matrix3d& turn,
+                                                                    const rectification::RandomQuadrature& q,
+                                                                    const rectification::ResponseAt& h) {
   // (h asks get() for the responses: made without the lock.)
-  return find_or_make(mutex_, random_, k, [&] { return RandomEntry{p.measured, rectification::random_response(p, h, q, turn)}; })
+  return find_or_make(mutex_, random_, random_key(key, p, turn, q),
+                      [&] { return RandomEntry{p.measured, rectification::random_response(p, h, q, turn)}; })
       .response;
+}
+
+const rectification::DampedRandomSpectrum& ResponseCache::damped_random_spectrum(
+    const std::string& key, const vibration::RandomProfile& p, const Eigen::Matrix3d& turn, const rectification::RandomQuadrature& q,
+    const rectification::ResponseAt& h, const rectification::ResponseAt& h_twice) {
+  return find_or_make(mutex_, damped_, random_key(key, p, turn, q),
+                      [&] { return DampedEntry{p.measured, rectification::damped_random_spectrum(p, h, h_twice, q, turn)}; })
+      .spectrum;
 }
 
 std::shared_ptr<const Table> ResponseCache::table(const std::string& key) {

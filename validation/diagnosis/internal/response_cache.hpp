@@ -85,6 +85,14 @@ class ResponseCache {
   const rectification::RandomResponse& random_response(const std::string& key, const vibration::RandomProfile& p,
                                                        const Eigen::Matrix3d& turn, const rectification::RandomQuadrature& q,
                                                        const rectification::ResponseAt& h);
+  // The same kept for any damping of a film (rectification::damped_random_spectrum, h and
+  // h_twice the responses of `key` without the film and with its damping doubled): every
+  // value of the film and every table take the same one per run.
+  const rectification::DampedRandomSpectrum& damped_random_spectrum(const std::string& key, const vibration::RandomProfile& p,
+                                                                    const Eigen::Matrix3d& turn,
+                                                                    const rectification::RandomQuadrature& q,
+                                                                    const rectification::ResponseAt& h,
+                                                                    const rectification::ResponseAt& h_twice);
 
  private:
   // Every field of plant::Dynamics (design_servo's only input).
@@ -104,6 +112,13 @@ class ResponseCache {
     rectification::RandomResponse response;
   };
   std::map<std::string, RandomEntry, std::less<>> random_;
+  struct DampedEntry {
+    std::shared_ptr<const vibration::CrossSpectralMatrix> measured;
+    rectification::DampedRandomSpectrum spectrum;
+  };
+  std::map<std::string, DampedEntry, std::less<>> damped_;
+  static std::string random_key(const std::string& key, const vibration::RandomProfile& p, const Eigen::Matrix3d& turn,
+                                const rectification::RandomQuadrature& q);
   std::map<std::string, std::shared_ptr<const Table>> tables_;
   plant::PlantConfig plant_;
   bool bound_ = false;

@@ -95,12 +95,31 @@ Table tabulate(const PlantConfig& nominal, const std::vector<RunRecord>& runs, c
 }
 
 namespace {
-// A squeeze film's amplitude-dependent damping replaced by its describing function (a sine or
-// periodic run) or its statistical linearisation (a random or sine-on-random run).
-PlantConfig linearised(const PlantConfig& cfg, const RunRecord& r, const TableMotion& m) {
-  if (!r.random) return rectification::amplitude_linearised(cfg, m.sine);
-  return rectification::random_linearised(cfg, run_random(r), kRandomRunQuadrature, m.random_turn,
-                                          r.sine_part ? std::optional(m.sine) : std::nullopt);
+bool has_film(const PlantConfig& cfg) {
+  return std::any_of(cfg.effects.begin(), cfg.effects.end(), [](const auto& x) { return x->amplitude_dependent_damping(); });
+}
+
+// A squeeze film on a random or sine-on-random run: its statistical linearisation's damping
+// ratio (rectification::random_linearised_damping) from the loop's responses without the film
+// at its nominal damping and twice it; the run's responses are then damped_response of those.
+struct RandomFilm {
+  PlantConfig base, twice;  // without the films; the same with the damping doubled
+  double zeta0 = 0, zeta = 0;
+};
+RandomFilm random_film(const PlantConfig& with_films, const RunRecord& r, const TableMotion& m,
+                       const rectification::DampedRandomSpectrum& spectrum, const rectification::ResponseAt& at0,
+                       const rectification::ResponseAt& at2) {
+  RandomFilm out;
+  out.zeta0 = with_films.dynamics.pendulum_damping_ratio;
+  out.zeta = rectification::random_linearised_damping(with_films, spectrum, r.sine_part ? std::optional(m.sine) : std::nullopt, at0, at2);
+  return out;
+}
+RandomFilm film_plants(const PlantConfig& with_films) {
+  RandomFilm out;
+  out.base = rectification::without_films(with_films);
+  out.twice = out.base;
+  out.twice.dynamics.pendulum_damping_ratio *= 2;
+  return out;
 }
 
 Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e,
@@ -132,7 +151,26 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     const std::string film_key = r.random ? std::string() : rectification::film_balance_key(with_films, m.sine, motion);
     const auto memo = film_key.empty() ? film_memo.end() : film_memo.find(film_key);
     if (memo != film_memo.end()) cfg = memo->second.first;
-    else cfg = linearised(cfg, r, m);
+    else if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
+    // A film on a random run: the loop without it at its damping and twice it, by keys of the
+    // effect's further values alone (the same plants at every value of the film), so every
+    // value and run shares their responses.
+    std::optional<RandomFilm> film;
+    const rectification::DampedRandomSpectrum* film_spectrum = nullptr;
+    std::string film_key0, film_key2;
+    if (r.random && has_film(with_films)) {
+      film = film_plants(with_films);
+      film_key0 = (e ? e->name : std::string()) + '\x01';
+      for (std::size_t j = 1; j < values.size(); ++j) film_key0.append(reinterpret_cast<const char*>(&values[j]), sizeof(double));
+      film_key2 = film_key0 + "twice";
+      const auto at0 = [&](double f) { return cache.get(film->base, film_key0, f); };
+      const auto at2 = [&](double f) { return cache.get(film->twice, film_key2, f); };
+      film_spectrum = &cache.damped_random_spectrum(film_key0, run_random(r), m.random_turn, kRandomRunQuadrature, at0, at2);
+      const RandomFilm z = random_film(with_films, r, m, *film_spectrum, at0, at2);
+      film->zeta0 = z.zeta0, film->zeta = z.zeta;
+      cfg = film->base;
+      cfg.dynamics.pendulum_damping_ratio = film->zeta;
+    }
     // The loop responses depend on the effect's value and, for an amplitude-dependent one,
     // on the run: the key says both.
     // (The name, a NUL and the numbers' bytes: the same numbers give the same key, as their
@@ -148,10 +186,13 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     // A squeeze film's linearised plant is this run's own (its damping is in the key): its
     // responses are kept for the run only, not in the cache (the same numbers: the plant
     // linearised once, each frequency solved once).
-    const bool own = cfg.dynamics.pendulum_damping_ratio != with_films.dynamics.pendulum_damping_ratio && cfg.servo;
+    const bool own = !film && cfg.dynamics.pendulum_damping_ratio != with_films.dynamics.pendulum_damping_ratio && cfg.servo;
     std::optional<rectification::LoopResponder> own_responder;
     std::map<double, rectification::LoopResponse> own_responses;
     const rectification::ResponseAt h = [&](double f) {
+      if (film)
+        return rectification::damped_response(cache.get(film->base, film_key0, f), cache.get(film->twice, film_key2, f),
+                                              film->zeta / film->zeta0 - 1);
       if (!own) return cache.get(cfg, key, f);
       auto it = own_responses.find(f);
       if (it == own_responses.end()) {
@@ -170,7 +211,9 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     std::optional<vibration::SineVibration> sine;
     std::optional<rectification::LoopResponse> sine_h;
     if (r.random) {
-      rr = cache.random_response(key, run_random(r), m.random_turn, kRandomRunQuadrature, h);
+      // (A film's are this run's and value's own.)
+      rr = film ? rectification::random_response_at_damping(*film_spectrum, film->zeta / film->zeta0 - 1)
+                : cache.random_response(key, run_random(r), m.random_turn, kRandomRunQuadrature, h);
       if (r.sine_part) sine = m.sine, sine_h = h(r.frequency_Hz);
     }
     // Coefficients as identified, then the effect's own change of them (if any) on top.
@@ -218,7 +261,10 @@ using internal::apply_effect;
 using internal::measured_sine;
 using internal::run_input;
 using internal::run_random;
-using internal::linearised;
+using internal::has_film;
+using internal::RandomFilm;
+using internal::film_plants;
+using internal::random_film;
 using internal::kRandomRunQuadrature;
 
 TableMotion table_motion(const RunRecord& r) {
@@ -276,10 +322,36 @@ double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effe
   TableMotion m = table_motion(r);
   apply_effect(e, values, r, cfg, m);
   const PlantConfig with_films = cfg;
-  cfg = linearised(cfg, r, m);
+  if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
+  // A film on a random run: as tabulate_runs, the responses without it at its damping and
+  // twice it (each plant linearised once).
+  std::optional<RandomFilm> film;
+  std::optional<rectification::DampedRandomSpectrum> film_spectrum;
+  std::optional<rectification::LoopResponder> at0, at2;
+  std::map<double, std::pair<rectification::LoopResponse, rectification::LoopResponse>> film_responses;
+  const auto film_at = [&](double f) -> const std::pair<rectification::LoopResponse, rectification::LoopResponse>& {
+    auto it = film_responses.find(f);
+    if (it == film_responses.end()) it = film_responses.emplace(f, std::make_pair((*at0)(f), (*at2)(f))).first;
+    return it->second;
+  };
+  if (r.random && has_film(with_films)) {
+    film = film_plants(with_films);
+    at0.emplace(film->base), at2.emplace(film->twice);
+    const rectification::ResponseAt h0 = [&](double f) { return film_at(f).first; };
+    const rectification::ResponseAt h2 = [&](double f) { return film_at(f).second; };
+    film_spectrum = rectification::damped_random_spectrum(run_random(r), h0, h2, kRandomRunQuadrature, m.random_turn);
+    const RandomFilm z = random_film(with_films, r, m, *film_spectrum, h0, h2);
+    film->zeta0 = z.zeta0, film->zeta = z.zeta;
+    cfg = film->base;
+    cfg.dynamics.pendulum_damping_ratio = film->zeta;
+  }
   std::map<double, rectification::LoopResponse> responses;
   std::optional<PlantConfig> loop_cfg;  // cfg with its servo designed once (ResponseCache)
   const rectification::ResponseAt h = [&](double f) {
+    if (film) {
+      const auto& [r0, r2] = film_at(f);
+      return rectification::damped_response(r0, r2, film->zeta / film->zeta0 - 1);
+    }
     auto it = responses.find(f);
     if (it == responses.end()) {
       if (!loop_cfg) {
@@ -291,7 +363,9 @@ double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effe
     return it->second;
   };
   if (r.random) {
-    const rectification::RandomResponse rr = rectification::random_response(run_random(r), h, kRandomRunQuadrature, m.random_turn);
+    const rectification::RandomResponse rr =
+        film ? rectification::random_response_at_damping(*film_spectrum, film->zeta / film->zeta0 - 1)
+             : rectification::random_response(run_random(r), h, kRandomRunQuadrature, m.random_turn);
     std::optional<vibration::SineVibration> sine;
     std::optional<rectification::LoopResponse> sine_h;
     if (r.sine_part) sine = m.sine, sine_h = h(r.frequency_Hz);
