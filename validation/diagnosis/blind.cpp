@@ -395,13 +395,16 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
   ++r.confusion[k.category == "single"           ? k.hidden[0].name
                 : k.category == "out_of_library" ? k.hidden[0].name + " (out of library)"
                                                  : k.category][called];
-  if (k.category == "single" && k.error.empty() && k.effect_gap_sigma < 5) {
-    ++s.small;  // below the "gap >= 5 sigma": reported, not scored
-    s.small_right += called == k.hidden[0].name;
-    r.wrong.push_back(fmt::format("campaign {} (seed {}): {} = {:.4g} hidden, its gap {:.1f} sigma as the nominal model sees "
+  const bool ool = k.category == "out_of_library";
+  if ((k.category == "single" || ool) && k.error.empty() && k.effect_gap_sigma < 5) {
+    // Below the "gap >= 5 sigma" (out of library: no gap to call unexplained in this
+    // design): reported, not scored.
+    if (ool) ++s.out_of_library_small;
+    else ++s.small, s.small_right += called == k.hidden[0].name;
+    r.wrong.push_back(fmt::format("campaign {} (seed {}): {} = {:.4g} hidden{}, its gap {:.1f} sigma as the nominal model sees "
                                   "it (largest run {:.1f} sigma; not scored); called {}",
-                                  k.index, k.seed, k.hidden[0].name, k.hidden[0].parameter, k.effect_gap_sigma,
-                                  k.effect_max_sigma, called));
+                                  k.index, k.seed, k.hidden[0].name, k.hidden[0].parameter, ool ? " out of library" : "",
+                                  k.effect_gap_sigma, k.effect_max_sigma, called));
   } else if (k.category == "single") {
     ++s.single;
     // Right: the gap found and attributed to the hidden effect (the verdict "explained by"
@@ -419,13 +422,7 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
     const bool nuisance_flagged = std::any_of(d.nuisances.begin(), d.nuisances.end(), [](const Nuisance& x) { return x.significant; });
     s.false_alarms += called != "clean" || nuisance_flagged;
 
-  } else if (k.category == "out_of_library" && k.error.empty() && k.effect_gap_sigma < 5) {
-    ++s.out_of_library_small;  // its gap below 5 sigma in this design: reported, not scored
-    r.wrong.push_back(fmt::format("campaign {} (seed {}): {} = {:.4g} hidden out of library, its gap {:.1f} sigma as the "
-                                  "nominal model sees it (largest run {:.1f} sigma; not scored); called {}",
-                                  k.index, k.seed, k.hidden[0].name, k.hidden[0].parameter, k.effect_gap_sigma,
-                                  k.effect_max_sigma, called));
-  } else if (k.category == "out_of_library") {
+  } else if (ool) {
     ++s.out_of_library;
     s.out_of_library_unexplained += called == "unexplained";
 

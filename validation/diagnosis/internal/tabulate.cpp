@@ -104,22 +104,19 @@ bool has_film(const PlantConfig& cfg) {
 // at its nominal damping and twice it; the run's responses are then damped_response of those.
 struct RandomFilm {
   PlantConfig base, twice;  // without the films; the same with the damping doubled
-  double zeta0 = 0, zeta = 0;
+  double zeta = 0;          // the linearised damping ratio
+  double x() const { return zeta / base.dynamics.pendulum_damping_ratio - 1; }  // (damped_response's)
 };
-RandomFilm random_film(const PlantConfig& with_films, const RunRecord& r, const TableMotion& m,
-                       const rectification::DampedRandomSpectrum& spectrum, const rectification::ResponseAt& at0,
-                       const rectification::ResponseAt& at2) {
-  RandomFilm out;
-  out.zeta0 = with_films.dynamics.pendulum_damping_ratio;
-  out.zeta = rectification::random_linearised_damping(with_films, spectrum, r.sine_part ? std::optional(m.sine) : std::nullopt, at0, at2);
-  return out;
-}
+// The plants a film's linearisation reads (its damping ratio zeta set by the caller).
 RandomFilm film_plants(const PlantConfig& with_films) {
   RandomFilm out;
   out.base = rectification::without_films(with_films);
   out.twice = out.base;
   out.twice.dynamics.pendulum_damping_ratio *= 2;
   return out;
+}
+std::optional<vibration::SineVibration> sine_part(const RunRecord& r, const TableMotion& m) {
+  return r.sine_part ? std::optional(m.sine) : std::nullopt;
 }
 
 Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& runs, const Effect* e,
@@ -166,8 +163,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       const auto at0 = [&](double f) { return cache.get(film->base, film_key0, f); };
       const auto at2 = [&](double f) { return cache.get(film->twice, film_key2, f); };
       film_spectrum = &cache.damped_random_spectrum(film_key0, run_random(r), m.random_turn, kRandomRunQuadrature, at0, at2);
-      const RandomFilm z = random_film(with_films, r, m, *film_spectrum, at0, at2);
-      film->zeta0 = z.zeta0, film->zeta = z.zeta;
+      film->zeta = rectification::random_linearised_damping(with_films, *film_spectrum, sine_part(r, m), at0, at2);
       cfg = film->base;
       cfg.dynamics.pendulum_damping_ratio = film->zeta;
     }
@@ -192,7 +188,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     const rectification::ResponseAt h = [&](double f) {
       if (film)
         return rectification::damped_response(cache.get(film->base, film_key0, f), cache.get(film->twice, film_key2, f),
-                                              film->zeta / film->zeta0 - 1);
+                                              film->x());
       if (!own) return cache.get(cfg, key, f);
       auto it = own_responses.find(f);
       if (it == own_responses.end()) {
@@ -212,7 +208,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     std::optional<rectification::LoopResponse> sine_h;
     if (r.random) {
       // (A film's are this run's and value's own.)
-      rr = film ? rectification::random_response_at_damping(*film_spectrum, film->zeta / film->zeta0 - 1)
+      rr = film ? rectification::random_response_at_damping(*film_spectrum, film->x())
                 : cache.random_response(key, run_random(r), m.random_turn, kRandomRunQuadrature, h);
       if (r.sine_part) sine = m.sine, sine_h = h(r.frequency_Hz);
     }
@@ -264,7 +260,7 @@ using internal::run_random;
 using internal::has_film;
 using internal::RandomFilm;
 using internal::film_plants;
-using internal::random_film;
+using internal::sine_part;
 using internal::kRandomRunQuadrature;
 
 TableMotion table_motion(const RunRecord& r) {
@@ -340,8 +336,7 @@ double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effe
     const rectification::ResponseAt h0 = [&](double f) { return film_at(f).first; };
     const rectification::ResponseAt h2 = [&](double f) { return film_at(f).second; };
     film_spectrum = rectification::damped_random_spectrum(run_random(r), h0, h2, kRandomRunQuadrature, m.random_turn);
-    const RandomFilm z = random_film(with_films, r, m, *film_spectrum, h0, h2);
-    film->zeta0 = z.zeta0, film->zeta = z.zeta;
+    film->zeta = rectification::random_linearised_damping(with_films, *film_spectrum, sine_part(r, m), h0, h2);
     cfg = film->base;
     cfg.dynamics.pendulum_damping_ratio = film->zeta;
   }
@@ -350,7 +345,7 @@ double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effe
   const rectification::ResponseAt h = [&](double f) {
     if (film) {
       const auto& [r0, r2] = film_at(f);
-      return rectification::damped_response(r0, r2, film->zeta / film->zeta0 - 1);
+      return rectification::damped_response(r0, r2, film->x());
     }
     auto it = responses.find(f);
     if (it == responses.end()) {
@@ -364,7 +359,7 @@ double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effe
   };
   if (r.random) {
     const rectification::RandomResponse rr =
-        film ? rectification::random_response_at_damping(*film_spectrum, film->zeta / film->zeta0 - 1)
+        film ? rectification::random_response_at_damping(*film_spectrum, film->x())
              : rectification::random_response(run_random(r), h, kRandomRunQuadrature, m.random_turn);
     std::optional<vibration::SineVibration> sine;
     std::optional<rectification::LoopResponse> sine_h;
