@@ -58,6 +58,12 @@ double SumExcitation::max_frequency_Hz() const {
   return f;
 }
 
+Vec3 SumExcitation::mean_g() const {
+  Vec3 m = Vec3::Zero();
+  for (const auto& p : parts_) m += p->mean_g();
+  return m;
+}
+
 std::string SumExcitation::describe() const {
   std::string s;
   for (const auto& p : parts_) s += (s.empty() ? "" : " + ") + p->describe();
@@ -226,6 +232,14 @@ Vec3 Rocking::acceleration_g(double t) const {
     a += (alpha_ddot * e.cross(r) - alpha_dot * alpha_dot * r_perp) / spec_.g_m_per_s2;
   }
   return a;
+}
+
+Vec3 Rocking::mean_g() const {
+  constexpr int kPoints = 256;
+  const double period_s = 1 / carrier_->carrier(0.0).frequency_Hz;
+  Vec3 m = Vec3::Zero();
+  for (int k = 0; k < kPoints; ++k) m += acceleration_g(period_s * k / kPoints) / kPoints;
+  return m;
 }
 
 double Rocking::max_frequency_Hz() const {

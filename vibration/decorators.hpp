@@ -48,6 +48,7 @@ class SumExcitation final : public Excitation {
   Vec3 acceleration_g(double t_s) const override;
   double max_frequency_Hz() const override;
   std::string describe() const override;
+  Vec3 mean_g() const override;  // the parts' sum
 
  private:
   std::vector<std::shared_ptr<const Excitation>> parts_;
@@ -121,6 +122,10 @@ class Rocking final : public Excitation {
   Vec3 acceleration_g(double t_s) const override;
   double max_frequency_Hz() const override;
   std::string describe() const override;
+  // Over one period of the carrier at its frequency at t = 0 (a steady tone's mean), 256
+  // points: exact for content below the 128th harmonic (the rotation's series in alpha0, a
+  // few 1e-5 rad, has none that matters there).
+  Vec3 mean_g() const override;
   double angle_rad(double t_s) const;
 
  private:

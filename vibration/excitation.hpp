@@ -27,6 +27,11 @@ class Excitation {
   // sample by sample (rectification/simulation/discretised.hpp); nullptr when it is not one
   // (a sum holding one is not: its other parts are not sampled).
   virtual const RandomExcitation* random_samples() const { return nullptr; }
+  // The motion's deterministic mean, g: zero for a tone, its harmonics and a random part (a
+  // record's sample mean is random, not the motion's); a rocking fixture's turned gravity and
+  // centripetal acceleration are not zero-mean (rectification::shake_excitation gives its
+  // linear output back).
+  virtual Vec3 mean_g() const { return Vec3::Zero(); }
 };
 
 // A tone: A_i sin(theta(t) + phase_i) on axis i, one carrier phase theta(t) for all axes

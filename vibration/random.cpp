@@ -158,6 +158,15 @@ void validate(const RandomProfile& p) {
   if (!any) throw std::invalid_argument("psd: no axis has a PSD table");
 }
 
+void scale_levels(RandomProfile& p, double factor) {
+  if (!(factor > 0) || !std::isfinite(factor)) throw std::invalid_argument("scale_levels: factor must be positive");
+  if (p.measured) throw std::invalid_argument("scale_levels: a measured cross-spectral matrix is not scaled");
+  for (auto& t : p.psd)
+    if (t)
+      for (auto& row : t->rows)
+        if (row.psd_g2_per_Hz) *row.psd_g2_per_Hz *= factor;
+}
+
 double max_frequency_Hz(const RandomProfile& p) {
   validate(p);
   double f = 0;

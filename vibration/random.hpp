@@ -87,6 +87,9 @@ struct RandomProfile {
 // Throws std::invalid_argument if no axis has a table, or a table is invalid (the message
 // names the axis, then the table's field and row).
 void validate(const RandomProfile& p);
+// Every table's levels times factor (> 0; slopes in dB/octave unchanged): the rms times
+// sqrt(factor). A measured matrix is refused (std::invalid_argument): it is a record, not a demand.
+void scale_levels(RandomProfile& p, double factor);
 // Highest table frequency over the axes, Hz.
 double max_frequency_Hz(const RandomProfile& p);
 std::string describe(const RandomProfile& p);

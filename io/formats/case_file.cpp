@@ -315,11 +315,7 @@ void read_random_runs(Table& t, validation::CampaignDesign& d) {
       double now2 = 0;
       for (const auto& p : r.profile.psd)
         if (p) now2 += std::pow(vibration::rms_g(*p), 2);
-      const double scale = *rms * *rms / now2;
-      for (auto& p : r.profile.psd)
-        if (p)
-          for (auto& row : p->rows)
-            if (row.psd_g2_per_Hz) *row.psd_g2_per_Hz *= scale;
+      vibration::scale_levels(r.profile, *rms * *rms / now2);
     }
     const int sine_keys = rt.has("sine_frequency_Hz") + rt.has("sine_amplitude_g") + rt.has("sine_direction");
     if (sine_keys != 0 && sine_keys != 3)

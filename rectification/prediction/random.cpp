@@ -405,13 +405,171 @@ double random_linearised_damping(const PlantConfig& config, const DampedRandomSp
   throw std::runtime_error("random_linearised_damping: the squeeze film's equivalent damping did not converge");
 }
 
+namespace {
+
+using R = RandomResponse;
+
+// What the terms of (1) see of the random part: the felt motion's covariance, and the same
+// with IA the current (the loop-placed terms).
+struct GaussianParts {
+  vibration::RandomVibration felt, through_loop;
+};
+GaussianParts gaussian_parts(const RandomResponse& rr) {
+  const auto& c5 = rr.covariance;
+  const Eigen::Matrix3d felt_cov = c5.topLeftCorner<3, 3>();
+  Eigen::Matrix3d loop_cov = felt_cov;
+  loop_cov(IA, IA) = c5(R::kCurrent, R::kCurrent);
+  for (int j : {PA, OA}) loop_cov(IA, j) = loop_cov(j, IA) = c5(R::kCurrent, j);
+  return {gaussian_of(felt_cov), gaussian_of(loop_cov)};
+}
+
+// The output's oscillation U = I + slope . F: the slope of the output-placed cross terms.
+Vec3 readout_slope(const PlantConfig& config, const Vec3& a) {
+  Coefficients cross_out;
+  cross_out[K1] = 1;
+  for (int c = delta_OA; c < kNumCoefficients; ++c)
+    if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
+  return plant::output_gradient(cross_out, a) - Vec3::UnitX();
+}
+double readout_sigma(const RandomResponse& rr, const Vec3& slope) {
+  Eigen::Matrix<double, 5, 1> u_row = Eigen::Matrix<double, 5, 1>::Zero();
+  u_row[R::kCurrent] = 1;
+  for (int i = 0; i < 3; ++i) u_row[i] = slope[i];
+  return std::sqrt(std::max(0.0, u_row.dot(rr.covariance * u_row)));
+}
+
+// Each coefficient of (1) that rectifies (not k0 or the misalignments; not zero) alone beside
+// K1 = 1, and whether it sees the loop's current on IA (in the loop or at the output: k2..k4
+// not at the input).
+template <class Visit>
+void for_each_rectifying_term(const PlantConfig& config, Visit&& visit) {
+  for (int c = k0; c < kNumCoefficients; ++c) {
+    if (c == k0 || c == delta_OA || c == delta_PA || config.coefficients[c] == 0) continue;
+    Coefficients only;
+    only[K1] = 1;
+    only[c] = config.coefficients[c];
+    visit(c, only, c <= k4 && config.location[c] != Location::input);
+  }
+}
+
+// A periodic part with harmonics, a mean or tones inside the loop, on random. With s(t) the
+// periodic part at a term's place and G the random part's, independent of it, each term is
+//   <E_G f(a + s(t) + G)> - f(a) = <[E_G f(a + s + G) - f(a + s)] + [f(a + s) - f(a)]>,
+// the Gaussian expectation (eq3.hpp random_rectification) at the point s(t) moves the static
+// orientation to plus the term there, averaged over the period on periodic_rectification's
+// points: the sum is smooth in s (the Gaussian smooths k1's |a_IA|), so the average converges
+// spectrally, and is exact for the polynomial terms. The rest (the input's mean, the angle's
+// moments of the periodic part) as periodic_rectification has it; the random part's angle
+// moments add; a readout polynomial is averaged jointly (the period's points, Gauss-Hermite
+// in U).
+FrequencyPrediction periodic_on_random(const PlantConfig& config, const Vec3& a, const RandomResponse& rr, const PeriodicInput& in,
+                                       const ResponseAt& response) {
+  FrequencyPrediction out = periodic_rectification(config, a, in, response);
+  out.terms = {};
+  struct Tone {
+    int h;
+    Eigen::Vector3cd F;
+    std::complex<double> I;
+  };
+  std::vector<Tone> tones;
+  int h_max = 1;
+  for (const auto& [h, W] : in.tones) {
+    const LoopResponse r = response(h * in.frequency_Hz);
+    Tone t{h, Eigen::Vector3cd::Zero(), 0.0};
+    for (int j = 0; j < 3; ++j) {
+      const auto sj = static_cast<std::size_t>(j);
+      t.F[j] = r.mechanical[sj] * W[j];
+      t.I += r.current[sj] * W[j];
+    }
+    tones.push_back(t);
+    h_max = std::max(h_max, h);
+  }
+  for (const PeriodicInput::LoopTone& l : in.loop) tones.push_back({l.h, Eigen::Vector3cd::Zero(), l.current_g}), h_max = std::max(h_max, l.h);
+  const int points = std::max(64, 6 * h_max + 1);
+  const Vec3 a_mean = a + in.mean_g;
+  std::vector<Vec3> felt_at(static_cast<std::size_t>(points)), loop_at(felt_at.size());
+  std::vector<double> current_at(felt_at.size());
+  for (int k = 0; k < points; ++k) {
+    const double phi = 2 * std::numbers::pi * k / points;
+    Vec3 felt = a_mean;
+    double current = 0;
+    for (const Tone& t : tones) {
+      const std::complex<double> e = std::polar(1.0, t.h * phi);
+      for (int i = 0; i < 3; ++i) felt[i] += std::imag(t.F[i] * e);
+      current += std::imag(t.I * e);
+    }
+    const auto sk = static_cast<std::size_t>(k);
+    felt_at[sk] = loop_at[sk] = felt;
+    loop_at[sk][IA] = a_mean[IA] + current;
+    current_at[sk] = current;
+  }
+  const GaussianParts g = gaussian_parts(rr);
+  const double dc_gain = out.loop_dc_gain;
+  const plant::Basis b0 = plant::basis(a);
+  for_each_rectifying_term(config, [&](int c, const Coefficients& only, bool filtered) {
+    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
+    const int term = term_of_coefficient(c);
+    for (std::size_t k = 0; k < felt_at.size(); ++k) {
+      const Vec3& x = filtered ? loop_at[k] : felt_at[k];
+      Eq3Terms t = random_rectification(only, x, filtered ? g.through_loop : g.felt);
+      t.g[term] += config.coefficients[c] * (plant::basis(x)[c] - b0[c]);
+      for (int j = 0; j < kNumTerms; ++j) out.terms.g[j] += gain * t.g[j] / points;
+    }
+  });
+  double p2 = 0.0;
+  bool geometry = false, readout = false;
+  for (const auto& e : config.effects) {
+    p2 += e->pickoff_p2_per_rad();
+    geometry = geometry || e->vibropendulous();
+    readout = readout || e->readout_averaged_in_prediction();
+  }
+  const auto& c5 = rr.covariance;
+  const Dynamics& d = config.dynamics;
+  const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+  out.pickoff_g += wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * c5(R::kAngle, R::kAngle);
+  if (geometry) out.pendulum_geometry_g += dc_gain * (-c5(R::kF_PA, R::kAngle) - a_mean[IA] * c5(R::kAngle, R::kAngle) / 2);
+  if (readout) {  // as PreparedPeriodicRectification's, with U's Gaussian part at every point
+    const Vec3 slope = readout_slope(config, a);
+    const double sigma_u = readout_sigma(rr, slope);
+    const double u0 = plant::output_g(config.coefficients, a);
+    const double u_mean = u0 + in.mean_g[IA] + slope.dot(in.mean_g);
+    const HermiteRule& gh = hermite_rule();
+    out.readout_g = 0;
+    for (std::size_t k = 0; k < felt_at.size(); ++k) {
+      const double u = u_mean + current_at[k] + slope.dot(felt_at[k] - a_mean);
+      for (const auto& e : config.effects) {
+        if (!e->readout_averaged_in_prediction()) continue;
+        for (std::size_t n = 0; n < gh.x.size(); ++n) {
+          const double un = u + sigma_u * gh.x[n];
+          out.readout_g += gh.w[n] * (e->readout(un) - un) / points;
+        }
+      }
+    }
+    for (const auto& e : config.effects)
+      if (e->readout_averaged_in_prediction()) out.readout_g -= e->readout(u0) - u0;
+  }
+  return out;
+}
+
+}  // namespace
+
 FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const RandomResponse& rr,
-                                                      const std::optional<vibration::SineVibration>& sine,
-                                                      const std::optional<LoopResponse>& sine_response,
+                                                      const std::optional<PeriodicInput>& periodic, const ResponseAt& response,
                                                       std::optional<double> range_g) {
-  if (sine && !sine_response) throw std::invalid_argument("random_rectification_at_frequency: a sine needs its loop response");
-  if (sine && std::abs(sine_response->frequency_Hz - sine->frequency_Hz) > 1e-9 * sine->frequency_Hz)
-    throw std::invalid_argument("random_rectification_at_frequency: the loop response is for another frequency");
+  if (periodic && !response) throw std::invalid_argument("random_rectification_at_frequency: a periodic part needs the loop's response");
+  if (periodic && !(periodic->frequency_Hz > 0))
+    throw std::invalid_argument("random_rectification_at_frequency: the periodic part's frequency_Hz must be positive");
+  if (periodic && !periodic->single_tone()) return periodic_on_random(config, a, rr, *periodic, response);
+  // Random alone, or a single tone on it (the sine's terms in closed form, eq3.hpp).
+  std::optional<vibration::SineVibration> sine;
+  std::optional<LoopResponse> sine_response;
+  if (periodic) {
+    vibration::SineVibration v;
+    v.frequency_Hz = periodic->frequency_Hz;
+    const Eigen::Vector3cd& w = periodic->tones.front().second;
+    for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(w[i]), v.phase_rad[i] = std::arg(w[i]);
+    sine = v, sine_response = response(v.frequency_Hz);
+  }
   double p2 = 0.0;
   bool geometry = false;
   for (const auto& e : config.effects) {
@@ -419,13 +577,7 @@ FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config,
     geometry = geometry || e->vibropendulous();
   }
   const auto& c5 = rr.covariance;
-  using R = RandomResponse;
-  // What the terms see: the felt motion's covariance, and the same with IA the current.
-  const Eigen::Matrix3d felt_cov = c5.topLeftCorner<3, 3>();
-  Eigen::Matrix3d loop_cov = felt_cov;
-  loop_cov(IA, IA) = c5(R::kCurrent, R::kCurrent);
-  for (int j : {PA, OA}) loop_cov(IA, j) = loop_cov(j, IA) = c5(R::kCurrent, j);
-  const vibration::RandomVibration felt = gaussian_of(felt_cov), through_loop = gaussian_of(loop_cov);
+  const auto [felt, through_loop] = gaussian_parts(rr);
 
   // The sine, as in sine_rectification_at_frequency.
   vibration::SineVibration sine_felt, sine_loop;
@@ -452,18 +604,13 @@ FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config,
   out.loop_dc_gain = dc_gain;
   out.current_amplitude_g = Is;
   out.angle_amplitude_rad = Ths;
-  for (int c = k0; c < kNumCoefficients; ++c) {
-    if (c == k0 || c == delta_OA || c == delta_PA || config.coefficients[c] == 0) continue;
-    Coefficients only;
-    only[K1] = 1;
-    only[c] = config.coefficients[c];
-    const bool filtered = c <= k4 && config.location[c] != Location::input;
+  for_each_rectifying_term(config, [&](int c, const Coefficients& only, bool filtered) {
     const Eq3Terms t = sine ? sine_on_random_rectification(only, a, filtered ? sine_loop : sine_felt,
                                                            filtered ? through_loop : felt)
                             : random_rectification(only, a, filtered ? through_loop : felt);
     const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
     for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
-  }
+  });
   if (range_g) {
     Coefficients unit;
     unit[K1] = 1;
@@ -483,15 +630,8 @@ FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config,
   bool readout = false;
   for (const auto& e : config.effects) readout = readout || e->readout_averaged_in_prediction();
   if (readout) {
-    Coefficients cross_out;
-    cross_out[K1] = 1;
-    for (int c = delta_OA; c < kNumCoefficients; ++c)
-      if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
-    const Vec3 slope = plant::output_gradient(cross_out, a) - Vec3::UnitX();
-    Eigen::Matrix<double, 5, 1> u_row = Eigen::Matrix<double, 5, 1>::Zero();  // U = I + slope . F
-    u_row[R::kCurrent] = 1;
-    for (int i = 0; i < 3; ++i) u_row[i] = slope[i];
-    const double sigma_u = std::sqrt(std::max(0.0, u_row.dot(c5 * u_row)));
+    const Vec3 slope = readout_slope(config, a);
+    const double sigma_u = readout_sigma(rr, slope);
     const std::complex<double> Us = Is + slope[IA] * Fs[IA] + slope[PA] * Fs[PA] + slope[OA] * Fs[OA];
     const double u0 = plant::output_g(config.coefficients, a);
     const HermiteRule& gh = hermite_rule();
@@ -511,7 +651,7 @@ FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config,
 
 FrequencyPrediction random_rectification_at_frequency(const PlantConfig& plant, const Vec3& a, const vibration::RandomProfile& p,
                                                       std::optional<double> range_g) {
-  return random_rectification_at_frequency(plant, a, random_response(plant, p), std::nullopt, std::nullopt, range_g);
+  return random_rectification_at_frequency(plant, a, random_response(plant, p), std::nullopt, nullptr, range_g);
 }
 
 FrequencyPrediction sine_on_random_rectification_at_frequency(const PlantConfig& plant, const Vec3& a,
@@ -519,8 +659,9 @@ FrequencyPrediction sine_on_random_rectification_at_frequency(const PlantConfig&
                                                               const vibration::RandomProfile& p, std::optional<double> range_g) {
   vibration::validate(sine);
   if (!(sine.frequency_Hz > 0)) throw std::invalid_argument("sine_on_random: the sine's frequency_Hz must be positive");
-  return random_rectification_at_frequency(plant, a, random_response(plant, p), sine, loop_response(plant, sine.frequency_Hz),
-                                           range_g);
+  const LoopResponse at_sine = loop_response(plant, sine.frequency_Hz);
+  return random_rectification_at_frequency(plant, a, random_response(plant, p), periodic_input(sine),
+                                           [&at_sine](double) { return at_sine; }, range_g);
 }
 
 }  // namespace vrelab::rectification

@@ -28,7 +28,8 @@
 // 24-point Gauss-Hermite (exact for degree < 48), U = I + the output cross terms' slope . F.
 // Sine on random (independent): each term's joint expectation, the random one averaged over
 // the sine's phase (eq3.hpp sine_on_random_rectification) with the sine through the loop at
-// its frequency; the angle's second moments add.
+// its frequency; the angle's second moments add. A sine with harmonics (a shaker's
+// distortion, a rocking fixture) likewise over its period, each harmonic at its frequency.
 // A squeeze film's amplitude-dependent damping: by statistical linearisation
 // (random_linearised_damping below), the film's harmonics and the angle's departure from a Gaussian
 // left out. Not modelled: clipping beyond the current's Gaussian (range limit of I).
@@ -115,11 +116,16 @@ double random_linearised_damping(const plant::PlantConfig& plant, const DampedRa
 // input axis), and the base's motion and the DC gain are unchanged.
 LoopResponse damped_response(const LoopResponse& at_zeta0, const LoopResponse& at_twice, double x);
 
-// Random only (sine == nullopt), or sine on random (the sine's loop response at its frequency).
+// Random only (no periodic part), or a periodic part on random: a sine (periodic_input(sine))
+// or a distorted or rocking table's tone with its harmonics and mean (periodic_input of the
+// excitation, measured tones), each tone through `response` at its own frequency. A single
+// tone takes eq3.hpp's sine_on_random_rectification (the sine's terms in closed form); several
+// take periodic_rectification's period for the periodic part alone plus each term's Gaussian
+// expectation averaged over that period. Clipping (range_limit_g): a single tone only.
 FrequencyPrediction random_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
                                                       const RandomResponse& random,
-                                                      const std::optional<vibration::SineVibration>& sine = std::nullopt,
-                                                      const std::optional<LoopResponse>& sine_response = std::nullopt,
+                                                      const std::optional<PeriodicInput>& periodic = std::nullopt,
+                                                      const ResponseAt& response = nullptr,
                                                       std::optional<double> range_limit_g = std::nullopt);
 
 // Convenience: the loop responses computed here.

@@ -60,6 +60,19 @@ class WithLinearCompanion final : public plant::OdeSystem {
   int n_;
 };
 
+// The companion's linear output per g of a constant input (its DC gain, a row over the input's
+// axes): the steady state of the linearisation without the quadrature state, which feeds
+// nothing back (its column of A is zero), and without the states the plant does not use
+// (their rows and columns zero: an anti-aliasing filter left off), read through the
+// quadrature's row.
+Vec3 companion_dc_gain(const Accelerometer::Linear& lin) {
+  std::vector<int> rest;
+  for (int i = 0; i < static_cast<int>(lin.A.rows()); ++i)
+    if (i != Accelerometer::kQuadrature && !(lin.A.row(i).isZero(0.0) && lin.A.col(i).isZero(0.0))) rest.push_back(i);
+  const Eigen::MatrixXd steady = -lin.A(rest, rest).partialPivLu().solve(lin.B(rest, Eigen::all));
+  return (lin.A(Accelerometer::kQuadrature, rest) * steady + lin.B.row(Accelerometer::kQuadrature)).transpose();
+}
+
 // Standard uncertainty of the mean of equal blocks: std(block means) / sqrt(blocks).
 double batch_sigma(const std::vector<double>& means, double mean) {
   double ss = 0;
@@ -640,6 +653,7 @@ ShakeResult shake_excitation(const plant::PlantConfig& config, const Vec3& a_sta
     }
   }
   r.path = "CVODE: " + cvode_reason;
+  const double mean_part_g = companion_dc_gain(lin).dot(input.mean_g());
   const WithLinearCompanion system(shaken, std::move(lin), table);
   // Size of the motion (for the absolute tolerances): rms over the first 2000 points of 0.1 s.
   double ms = 0;
@@ -692,6 +706,9 @@ ShakeResult shake_excitation(const plant::PlantConfig& config, const Vec3& a_sta
     }
     rec.finish(r);
   }
+  // The companion took off the linear output of the input's deterministic mean too (a rocking
+  // fixture's): that part is the instrument's reading of a real mean, given back.
+  r.measured_g += mean_part_g, r.integral_slope_g += mean_part_g;
   r.periods = 0;
   r.simulated_s = r.settle_s + measure_s;
   r.steps = ode.steps();

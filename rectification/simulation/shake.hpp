@@ -153,7 +153,9 @@ ShakeResult shake_sine(const plant::PlantConfig& plant, const Vec3& a_static_g, 
 // plant's own linearisation runs beside it on the same input, and the error is the mean of
 // the output minus that linear output: a finite record of random motion has a non-zero
 // mean and the loop delays it across the window edges, and neither is rectification (a
-// lab does the same, less exactly, with its reference accelerometer and long records).
+// lab does the same, less exactly, with its reference accelerometer and long records). The
+// motion's deterministic mean (Excitation::mean_g: a rocking fixture's) is real, not the
+// record's: its linear output (the linearisation's DC gain) is given back.
 ShakeResult shake_excitation(const plant::PlantConfig& plant, const Vec3& a_static_g,
                              const vibration::Excitation& input, double measure_s, const ShakeSettings& s = {},
                              const SampleSink& sink = {});

@@ -157,6 +157,10 @@ TEST(Rocking, RotatedGravityAndBesselRectification) {
   }
   EXPECT_NEAR(period_mean(r, f, IA), std::cyl_bessel_j(0.0, a0) - 1, 1e-13);
   EXPECT_NEAR(period_mean(r, f, PA), -A * std::cyl_bessel_j(1.0, a0) * std::cos(0.3), 1e-13);
+  EXPECT_NEAR(r.mean_g()[IA], std::cyl_bessel_j(0.0, a0) - 1, 1e-13);  // the same means, as the decorator states them
+  EXPECT_NEAR(r.mean_g()[PA], -A * std::cyl_bessel_j(1.0, a0) * std::cos(0.3), 1e-13);
+  EXPECT_EQ(SumExcitation({tone, std::make_shared<Rocking>(tone, spec)}).mean_g(), r.mean_g());
+  EXPECT_EQ(tone->mean_g(), Vec3::Zero());
   // Only gravity rotated: IA = a_IA + cos a - 1, PA = -sin a (no cross-axis term from a_IA).
   spec.rotate_shaker_motion = false;
   const Rocking g_only(tone, spec);

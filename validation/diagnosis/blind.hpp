@@ -207,7 +207,10 @@ BlindCampaign blind_key(int index, std::uint64_t seed, bool mixed = false);
 // default's frequencies x 1, 2, 4 g x IA and PA x a_IA = +-0.71 g), 5-8 random runs (GEVS,
 // NAVMAT or flat 20 Hz - 2 kHz shapes at 2-12 g rms log-uniform; along IA, PA or OA, or IA
 // with PA or OA, common or independent; either orientation) and 1-2 sine-on-random runs (a
-// 1-3 g sine at 40-400 Hz along IA or PA on 2-6 g rms), each random record 8 s.
+// 1-3 g sine at 40-400 Hz along IA or PA on 2-6 g rms), each random record 8 s; a random run
+// whose output would pass kBlindOutputRange_g at 3 sigma on the campaign's truth backed off to
+// it (within_output_range: a hidden mode can amplify the table's motion threefold).
+inline constexpr double kBlindOutputRange_g = 50;
 CampaignDesign blind_design(const BlindCampaign& k);
 
 // A natural form's scoring: the diagnosis' top effect is the hidden one and each of its

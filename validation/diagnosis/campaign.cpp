@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "core/parallel.hpp"
+#include "rectification/prediction/random.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "vibration/decorators.hpp"
 #include "vibration/excitation.hpp"
@@ -122,6 +123,31 @@ rectification::ShakeResult shake_random_run(const plant::PlantConfig& truth, con
 }
 
 }  // namespace
+
+CampaignDesign within_output_range(CampaignDesign design, const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
+                                   double range_g) {
+  if (!(range_g > 0)) throw std::invalid_argument("within_output_range: range_g must be positive");
+  for (RandomRunDesign& rd : design.random_runs) {
+    RunRecord r;
+    r.random = rd.profile, r.sine_part = rd.sine_part, r.orientation_g = rd.orientation_g;
+    r.frequency_Hz = rd.frequency_Hz, r.amplitude_g = rd.amplitude_g, r.direction = rd.direction.normalized();
+    const VirtualLab lab = truth_lab(truth, hidden, rd.sine_part ? &r : nullptr);
+    plant::PlantConfig p = lab.run_plant();
+    if (!p.servo) p.servo = plant::design_servo(p.dynamics);
+    const rectification::LoopResponder loop(p);
+    const rectification::RandomResponse rr = rectification::random_response(rd.profile, loop, {}, lab.random_turn);
+    const double sigma_g = std::sqrt(rr.covariance(rectification::RandomResponse::kCurrent, rectification::RandomResponse::kCurrent));
+    double sine_g = 0;
+    if (rd.sine_part) {
+      const rectification::LoopResponse h = loop(rd.frequency_Hz);
+      std::complex<double> current = 0;
+      for (int i = 0; i < 3; ++i) current += h.current[static_cast<std::size_t>(i)] * (rd.amplitude_g * r.direction[i]);
+      sine_g = std::abs(current);
+    }
+    if (3 * sigma_g + sine_g > range_g && range_g > sine_g) vibration::scale_levels(rd.profile, std::pow((range_g - sine_g) / (3 * sigma_g), 2));
+  }
+  return design;
+}
 
 Campaign simulate_campaign(const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
                            const CampaignDesign& design, std::uint64_t seed, int threads,

@@ -92,6 +92,16 @@ struct CampaignDesign {
 // terms odd in a_IA change sign, the even ones do not); 3 x 12 static positions, twice each.
 CampaignDesign default_design();
 
+// A lab's back-off: each random or sine-on-random run whose rebalance current would pass
+// range_g (g peak) at its random part's 3 sigma plus the sine's amplitude, on the truth with
+// its hidden effects (the loop's linear response: rectification::random_response and
+// loop_response on the run's plant, the fixture's turn included), run instead with its random
+// levels scaled to reach range_g there, as a lab lowers a test whose output clips (a lightly
+// damped mode can lift 11 g rms of table motion to 32 g rms of current). The runs within range
+// and the sine runs as they are.
+CampaignDesign within_output_range(CampaignDesign design, const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
+                                   double range_g);
+
 // Out-of-library effects the virtual lab can hide (diagnose must call them unexplained).
 bool is_out_of_library(const std::string& name);
 // The registry's validity check of a hidden effect (known name, values its check accepts);

@@ -202,15 +202,15 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
                                                : memo != film_memo.end() ? memo->second.second
                                                                          : rectification::film_harmonic_balance(with_films, cfg, motion, h);
     if (!film_key.empty() && memo == film_memo.end()) film_memo.emplace(film_key, std::make_pair(cfg, input));
-    // A random or sine-on-random run: the random part's covariances through the loop, once.
+    // A random or sine-on-random run: the random part's covariances through the loop, once;
+    // the sine part as the table makes it (harmonics, rocking: motion_of).
     std::optional<rectification::RandomResponse> rr;
-    std::optional<vibration::SineVibration> sine;
-    std::optional<rectification::LoopResponse> sine_h;
+    std::optional<rectification::PeriodicInput> sine;
     if (r.random) {
       // (A film's are this run's and value's own.)
       rr = film ? rectification::random_response_at_damping(*film_spectrum, film->x())
                 : cache.random_response(key, run_random(r), m.random_turn, kRandomRunQuadrature, h);
-      if (r.sine_part) sine = m.sine, sine_h = h(r.frequency_Hz);
+      if (r.sine_part) sine = motion_of(r, m);
     }
     // Coefficients as identified, then the effect's own change of them (if any) on top.
     const Coefficients shift = [&] {
@@ -229,7 +229,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       if (rr) {
         PlantConfig q = cfg;
         for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
-        return rectification::random_rectification_at_frequency(q, r.orientation_g, *rr, sine, sine_h).total_g();
+        return rectification::random_rectification_at_frequency(q, r.orientation_g, *rr, sine, h).total_g();
       }
       Coefficients q;
       for (int i = 0; i < plant::kNumCoefficients; ++i) q[i] = co[i] + shift[i];
@@ -361,10 +361,9 @@ double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effe
     const rectification::RandomResponse rr =
         film ? rectification::random_response_at_damping(*film_spectrum, film->x())
              : rectification::random_response(run_random(r), h, kRandomRunQuadrature, m.random_turn);
-    std::optional<vibration::SineVibration> sine;
-    std::optional<rectification::LoopResponse> sine_h;
-    if (r.sine_part) sine = m.sine, sine_h = h(r.frequency_Hz);
-    return rectification::random_rectification_at_frequency(cfg, r.orientation_g, rr, sine, sine_h).total_g();
+    std::optional<rectification::PeriodicInput> sine;
+    if (r.sine_part) sine = run_input(r, m);
+    return rectification::random_rectification_at_frequency(cfg, r.orientation_g, rr, sine, h).total_g();
   }
   return rectification::periodic_rectification(cfg, r.orientation_g, rectification::film_harmonic_balance(with_films, cfg, run_input(r, m), h), h)
       .total_g();
