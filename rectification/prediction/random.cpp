@@ -577,7 +577,8 @@ FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config,
     geometry = geometry || e->vibropendulous();
   }
   const auto& c5 = rr.covariance;
-  const auto [felt, through_loop] = gaussian_parts(rr);
+  const GaussianParts parts = gaussian_parts(rr);
+  const vibration::RandomVibration &felt = parts.felt, &through_loop = parts.through_loop;
 
   // The sine, as in sine_rectification_at_frequency.
   vibration::SineVibration sine_felt, sine_loop;
