@@ -98,7 +98,9 @@ CampaignDesign default_design();
 // loop_response on the run's plant, the fixture's turn included), run instead with its random
 // levels scaled to reach range_g there, as a lab lowers a test whose output clips (a lightly
 // damped mode can lift 11 g rms of table motion to 32 g rms of current). The runs within range
-// and the sine runs as they are.
+// and the sine runs as they are, and a sine-on-random run whose sine alone passes the range
+// (not backed off: the sine is the test's point). The truth's linear response sizes the level
+// only; what the run measures is the ODE's.
 CampaignDesign within_output_range(CampaignDesign design, const plant::PlantConfig& truth, const std::vector<HiddenEffect>& hidden,
                                    double range_g);
 
