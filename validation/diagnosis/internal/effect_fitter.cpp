@@ -70,62 +70,112 @@ Eigen::VectorXd EffectFitter::slope(double p, double h) const {
   return Eigen::VectorXd::Zero(mid.size());
 }
 
+EffectFitter::Starts EffectFitter::starts(const Data& d, const std::vector<int>& idx) const {
+  const std::size_t m = e_.parameters.size();
+  Starts s;
+  s.first = fit(d, idx);
+  // The nominal first, then every combination of the further parameters' starts.
+  s.v = {nominal_values_};
+  for (std::size_t j = 1; j < m; ++j) {
+    const std::size_t nb = s.v.size();
+    for (double st : e_.parameters[j].starts) {
+      if (st == e_.parameters[j].nominal) continue;
+      for (std::size_t b = 0; b < nb; ++b) {
+        std::vector<double> v = s.v[b];
+        v[j] = st;
+        s.v.push_back(v);
+      }
+    }
+  }
+  for (std::size_t b = 0; b < s.v.size(); ++b) {
+    std::vector<double>& v = s.v[b];
+    v.front() = b == 0 ? s.first.first : fit_first(d, idx, v).first;
+    try {
+      const Table t = at(v);
+      s.l.push_back(likelihood(d, t.pred, t.G, idx).m2logl);
+    } catch (const std::invalid_argument&) {
+      s.l.push_back(static_cast<double>(INFINITY));
+    }
+  }
+  return s;
+}
+
+bool EffectFitter::discrete_nominal(const std::vector<double>& v) const {
+  for (std::size_t j = 1; j < v.size(); ++j)
+    if (e_.parameters[j].discrete && v[j] != e_.parameters[j].nominal) return false;
+  return true;
+}
+
+bool EffectFitter::same_form(const std::vector<double>& a, const std::vector<double>& b) const {
+  for (std::size_t j = 1; j < a.size(); ++j)
+    if (e_.parameters[j].discrete && a[j] != b[j]) return false;
+  return true;
+}
+
 EffectFitter::Multi EffectFitter::fit_all(const Data& d, const std::vector<int>& idx) const {
+  if (e_.parameters.size() == 1) return fit_from(d, idx, Starts{fit(d, idx), {nominal_values_}, {0.0}}, 0);
+  if (!any_discrete()) {
+    const Starts s = starts(d, idx);
+    return fit_from(d, idx, s, static_cast<std::size_t>(std::min_element(s.l.begin(), s.l.end()) - s.l.begin()));
+  }
+  // The form with the lowest objective and prior odds; the default form unless that one is an
+  // effect the runs see (against no effect, -2 ln L falls by kSeen, the targeted test's 25):
+  // on a clean campaign the best of three axes beats IA by more than 4 by chance (seen: OA
+  // chosen, NaturalForm.ACleanCampaign...).
+  const Starts s = starts(d, idx);
+  std::vector<Form> forms = fit_forms(d, idx, s);
+  const auto best = std::min_element(forms.begin(), forms.end(), [](const Form& a, const Form& b) { return a.m2logl < b.m2logl; });
+  const double l_none = likelihood(d, nominal_.pred, nominal_.G, idx).m2logl;
+  if (discrete_nominal(best->mf.values) || l_none - best->m2logl >= kSeen) return std::move(best->mf);
+  for (Form& f : forms)
+    if (discrete_nominal(f.mf.values)) return std::move(f.mf);
+  std::size_t best_nominal = 0;
+  for (std::size_t b = 0; b < s.v.size(); ++b)
+    if (discrete_nominal(s.v[b]) && s.l[b] < s.l[best_nominal]) best_nominal = b;
+  return fit_from(d, idx, s, best_nominal);
+}
+
+bool EffectFitter::any_discrete() const {
+  return std::any_of(e_.parameters.begin() + 1, e_.parameters.end(), [](const EffectParameter& q) { return q.discrete; });
+}
+
+std::vector<EffectFitter::Form> EffectFitter::fit_forms(const Data& d, const std::vector<int>& idx) const {
+  if (!any_discrete()) return {Form{fit_all(d, idx), 0.0}};
+  return fit_forms(d, idx, starts(d, idx));
+}
+
+std::vector<EffectFitter::Form> EffectFitter::fit_forms(const Data& d, const std::vector<int>& idx, const Starts& s) const {
+  const double l_best = *std::min_element(s.l.begin(), s.l.end());
+  // Each form's best start; the forms whose best start is within kSeen of the best overall.
+  std::vector<std::size_t> heads;
+  for (std::size_t b = 0; b < s.v.size(); ++b) {
+    if (!(s.l[b] - l_best <= kSeen)) continue;
+    const auto same = std::find_if(heads.begin(), heads.end(), [&](std::size_t h) { return same_form(s.v[h], s.v[b]); });
+    if (same == heads.end()) heads.push_back(b);
+    else if (s.l[b] < s.l[*same]) *same = b;
+  }
+  std::vector<Form> forms;
+  for (std::size_t h : heads) {
+    Multi mf = fit_from(d, idx, s, h);
+    const double obj = objective_at(d, idx, mf.values, fitted_set(mf));
+    if (!std::isfinite(obj)) continue;
+    forms.push_back(Form{std::move(mf), obj + (discrete_nominal(s.v[h]) ? 0.0 : kDiscreteGain)});
+  }
+  if (forms.empty()) {  // (no form the plant takes: the first start's, as the one-parameter fit)
+    forms.push_back(Form{fit_from(d, idx, s, 0), static_cast<double>(INFINITY)});
+  }
+  return forms;
+}
+
+EffectFitter::Multi EffectFitter::fit_from(const Data& d, const std::vector<int>& idx, const Starts& s, std::size_t best) const {
   const std::size_t m = e_.parameters.size();
   Multi out;
   out.values = nominal_values_;
   out.status.assign(m, ParameterStatus::held);
   out.sigma.assign(m, NAN);
-  const auto [p0, s0] = fit(d, idx);
-  out.values.front() = p0, out.status.front() = ParameterStatus::fitted, out.sigma.front() = s0;
+  out.values.front() = s.first.first, out.status.front() = ParameterStatus::fitted, out.sigma.front() = s.first.second;
   if (m == 1) return out;
-  // The starts: the nominal first, then every combination of the further parameters' starts.
-  std::vector<std::vector<double>> bases = {nominal_values_};
-  for (std::size_t j = 1; j < m; ++j) {
-    const std::size_t nb = bases.size();
-    for (double st : e_.parameters[j].starts) {
-      if (st == e_.parameters[j].nominal) continue;
-      for (std::size_t b = 0; b < nb; ++b) {
-        std::vector<double> v = bases[b];
-        v[j] = st;
-        bases.push_back(v);
-      }
-    }
-  }
-  const auto m2logl = [&](const std::vector<double>& v) {
-    try {
-      const Table t = at(v);
-      return likelihood(d, t.pred, t.G, idx).m2logl;
-    } catch (const std::invalid_argument&) {
-      return static_cast<double>(INFINITY);
-    }
-  };
-  std::vector<double> start_l;
-  std::vector<std::vector<double>> start_v;
-  for (const auto& b : bases) {
-    std::vector<double> v = b;
-    v.front() = &b == &bases.front() ? p0 : fit_first(d, idx, b).first;
-    start_l.push_back(m2logl(v)), start_v.push_back(v);
-  }
-  const auto discrete_nominal = [&](const std::vector<double>& v) {
-    for (std::size_t j = 1; j < m; ++j)
-      if (e_.parameters[j].discrete && v[j] != e_.parameters[j].nominal) return false;
-    return true;
-  };
-  std::size_t best = 0, best_nominal = 0;
-  for (std::size_t b = 0; b < bases.size(); ++b) {
-    if (start_l[b] < start_l[best]) best = b;
-    if (discrete_nominal(start_v[b]) && start_l[b] < start_l[best_nominal]) best_nominal = b;
-  }
-  // A discrete form is chosen only for an effect the runs see (against no effect, -2 ln L
-  // falls by kSeen, the targeted test's 25) and when it beats the default form by
-  // kDiscreteGain: on a clean campaign the best of three axes beats IA by more than 4 by
-  // chance (seen: OA chosen, NaturalForm.ACleanCampaign...).
-  const double l_none = likelihood(d, nominal_.pred, nominal_.G, idx).m2logl;
-  if (!discrete_nominal(start_v[best]) &&
-      (start_l[best_nominal] - start_l[best] < kDiscreteGain || l_none - start_l[best] < kSeen))
-    best = best_nominal;
-  std::vector<double> start = start_v[best];
+  const std::vector<double>& start = s.v[best];
   for (std::size_t j = 1; j < m; ++j)
     if (e_.parameters[j].discrete && start[j] != e_.parameters[j].nominal) out.status[j] = ParameterStatus::chosen;
   // The continuous candidates: the first parameter and the further continuous ones.
@@ -139,18 +189,14 @@ EffectFitter::Multi EffectFitter::fit_all(const Data& d, const std::vector<int>&
       // A phase's -2 ln L has a valley on each side of the circle, and a start's first-
       // parameter fit says little about where the descent ends (seen: the best start, 0 rad,
       // ended at 0.30 rad, 36 above the valley at 2.3 rad a start of pi/2 leads to). Every
-      // other start with the same discrete values whose -2 ln L is within kSeen of the best
-      // start's descends too; the lowest objective wins.
+      // other start of the same form whose -2 ln L is within kSeen of this one's descends
+      // too; the lowest objective wins.
       double f_best = objective_at(d, idx, res.values, res.free);
-      for (std::size_t b = 0; b < bases.size(); ++b) {
-        if (b == best || start_l[b] - start_l[best] > kSeen) continue;
-        bool same = true;
-        for (std::size_t j = 1; j < m; ++j)
-          if (e_.parameters[j].discrete && start_v[b][j] != start[j]) same = false;
-        if (!same) continue;
+      for (std::size_t b = 0; b < s.v.size(); ++b) {
+        if (b == best || s.l[b] - s.l[best] > kSeen || !same_form(s.v[b], start)) continue;
         std::vector<int> fb = free;
         Multi rb = out;
-        if (!descend(d, idx, start_v[b], fb, rb)) continue;
+        if (!descend(d, idx, s.v[b], fb, rb)) continue;
         const double fb_obj = objective_at(d, idx, rb.values, rb.free);
         if (fb_obj < f_best) f_best = fb_obj, res = rb;
       }

@@ -66,8 +66,9 @@ class EffectFitter {
 
   // Every parameter the runs `idx` pin (docs/diagnose.md, "Natural forms"): the first
   // parameter's fit at each start of the further ones (their `starts`, the nominal first); a
-  // discrete parameter's value chosen by likelihood (held at nominal unless it lowers -2 ln L
-  // by kDiscreteGain); then Levenberg-Marquardt on the first and the continuous further
+  // discrete parameter's value (the form) chosen by the fitted forms' objectives (fit_forms:
+  // the default form unless another lowers it by kDiscreteGain and lowers -2 ln L against no
+  // effect by kSeen); in each form, Levenberg-Marquardt on the first and the continuous further
   // parameters, on -2 ln L with the weak Gaussian priors of the further ones, each step's
   // covariance V at the current value (the coefficients' errors taken out as in the one-
   // parameter fit). A further parameter whose sigma from the data alone is not smaller than
@@ -83,6 +84,19 @@ class EffectFitter {
   };
   static constexpr double kDiscreteGain = 4, kSeen = 25;
   Multi fit_all(const Data& d, const std::vector<int>& idx) const;
+
+  // A natural form with a discrete parameter, fitted in each of its forms (a mode on each
+  // axis): what a fold's training runs say when they cannot choose (docs/diagnose.md, "Natural
+  // forms", step 5). Each form whose best start's -2 ln L is within kSeen of the best start's is
+  // fitted as fit_all fits its chosen one; m2logl is its objective at its fit (-2 ln L with the
+  // further parameters' priors) plus -2 ln of its prior odds against the default form
+  // (kDiscreteGain for any other form, the choice's own Bayes factor). An effect without a
+  // discrete parameter: fit_all's fit alone.
+  struct Form {
+    Multi mf;
+    double m2logl = 0;
+  };
+  std::vector<Form> fit_forms(const Data& d, const std::vector<int>& idx) const;
 
   // The fitted parameters' sigma with the hypothesis' own error added: the change the effect
   // makes, Delta = pred(v) - pred(nominal), is right to hypothesis_accuracy f (not better:
@@ -142,6 +156,20 @@ class EffectFitter {
                                     const std::vector<double>& xs) const;
 
  private:
+  // The first parameter's fit with the others nominal, and each start of the further ones
+  // (the nominal first) with the first fitted there and -2 ln L over the runs at it.
+  struct Starts {
+    std::pair<double, double> first;
+    std::vector<std::vector<double>> v;
+    std::vector<double> l;
+  };
+  Starts starts(const Data& d, const std::vector<int>& idx) const;
+  // fit_all's steps 3-4 from start `best` (its form's discrete values kept).
+  Multi fit_from(const Data& d, const std::vector<int>& idx, const Starts& s, std::size_t best) const;
+  std::vector<Form> fit_forms(const Data& d, const std::vector<int>& idx, const Starts& s) const;
+  bool any_discrete() const;                                                         // a further parameter is discrete
+  bool discrete_nominal(const std::vector<double>& v) const;                       // every discrete parameter at its nominal
+  bool same_form(const std::vector<double>& a, const std::vector<double>& b) const;  // the same discrete values
   // The parameters mf fitted: its free set, or the first alone (the one-parameter fit).
   static std::vector<int> fitted_set(const Multi& mf) { return mf.cov.size() > 0 ? mf.free : std::vector<int>{0}; }
   bool further_nominal(const std::vector<double>& v) const;

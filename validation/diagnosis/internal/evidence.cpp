@@ -52,6 +52,10 @@ Likelihood Scorer::conditional_on(const Data& dd, const Eigen::VectorXd& pred, c
 }
 
 void Scorer::score(const std::function<Fitted(const std::vector<int>&)>& fit_on, Scored& sc) const {
+  score_forms([&](const std::vector<int>& train) { return std::vector<Form>{Form{fit_on(train), 0.0}}; }, sc);
+}
+
+void Scorer::score_forms(const std::function<std::vector<Form>(const std::vector<int>&)>& fit_on, Scored& sc) const {
   const Data& data = m_.data;
   const Table& nominal = m_.nominal;
   const std::vector<int>& all = m_.all;
@@ -59,28 +63,55 @@ void Scorer::score(const std::function<Fitted(const std::vector<int>&)>& fit_on,
   sc.heldout = Eigen::VectorXd::Zero(n);
   for (const auto& [key, test] : folds_.test) {
     const std::vector<int> train = folds_.train(key);
-    const Fitted f = fit_on(train);
-    Likelihood with;
-    if (train.size() == all.size()) {
-      with = likelihood(data, f.t.pred, f.t.G, all);
-    } else {
-      const Eigen::Index k = f.cov.rows(), m = plant::kNumCoefficients;
-      Data da = data;
-      da.Sigma = Eigen::MatrixXd::Zero(m + k, m + k);
-      da.Sigma.topLeftCorner(m, m) = data.Sigma;
-      da.Sigma.bottomRightCorner(k, k) = f.cov;
-      Eigen::MatrixXd Ga(n, m + k);
-      Ga << f.t.G, f.slopes;
-      with = conditional_on(da, f.t.pred, Ga, train);
+    const std::vector<Form> forms = fit_on(train);
+    std::vector<Likelihood> with(forms.size());
+    std::vector<Eigen::VectorXd> a(forms.size());
+    for (std::size_t c = 0; c < forms.size(); ++c) {
+      const Fitted& f = forms[c].f;
+      if (train.size() == all.size()) {
+        with[c] = likelihood(data, f.t.pred, f.t.G, all);
+      } else {
+        const Eigen::Index k = f.cov.rows(), m = plant::kNumCoefficients;
+        Data da = data;
+        da.Sigma = Eigen::MatrixXd::Zero(m + k, m + k);
+        da.Sigma.topLeftCorner(m, m) = data.Sigma;
+        da.Sigma.bottomRightCorner(k, k) = f.cov;
+        Eigen::MatrixXd Ga(n, m + k);
+        Ga << f.t.G, f.slopes;
+        with[c] = conditional_on(da, f.t.pred, Ga, train);
+      }
+      a[c] = adjusted_residual(data, f.t.pred, f.t.G, train, test);
     }
+    // The forms' mixture: prior weights pi_c from the training runs, -2 ln p(test) =
+    // -2 ln sum pi_c p_c(test); the posterior weights rho_c (pi_c p_c, normalised) weigh the
+    // forms' held-out residuals, and chi^2 is theirs plus 2 KL(rho || pi): what the held-out
+    // runs had to overturn of the training runs' choice (0 with one form).
+    const auto log_sum_exp = [](const std::vector<double>& x) {
+      const double top = *std::max_element(x.begin(), x.end());
+      double s = 0;
+      for (double v : x) s += std::exp(v - top);
+      return top + std::log(s);
+    };
+    std::vector<double> lp(forms.size()), lj(forms.size());
+    for (std::size_t c = 0; c < forms.size(); ++c) lp[c] = -0.5 * forms[c].m2logl, lj[c] = lp[c] - 0.5 * with[c].m2logl;
+    const double zp = log_sum_exp(lp), zj = log_sum_exp(lj);
+    Likelihood mix{-2 * (zj - zp), 0.0};
+    Eigen::VectorXd residual = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(test.size()));
+    double mean_m2logl = 0;
+    for (std::size_t c = 0; c < forms.size(); ++c) {
+      const double rho = std::exp(lj[c] - zj);
+      if (!(rho > 0)) continue;
+      mix.chi2 += rho * with[c].chi2, mean_m2logl += rho * with[c].m2logl;
+      residual += rho * a[c];
+    }
+    mix.chi2 += mix.m2logl - mean_m2logl;
     const Likelihood without = find_or_make(nominal_heldout_lock_, nominal_heldout_, key, [&] {
       return train.size() == all.size() ? likelihood(data, nominal.pred, nominal.G, all)
                                         : conditional_on(data, nominal.pred, nominal.G, train);
     });
-    sc.fit.evidence += without.m2logl - with.m2logl;
-    sc.fit.heldout_chi2 += with.chi2;
-    const Eigen::VectorXd a = adjusted_residual(data, f.t.pred, f.t.G, train, test);
-    for (std::size_t i = 0; i < test.size(); ++i) sc.heldout(test[i]) = a(static_cast<Eigen::Index>(i));
+    sc.fit.evidence += without.m2logl - mix.m2logl;
+    sc.fit.heldout_chi2 += mix.chi2;
+    for (std::size_t i = 0; i < test.size(); ++i) sc.heldout(test[i]) = residual(static_cast<Eigen::Index>(i));
   }
 }
 
@@ -151,8 +182,10 @@ void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, D
     if (std::find(d.measured_effects.begin(), d.measured_effects.end(), e.name) == d.measured_effects.end()) effects.push_back(&e);
   std::vector<std::unique_ptr<EffectFitter>> fitters(effects.size());
   std::vector<Scored> scored(effects.size());
-  const auto fitted_one = [&](const EffectFitter& fitter, const Data& dd, const std::vector<int>& runs) {
-    return scorer.fitted_multi(fitter, fitter.fit_all(dd, runs));
+  const auto fitted_forms = [&](const EffectFitter& fitter, const Data& dd, const std::vector<int>& runs) {
+    std::vector<Scorer::Form> forms;
+    for (const EffectFitter::Form& form : fitter.fit_forms(dd, runs)) forms.push_back({scorer.fitted_multi(fitter, form.mf), form.m2logl});
+    return forms;
   };
   // Handed out costliest first (those that change the loop's dynamics need their own loop
   // responses at every value; then by the parameters a natural form fits), so that the last
@@ -171,7 +204,7 @@ void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, D
     const EffectFitter& fitter = *fitters[i];
     Scored& sc = scored[i];
     sc.fit.name = e.name, sc.fit.parameter = e.fitted().name, sc.fit.unit = e.fitted().unit;
-    scorer.score([&](const std::vector<int>& runs) { return fitted_one(fitter, data, runs); }, sc);
+    scorer.score_forms([&](const std::vector<int>& runs) { return fitted_forms(fitter, data, runs); }, sc);
     EffectFitter::Multi mf = fitter.fit_all(data, all);
     fitter.add_model_error(data, all, mf);
     const double p = mf.values.front(), sp = mf.sigma.front();

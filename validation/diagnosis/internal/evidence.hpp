@@ -71,6 +71,19 @@ class Scorer {
   // fit_on(runs) fits the candidate on `runs`; adds to sc.fit's evidence and heldout_chi2 and
   // fills sc.heldout.
   void score(const std::function<Fitted(const std::vector<int>&)>& fit_on, Scored& sc) const;
+  // A candidate with a discrete form (EffectFitter::fit_forms): fit_on(runs) fits it in each
+  // form the runs leave open, with -2 ln of the form's weight (its training objective and prior
+  // odds; any common constant). Each fold's held-out runs are scored by the forms' mixture:
+  // -2 ln sum_c pi_c p_c(held-out | training), pi_c the normalised weights; the held-out
+  // residual is the forms' mean under their posterior weights rho_c (pi_c p_c normalised) and
+  // chi^2 theirs plus 2 KL(rho || pi), the price of what the held-out runs overturned of the
+  // training runs' choice. So a fold whose training runs cannot choose the form (a transverse
+  // motion's axis cycle from 1 and 2 g) is not judged on the one it happened to prefer.
+  struct Form {
+    Fitted f;
+    double m2logl = 0;
+  };
+  void score_forms(const std::function<std::vector<Form>(const std::vector<int>&)>& fit_on, Scored& sc) const;
   // A fitted effect with its slope (none at a bound: sp not finite).
   Fitted fitted_at(const EffectFitter& fitter, double p, double sp) const;
   // Every parameter the runs pin (EffectFitter::fit_all): the one-parameter fit when the
