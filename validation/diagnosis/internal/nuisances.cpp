@@ -247,10 +247,12 @@ Nuisance sigma_scale(const Campaign& c, const SigmaScaleOptions& o, Diagnosis& d
   // Overdispersion beyond chance: with the stated sigma right, the repeats' pooled chi^2 is
   // chi^2 with rep_dof degrees of freedom exactly (Gaussian noise); the gaps' sum of z^2 is at
   // most chi^2 with n (the coefficients' errors taken out under their prior use up a little:
-  // the test errs on the side of not flagging). Beyond its quantile at kNuisanceTail: 1.13 x
-  // the stated sigma for 168 runs, 2.2 x for 5 degrees of freedom of repeats.
+  // the test errs on the side of not flagging). Beyond its quantile at kNuisanceTail for
+  // repeats (2.2 x the stated sigma for 5 degrees of freedom), at kScatterFromGapsTail for the
+  // gaps (1.22 x for 168 runs).
   const double chi2 = from_repeats ? rep_chi2 : z2;
-  const double chi2_crit = boost::math::quantile(boost::math::chi_squared(kdof), 1 - kNuisanceTail);
+  const double chi2_crit =
+      boost::math::quantile(boost::math::chi_squared(kdof), 1 - (from_repeats ? kNuisanceTail : kScatterFromGapsTail));
   const bool excess = chi2 > chi2_crit;
   // It is scatter when measured by repeats, or when no effect explains the gaps, their
   // neighbours are not alike and neither their means nor their spreads depend on frequency,

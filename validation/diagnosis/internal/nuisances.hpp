@@ -26,6 +26,13 @@ namespace vrelab::validation::internal {
 // with room for the gap's own test). The thresholds are this tail's quantiles of each
 // statistic's distribution under "no nuisance", not values tuned on campaigns.
 constexpr double kNuisanceTail = 1.3498980316300946e-3;
+// An understated sigma measured from the gaps alone (no repeated runs) is tested at 4 sigma,
+// 1 - Phi(4) = 3.17e-5: there an excess is also what unmodelled physics leaves below the
+// structure tests' power (few runs share a frequency or an amplitude on a mixed design), and
+// "sigma understated" would swallow it (seed 11501 mixed, campaign 122: an out-of-library
+// damping, sum z^2 84 for 45 runs, 3.6 sigma, no structure at 3 sigma). At 4 sigma 45 runs
+// still flag a sigma 1.44 x understated (blind's draws: 1.8 - 3), 168 runs 1.22 x.
+constexpr double kScatterFromGapsTail = 3.167124183311986e-5;
 
 // Runs alike but for one step of frequency or of amplitude (same direction, orientation and
 // the other): how alike their gaps z are, as the correlation of neighbours, and how many pairs.
