@@ -161,9 +161,10 @@ std::vector<EffectFitter::Form> EffectFitter::fit_forms(const Data& d, const std
     if (!std::isfinite(obj)) continue;
     forms.push_back(Form{std::move(mf), obj + (discrete_nominal(s.v[h]) ? 0.0 : kDiscreteGain)});
   }
-  if (forms.empty()) {  // (no form the plant takes: the first start's, as the one-parameter fit)
-    forms.push_back(Form{fit_from(d, idx, s, 0), static_cast<double>(INFINITY)});
-  }
+  // No form the plant takes: the first start's alone, as the one-parameter fit (its weight
+  // finite: with one form the weight cancels, and an infinite one would make the mixture's
+  // score NaN where the single fit's is what it always was).
+  if (forms.empty()) forms.push_back(Form{fit_from(d, idx, s, 0), 0.0});
   return forms;
 }
 
