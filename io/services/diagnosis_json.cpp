@@ -53,6 +53,8 @@ json effects_json(const validation::Diagnosis& d) {
                        {"sigma", finite_or_null(e.sigma)},
                        {"evidence", e.evidence},
                        {"heldout_chi2", e.heldout_chi2},
+                       {"insample_chi2", finite_or_null(e.insample_chi2)},
+                       {"insample_dof", e.insample_dof},
                        {"at_bound", e.at_bound},
                        {"parameters", parameters_json(e)}});
     if (!e.not_ranked.empty()) effects.back()["not_ranked"] = e.not_ranked;  // why it is no candidate
@@ -115,7 +117,8 @@ json pairs_json(const validation::Diagnosis& d) {
     pairs.push_back({{"names", {p.a, p.b}},
                      {"parameters", {p.pa, p.pb}},
                      {"evidence", p.evidence},
-                     {"heldout_chi2", p.heldout_chi2}});
+                     {"heldout_chi2", p.heldout_chi2},
+                     {"insample_chi2", finite_or_null(p.insample_chi2)}});
   return pairs;
 }
 

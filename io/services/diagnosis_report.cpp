@@ -72,14 +72,15 @@ void which_effect(Report& rep, const validation::Diagnosis& d) {
                 "runs do not determine the parameter.");
   std::vector<std::vector<std::string>> rows = {
       {"effect", "parameter", "unit", "value", "sigma", "datasheet (IEEE Std 1293 units)", "evidence (held-out chi^2 drop)",
-       "held-out chi^2"}};
+       "held-out chi^2", "all-run chi^2 (fitted on every run)"}};
   for (const auto& e : d.effects) {
     const auto ds = validation::datasheet_form(e.value, e.sigma, e.unit);
     rows.push_back({e.name, e.parameter, e.unit, fmt::format("{:.5g}", e.value), sigma_text(e.sigma, e.at_bound),
                     ds ? fmt::format("{:.4g} {} (sigma {})", ds->value, ds->unit,
                                      std::isfinite(ds->sigma) ? fmt::format("{:.2g}", ds->sigma) : "not pinned")
                        : "",
-                    fmt::format("{:.1f}", e.evidence), fmt::format("{:.1f}", e.heldout_chi2)});
+                    fmt::format("{:.1f}", e.evidence), fmt::format("{:.1f}", e.heldout_chi2),
+                    fmt::format("{:.1f} for {}", e.insample_chi2, e.insample_dof)});
   }
   rep.table(rows);
   if (!d.pairs.empty()) {
@@ -87,10 +88,10 @@ void which_effect(Report& rep, const validation::Diagnosis& d) {
                               "each fold's training runs), fitted together (additive to first order), a pair chosen "
                               "only when its evidence beats the best single effect's by {:.0f}:",
                               d.pair_evidence_margin));
-    std::vector<std::vector<std::string>> prow = {{"pair", "parameters (each effect's unit)", "evidence", "held-out chi^2"}};
+    std::vector<std::vector<std::string>> prow = {{"pair", "parameters (each effect's unit)", "evidence", "held-out chi^2", "all-run chi^2"}};
     for (const auto& p : d.pairs)
       prow.push_back({p.a + " + " + p.b, fmt::format("{:.5g}, {:.5g}", p.pa, p.pb), fmt::format("{:.1f}", p.evidence),
-                      fmt::format("{:.1f}", p.heldout_chi2)});
+                      fmt::format("{:.1f}", p.heldout_chi2), fmt::format("{:.1f}", p.insample_chi2)});
     rep.table(prow);
   }
 }

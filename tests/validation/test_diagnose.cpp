@@ -292,6 +292,13 @@ TEST(DiagnoseCampaign, HiddenK5IsFittedWithWhatTheStaticTestTookUpGivenBack) {
   // hypothesis' own 1 % (hypothesis_accuracy) in quadrature, so below hypot(1 %, 1 %).
   EXPECT_LT(d.effects.front().sigma, std::hypot(0.01, 0.01) * 2e-7);
   EXPECT_GE(d.effects.front().sigma, 0.01 * 2e-7);  // the hypothesis' accuracy is in it
+  // Fitted on every run, the truth leaves what the noise and the simulation's accuracy leave:
+  // chi^2 with n - 1 degrees of freedom (the verdict's all-run test; the runs are the ODE's).
+  const EffectFit& k5 = d.effects.front();
+  const double v = 2.0 / (9.0 * k5.insample_dof), all_run_sigma = (std::cbrt(k5.insample_chi2 / k5.insample_dof) - (1 - v)) / std::sqrt(v);
+  std::printf("  all-run chi2 %.1f for %d degrees of freedom (%.2f sigma)\n", k5.insample_chi2, k5.insample_dof, all_run_sigma);
+  EXPECT_EQ(k5.insample_dof, static_cast<int>(c.runs.size()) - 1);
+  EXPECT_LT(std::abs(all_run_sigma), 3);
   // Where: k5 rectifies 5 a0^3 |I|^2 + (15/8) a0 |I|^4, odd in the static a_IA; the runs at
   // a_IA = +-0.71 g say so. Noise and the coefficients' share leave some even part: the
   // simulation's accuracy sits at each run's error, which differs between +-a0 (its k3 a0 term),

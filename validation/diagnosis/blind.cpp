@@ -123,6 +123,16 @@ std::vector<double> apply_lab_log(Campaign& camp, const BlindCampaign& k) {
   return added;
 }
 
+// The lab's log applied (apply_lab_log) and the manifest's dynamics the lab's estimate, not
+// the truth's. Returns what the log added to each run's measured_g (g).
+std::vector<double> hand_to_lab(Campaign& camp, const BlindCampaign& k) {
+  std::vector<double> lab_g = apply_lab_log(camp, k);
+  camp.dynamics.loop_bandwidth_Hz *= k.manifest_crossover_ratio;
+  camp.dynamics.pendulum_frequency_Hz *= k.manifest_pendulum_ratio;
+  camp.dynamics.phase_margin_deg += k.manifest_margin_offset_deg;
+  return lab_g;
+}
+
 // Simulates campaign k from its truth and hidden effects, diagnoses it without the key.
 void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
   const auto t0 = Clock::now();
@@ -145,11 +155,7 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
             std::max(k.effect_max_sigma, std::abs(camp.runs[j].measured_g - clean.runs[j].measured_g) / camp.runs[j].sigma_g);
       k.effect_gap_sigma = nominal_gap_significance(camp, clean, settings);
     }
-    const std::vector<double> lab_g = apply_lab_log(camp, k);
-    // The manifest states the lab's estimate of the dynamics, not the truth's.
-    camp.dynamics.loop_bandwidth_Hz *= k.manifest_crossover_ratio;
-    camp.dynamics.pendulum_frequency_Hz *= k.manifest_pendulum_ratio;
-    camp.dynamics.phase_margin_deg += k.manifest_margin_offset_deg;
+    const std::vector<double> lab_g = hand_to_lab(camp, k);
     k.simulate_s = seconds_since(t0);
     k.diagnosis = diagnose(camp, settings);  // the key (k.hidden) is not passed
     // The gap's held-out rms without the lab's noise: a run's measured value is the ODE's plus
@@ -177,6 +183,18 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
                                          : "unexplained";
   k.top = k.error.empty() && d.effects.front().not_ranked.empty() ? d.effects.front().name : "";
 }
+
+}  // namespace
+
+Campaign blind_lab_campaign(const BlindCampaign& k) {
+  std::mt19937_64 rng(k.seed + 17);
+  const plant::PlantConfig truth = blind_truth(rng);
+  Campaign camp = simulate_campaign(truth, k.hidden, blind_design(k), k.seed, 1);
+  hand_to_lab(camp, k);
+  return camp;
+}
+
+namespace {
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());

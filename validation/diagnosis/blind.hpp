@@ -213,6 +213,13 @@ BlindCampaign blind_key(int index, std::uint64_t seed, bool mixed = false);
 inline constexpr double kBlindOutputRange_g = 50;
 CampaignDesign blind_design(const BlindCampaign& k);
 
+// Campaign k as the virtual lab hands it to diagnose (what run_blind diagnoses): simulated on
+// the ODE plant from its truth and hidden effects on blind_design(k), the lab's log applied
+// (each run's time and rest reading, the drift and extra scatter of a nuisance campaign), the
+// manifest's dynamics the lab's estimate. A scored campaign's full diagnosis, which blind's
+// result text does not carry: diagnose(blind_lab_campaign(k), BlindSettings{}.diagnose).
+Campaign blind_lab_campaign(const BlindCampaign& k);
+
 // A natural form's scoring: the diagnosis' top effect is the hidden one and each of its
 // parameters the data pinned is within 3 sigma of the truth (a phase's difference wrapped to
 // [-pi, pi); a discrete one, the mode's axis, equal, chosen or held); a held continuous

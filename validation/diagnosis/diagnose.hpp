@@ -132,6 +132,11 @@ struct EffectFit {
   std::vector<double> values() const;       // every parameter's value
   double evidence = 0;           // held-out chi^2 reduction, summed over folds
   double heldout_chi2 = 0;       // held-out chi^2 with the effect (given the training runs), summed over folds
+  // chi^2 of every run with the effect fitted on every run, and its degrees of freedom (the
+  // runs less the parameters fitted): the fit's own adequacy, which no parameter's looseness
+  // on a fold's training runs can soften (docs/diagnose.md, "The verdict").
+  double insample_chi2 = NAN;
+  int insample_dof = 0;
   bool at_bound = false;         // the fit ended on the edge of its range (no curvature: no sigma)
   std::string not_ranked;        // why the effect is no candidate (listed after the ranked ones); empty: ranked
 };
@@ -141,6 +146,7 @@ struct PairFit {
   std::string a, b;
   double pa = 0, pb = 0;         // their parameters, fitted on all runs
   double evidence = 0, heldout_chi2 = 0;
+  double insample_chi2 = NAN;    // every run, the pair fitted on every run (n - 2 degrees of freedom)
 };
 
 // A lab nuisance (not physics): estimated, removed or allowed for, and reported apart from

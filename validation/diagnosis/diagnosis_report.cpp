@@ -62,11 +62,12 @@ std::string Diagnosis::FullReport(double wall_s) const {
   std::string t = "Gap: " + d.where + "\n";
   t += "Cross-validation: " + d.folds + "\n";
   t += "Verdict: " + verdict_text(d) + "\n";
-  t += fmt::format("  {:<26}{:>16}{:>12}{:>12}{:>14}\n", "effect", "parameter", "sigma", "evidence", "held-out chi2");
+  t += fmt::format("  {:<26}{:>16}{:>12}{:>12}{:>14}{:>12}\n", "effect", "parameter", "sigma", "evidence", "held-out chi2",
+                   "all-run chi2");
   for (const auto& e : d.effects) {
     const std::optional<DatasheetValue> ds = datasheet_form(e.value, e.sigma, e.unit);
-    t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}{:>12.1f}{:>14.1f}  {} ({}{})\n", e.name, e.value, e.sigma, e.evidence,
-                     e.heldout_chi2, e.parameter, e.unit,
+    t += fmt::format("  {:<26}{:>16.5g}{:>12.3g}{:>12.1f}{:>14.1f}{:>12.1f}  {} ({}{})\n", e.name, e.value, e.sigma, e.evidence,
+                     e.heldout_chi2, e.insample_chi2, e.parameter, e.unit,
                      !ds ? ""
                      : std::isfinite(ds->sigma) ? fmt::format("; datasheet {:.4g} +- {:.2g} {}", ds->value, ds->sigma, ds->unit)
                                                 : fmt::format("; datasheet {:.4g} {}, not pinned", ds->value, ds->unit));
@@ -83,8 +84,8 @@ std::string Diagnosis::FullReport(double wall_s) const {
     }
   }
   for (const auto& p : d.pairs)
-    t += fmt::format("  pair {:<40}{:>12.5g},{:<12.5g}{:>12.1f}{:>14.1f}\n", p.a + " + " + p.b, p.pa, p.pb, p.evidence,
-                     p.heldout_chi2);
+    t += fmt::format("  pair {:<40}{:>12.5g},{:<12.5g}{:>12.1f}{:>14.1f}{:>12.1f}\n", p.a + " + " + p.b, p.pa, p.pb, p.evidence,
+                     p.heldout_chi2, p.insample_chi2);
   for (const auto& e : d.effects)
     if (!e.not_ranked.empty()) t += fmt::format("  {} is not ranked: {}\n", e.name, e.not_ranked);
   t += heldout_line(d, wall_s);

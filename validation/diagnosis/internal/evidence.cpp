@@ -206,6 +206,9 @@ void score_effects(const CampaignModel& m, const Scorer& scorer, Evidence& ev, D
     sc.fit.name = e.name, sc.fit.parameter = e.fitted().name, sc.fit.unit = e.fitted().unit;
     scorer.score_forms([&](const std::vector<int>& runs) { return fitted_forms(fitter, data, runs); }, sc);
     EffectFitter::Multi mf = fitter.fit_all(data, all);
+    const Table at_fit = fitter.at(mf.values);
+    sc.fit.insample_chi2 = likelihood(data, at_fit.pred, at_fit.G, all).chi2;
+    sc.fit.insample_dof = m.n - static_cast<int>(mf.cov.size() > 0 ? mf.free.size() : 1);
     fitter.add_model_error(data, all, mf);
     const double p = mf.values.front(), sp = mf.sigma.front();
     sc.fit.value = p, sc.fit.sigma = sp;

@@ -69,6 +69,8 @@ const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer
     const double evidence = a_default.fit.evidence, chi2 = a_default.fit.heldout_chi2;
     a_default.fit = best->fit;  // (reported as the natural form's fit; scored as the default form)
     a_default.fit.evidence = evidence, a_default.fit.heldout_chi2 = chi2;
+    const Table t = A.at(p);
+    a_default.fit.insample_chi2 = likelihood(data, t.pred, t.G, all).chi2, a_default.fit.insample_dof = n - 1;
     a_default.all = best->all;
     if (std::isfinite(evidence) && std::isfinite(chi2) && explains_gap(a_default, rms(a_default.heldout))) {
       pair_best = std::move(a_default);
@@ -110,7 +112,8 @@ const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer
     const Effect& eb = *seconds(all)[j];
     sc.fit.name = ea.name + " + " + eb.name;
     const auto [pa, pb, t] = fit_pair(A, *fitters.at(eb.name), eb.fitted().nominal, all);
-    const PairFit pf{ea.name, eb.name, pa, pb, sc.fit.evidence, sc.fit.heldout_chi2};
+    sc.fit.insample_chi2 = likelihood(data, t.t.pred, t.t.G, all).chi2, sc.fit.insample_dof = n - 2;
+    const PairFit pf{ea.name, eb.name, pa, pb, sc.fit.evidence, sc.fit.heldout_chi2, sc.fit.insample_chi2};
     d.pairs.push_back(pf);
     // (A pair whose evidence or chi^2 is not a finite number is listed, last, never chosen.)
     const bool finite = std::isfinite(sc.fit.evidence) && std::isfinite(sc.fit.heldout_chi2);
@@ -134,9 +137,11 @@ const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer
 }  // namespace
 
 bool explains(const Scored& sc, double rms_after_g, double rms_before_g, int n, const VerdictOptions& o) {
+  // (No run beyond the fitted parameters: the all-run fit has nothing left to judge.)
+  const bool no_gap_left = chi2_as_sigma(sc.fit.heldout_chi2, n) < o.threshold_sigma &&
+                           (sc.fit.insample_dof <= 0 || chi2_as_sigma(sc.fit.insample_chi2, sc.fit.insample_dof) < o.threshold_sigma);
   return sc.fit.not_ranked.empty() && sc.fit.evidence > o.threshold_sigma * o.threshold_sigma &&
-         (chi2_as_sigma(sc.fit.heldout_chi2, n) < o.threshold_sigma ||
-          rms_after_g <= (1 - o.min_rms_removed) * rms_before_g);
+         (no_gap_left || rms_after_g <= (1 - o.min_rms_removed) * rms_before_g);
 }
 
 Chosen judge(const CampaignModel& m, const Evidence& ev, const Scorer& scorer, const VerdictOptions& o, Diagnosis& d) {
