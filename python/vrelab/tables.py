@@ -94,7 +94,7 @@ def runs_frame(self):
 
 def effects_columns(self, parameters=False):
     """The effects ranked by held-out evidence (to_dict()['effects']), one row an effect: name,
-    evidence, heldout_chi2, its headline parameter (parameter_name, parameter, sigma, unit,
+    evidence, heldout_chi2, insample_chi2 and insample_dof (the fit on every run), its headline parameter (parameter_name, parameter, sigma, unit,
     at_bound) and the number of its fitted parameters (n_parameters). parameters=True: one row
     a fitted parameter of an effect (effect, evidence, heldout_chi2, then the parameter's name,
     value, sigma, unit, status, at_bound, range_min, range_max). A dict of NumPy columns."""
