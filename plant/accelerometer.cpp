@@ -675,4 +675,10 @@ double settled_output_g(const PlantConfig& config, const Vec3& a_g, double rtol)
   return plant.output_g(30 * tau, x.data());
 }
 
+double rest_output_g(const PlantConfig& config, const Vec3& a_g) {
+  const Accelerometer plant(config, a_g);
+  const std::vector<double> x = plant.equilibrium();
+  return plant.output_g(0.0, x.data());
+}
+
 }  // namespace vrelab::plant

@@ -165,5 +165,8 @@ class Accelerometer final : public OdeSystem {
 // orientation a_g), integrated for 30 slowest time constants (transient e^-30 ~ 1e-13),
 // returns U/K1 in g. Solver failures throw SolverError.
 double settled_output_g(const PlantConfig& config, const Vec3& a_g, double relative_tolerance = 1e-12);
+// Its limit without the ODE: the equilibrium (Accelerometer::equilibrium, Newton to 1e-15 of
+// the state scales) read at the output, U/K1 in g.
+double rest_output_g(const PlantConfig& config, const Vec3& a_g);
 
 }  // namespace vrelab::plant

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 namespace vrelab::rectification {
 namespace {
@@ -134,15 +135,30 @@ Eq3Terms random_rectification(const plant::Coefficients& c, const Vec3& a,
   return t;
 }
 
-Eq3Terms sine_on_random_rectification(const plant::Coefficients& c, const Vec3& a,
-                                      const vibration::SineVibration& sine, const vibration::RandomVibration& random,
-                                      std::optional<double> range_g) {
-  Eq3Terms t = sine_rectification(c, a, sine, range_g);
-  constexpr int n = 64;
+SinePhasePoints sine_phase_points(const Vec3& a, const vibration::SineVibration& sine) {
+  SinePhasePoints points;
+  constexpr int n = std::tuple_size_v<SinePhasePoints>;
   for (int k = 0; k < n; ++k) {
     const double theta = 2 * kPi * k / n;
     Vec3 shifted = a;
     for (int i = 0; i < 3; ++i) shifted[i] += sine.amplitude_g[i] * std::sin(theta + sine.phase_rad[i]);
+    points[static_cast<std::size_t>(k)] = shifted;
+  }
+  return points;
+}
+
+Eq3Terms sine_on_random_rectification(const plant::Coefficients& c, const Vec3& a,
+                                      const vibration::SineVibration& sine, const vibration::RandomVibration& random,
+                                      std::optional<double> range_g) {
+  return sine_on_random_rectification(c, a, sine, sine_phase_points(a, sine), random, range_g);
+}
+
+Eq3Terms sine_on_random_rectification(const plant::Coefficients& c, const Vec3& a, const vibration::SineVibration& sine,
+                                      const SinePhasePoints& points, const vibration::RandomVibration& random,
+                                      std::optional<double> range_g) {
+  Eq3Terms t = sine_rectification(c, a, sine, range_g);
+  constexpr int n = std::tuple_size_v<SinePhasePoints>;
+  for (const Vec3& shifted : points) {
     const Eq3Terms g = random_rectification(c, shifted, random, range_g);
     for (int j = 0; j < kNumTerms; ++j) t.g[j] += g.g[j] / n;
   }

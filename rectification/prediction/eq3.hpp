@@ -62,6 +62,13 @@ Eq3Terms random_rectification(const plant::Coefficients& c, const Vec3& a_g,
 Eq3Terms sine_on_random_rectification(const plant::Coefficients& c, const Vec3& a_g,
                                       const vibration::SineVibration& sine, const vibration::RandomVibration& random,
                                       std::optional<double> range_limit_g = std::nullopt);
+// The same with the sine's 64 points a + S(theta_k) given (sine_phase_points): one set of
+// points for every coefficient of a prediction.
+using SinePhasePoints = std::array<Vec3, 64>;
+SinePhasePoints sine_phase_points(const Vec3& a_g, const vibration::SineVibration& sine);
+Eq3Terms sine_on_random_rectification(const plant::Coefficients& c, const Vec3& a_g, const vibration::SineVibration& sine,
+                                      const SinePhasePoints& points, const vibration::RandomVibration& random,
+                                      std::optional<double> range_limit_g = std::nullopt);
 
 // Eq. (3) literally as printed in the paper (in-phase amplitudes, asin without the factor
 // a, no k_PP/k_OO), for showing what the printed form returns. g.

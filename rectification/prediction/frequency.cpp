@@ -13,6 +13,8 @@
 
 #include <Eigen/Dense>
 
+#include "rectification/prediction/random.hpp"
+
 namespace vrelab::rectification {
 
 using plant::Accelerometer;
@@ -43,52 +45,125 @@ LoopResponder::LoopResponder(const PlantConfig& config, bool dc_gain) {
   // Linear: the response does not depend on the static orientation (IA up is as good as any).
   const Accelerometer plant(lin_cfg, Vec3(1, 0, 0));
   const Accelerometer::Linear lin = plant.linearise();
-  n_ = plant.size();
-  // (s I - A) x = B solved in the plant's state scales (x = S y, S = diag(state_scale)): a
-  // mechanical mode's states are ~1/w_m^2 g s^2, so unscaled A spans 1e-4 .. 1e11 and a full-pivot
-  // LU's rank threshold (eps n max|pivot|) would take real pivots for zero and return a zero response
-  // for a mode above the drive (a mode at 2.5 kHz would give |I| = 0 at 800 Hz).
-  const std::vector<double> scale = plant.state_scale();
-  sc_.resize(n_);
-  for (int k = 0; k < n_; ++k) sc_[k] = scale[static_cast<std::size_t>(k)];
-  a_scaled_ = (sc_.cwiseInverse().asDiagonal() * lin.A * sc_.asDiagonal()).cast<std::complex<double>>();
-  b_scaled_ = (sc_.cwiseInverse().asDiagonal() * lin.B).cast<std::complex<double>>();
+  const int n = plant.size();
   // The rebalance current of the linear plant: i = k G theta + (1 - k) q + w_i r, with
   // k = lead pole / lead zero (plant/accelerometer.cpp, the servo's realisation).
   const plant::Servo& sv = plant.servo();
-  lead_ratio_ = sv.lead_pole_rad_per_s / sv.lead_zero_rad_per_s;
-  gain_g_per_rad_ = sv.gain_g_per_rad;
-  integrator_rad_per_s_ = sv.integrator_rad_per_s;
+  const double lead_ratio = sv.lead_pole_rad_per_s / sv.lead_zero_rad_per_s;
+  Eigen::VectorXd current = Eigen::VectorXd::Zero(n);
+  current[Accelerometer::kTheta] = lead_ratio * sv.gain_g_per_rad;
+  current[Accelerometer::kLead] = 1 - lead_ratio;
+  current[Accelerometer::kIntegral] = sv.integrator_rad_per_s;
+  // The states the current and the angle depend on: theirs and, repeatedly, every state
+  // that enters one of them (A(i, j) != 0).
+  std::vector<bool> needed(static_cast<std::size_t>(n), false);
+  for (int k : {Accelerometer::kTheta, Accelerometer::kLead, Accelerometer::kIntegral}) needed[static_cast<std::size_t>(k)] = true;
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        if (needed[static_cast<std::size_t>(i)] && !needed[static_cast<std::size_t>(j)] && lin.A(i, j) != 0.0)
+          needed[static_cast<std::size_t>(j)] = grew = true;
+  }
+  std::vector<int> kept_states;
+  for (int k = 0; k < n; ++k)
+    if (needed[static_cast<std::size_t>(k)]) kept_states.push_back(k);
+  m_ = static_cast<int>(kept_states.size());
+  if (m_ > kMaxStates) throw std::invalid_argument("loop_response: the loop and its kept effects have more than 32 states");
+  // Scaled (x = S y): a mechanical mode's states are ~1/w_m^2 g s^2, so unscaled A spans
+  // 1e-4 .. 1e11; scaled, its entries are of the loop's rates.
+  const std::vector<double> scale = plant.state_scale();
+  for (int r = 0; r < m_; ++r) {
+    const int i = kept_states[static_cast<std::size_t>(r)];
+    const double si = scale[static_cast<std::size_t>(i)];
+    if (i == Accelerometer::kTheta) theta_ = r, angle_scale_ = si;
+    current_row_[static_cast<std::size_t>(r)] = current[i] * si;
+    for (int c = 0; c < m_; ++c) {
+      const int j = kept_states[static_cast<std::size_t>(c)];
+      a_[static_cast<std::size_t>(r * m_ + c)] = lin.A(i, j) * scale[static_cast<std::size_t>(j)] / si;
+    }
+    for (int c = 0; c < 3; ++c) b_[static_cast<std::size_t>(r * 3 + c)] = lin.B(i, c) / si;
+  }
   if (!dc_gain) return;
   // DC gain of the loop from a disturbance entering before it (an input term, a torque) to
   // the current: exactly 1 with the integrator, L0 / (1 + L0) without (L0 = b G / w_p^2).
-  // Evaluated at 0.01 Hz: within O((f / f_c)^2) ~ 1e-9 of DC, and clear of the pivot
-  // threshold that the quadrature and inert states (zero poles) would hit at f = 0.
-  const Eigen::VectorXcd x_dc = solve_at(2 * std::numbers::pi * 0.01, b_scaled_.col(IA)).col(0);
-  dc_gain_ = std::abs(lead_ratio_ * gain_g_per_rad_ * x_dc[Accelerometer::kTheta] +
-                      (1 - lead_ratio_) * x_dc[Accelerometer::kLead] + integrator_rad_per_s_ * x_dc[Accelerometer::kIntegral]);
+  // Evaluated at 0.01 Hz: within O((f / f_c)^2) ~ 1e-9 of DC, and clear of a singular
+  // system at f = 0 (an inert state's zero pole).
+  std::array<std::complex<double>, 3> i_dc{}, theta_dc{};
+  solve_at(2 * std::numbers::pi * 0.01, i_dc, theta_dc);
+  dc_gain_ = std::abs(i_dc[IA]);
 }
 
-Eigen::MatrixXcd LoopResponder::solve_at(double w_solve, const Eigen::MatrixXcd& rhs) const {
-  const Eigen::MatrixXcd m = std::complex<double>(0, w_solve) * Eigen::MatrixXcd::Identity(n_, n_) - a_scaled_;
-  Eigen::MatrixXcd y = m.partialPivLu().solve(rhs);
-  return Eigen::MatrixXcd(sc_.cast<std::complex<double>>().asDiagonal() * y);
+void LoopResponder::solve_at(double w, std::array<std::complex<double>, 3>& current, std::array<std::complex<double>, 3>& angle) const {
+  // Complex numbers as (re, im) pairs of doubles: arrays of std::complex would be zeroed at
+  // every call (its constructor) for the whole capacity.
+  const int m = m_;
+  std::array<double, kMaxStates * kMaxStates> ar, ai;  // j w I - A
+  std::array<double, kMaxStates * 3> xr, xi;           // B, then the solution
+  const auto at = [m](int r, int c) { return static_cast<std::size_t>(r * m + c); };
+  const auto xt = [](int r, int c) { return static_cast<std::size_t>(r * 3 + c); };
+  for (int r = 0; r < m; ++r) {
+    for (int c = 0; c < m; ++c) ar[at(r, c)] = -a_[at(r, c)], ai[at(r, c)] = 0;
+    ai[at(r, r)] = w;
+    for (int c = 0; c < 3; ++c) xr[xt(r, c)] = b_[xt(r, c)], xi[xt(r, c)] = 0;
+  }
+  // Elimination with partial pivoting (by |Re| + |Im|, as LAPACK's zgetrf), the pivot's
+  // reciprocal kept for the back substitution.
+  std::array<double, kMaxStates> inv_r, inv_i;
+  for (int k = 0; k < m; ++k) {
+    int p = k;
+    double best = -1;
+    for (int r = k; r < m; ++r) {
+      const double s = std::abs(ar[at(r, k)]) + std::abs(ai[at(r, k)]);
+      if (s > best) best = s, p = r;
+    }
+    if (p != k) {
+      for (int c = k; c < m; ++c) std::swap(ar[at(k, c)], ar[at(p, c)]), std::swap(ai[at(k, c)], ai[at(p, c)]);
+      for (int c = 0; c < 3; ++c) std::swap(xr[xt(k, c)], xr[xt(p, c)]), std::swap(xi[xt(k, c)], xi[xt(p, c)]);
+    }
+    const double pr = ar[at(k, k)], pi = ai[at(k, k)], norm = pr * pr + pi * pi;
+    const double vr = pr / norm, vi = -pi / norm;
+    inv_r[static_cast<std::size_t>(k)] = vr, inv_i[static_cast<std::size_t>(k)] = vi;
+    for (int r = k + 1; r < m; ++r) {
+      const double er = ar[at(r, k)], ei = ai[at(r, k)];
+      if (er == 0 && ei == 0) continue;
+      const double lr = er * vr - ei * vi, li = er * vi + ei * vr;
+      for (int c = k + 1; c < m; ++c) {
+        const double ur = ar[at(k, c)], ui = ai[at(k, c)];
+        ar[at(r, c)] -= lr * ur - li * ui, ai[at(r, c)] -= lr * ui + li * ur;
+      }
+      for (int c = 0; c < 3; ++c) {
+        const double ur = xr[xt(k, c)], ui = xi[xt(k, c)];
+        xr[xt(r, c)] -= lr * ur - li * ui, xi[xt(r, c)] -= lr * ui + li * ur;
+      }
+    }
+  }
+  for (int k = m - 1; k >= 0; --k)
+    for (int c = 0; c < 3; ++c) {
+      double sr = xr[xt(k, c)], si = xi[xt(k, c)];
+      for (int j = k + 1; j < m; ++j) {
+        const double ur = ar[at(k, j)], ui = ai[at(k, j)], yr = xr[xt(j, c)], yi = xi[xt(j, c)];
+        sr -= ur * yr - ui * yi, si -= ur * yi + ui * yr;
+      }
+      const double vr = inv_r[static_cast<std::size_t>(k)], vi = inv_i[static_cast<std::size_t>(k)];
+      xr[xt(k, c)] = sr * vr - si * vi, xi[xt(k, c)] = sr * vi + si * vr;
+    }
+  for (int c = 0; c < 3; ++c) {
+    double ir = 0, ii = 0;
+    for (int r = 0; r < m; ++r) ir += current_row_[static_cast<std::size_t>(r)] * xr[xt(r, c)], ii += current_row_[static_cast<std::size_t>(r)] * xi[xt(r, c)];
+    current[static_cast<std::size_t>(c)] = {ir, ii};
+    angle[static_cast<std::size_t>(c)] = {angle_scale_ * xr[xt(theta_, c)], angle_scale_ * xi[xt(theta_, c)]};
+  }
 }
 
 LoopResponse LoopResponder::operator()(double frequency_Hz) const {
   if (!(frequency_Hz > 0)) throw std::invalid_argument("frequency_Hz must be positive");
   LoopResponse out;
-  const double w_rad = 2 * std::numbers::pi * frequency_Hz;
-  for (const auto& e : kept_)
-    for (int j = 0; j < 3; ++j) out.mechanical[static_cast<std::size_t>(j)] *= e->transmissibility(j, w_rad);
   const double w = 2 * std::numbers::pi * frequency_Hz;
-  const Eigen::MatrixXcd x = solve_at(w, b_scaled_);  // n x 3: per unit input axis
+  for (const auto& e : kept_)
+    for (int j = 0; j < 3; ++j) out.mechanical[static_cast<std::size_t>(j)] *= e->transmissibility(j, w);
+  solve_at(w, out.current, out.angle_rad);
   out.frequency_Hz = frequency_Hz;
-  for (int j = 0; j < 3; ++j) {
-    out.current[j] = lead_ratio_ * gain_g_per_rad_ * x(Accelerometer::kTheta, j) + (1 - lead_ratio_) * x(Accelerometer::kLead, j) +
-                     integrator_rad_per_s_ * x(Accelerometer::kIntegral, j);
-    out.angle_rad[j] = x(Accelerometer::kTheta, j);
-  }
   out.dc_gain = dc_gain_;
   return out;
 }
@@ -121,10 +196,15 @@ PlantConfig amplitude_linearised(const PlantConfig& config, const vibration::Sin
     for (const auto* f : films) extra += f->extra_damping_per_s(theta, d0.angle_gain_rad_per_s2_per_g);
     return zeta0 + extra / two_wp;
   };
+  // The loop at any damping from the loop at zeta0 and twice it (damped_response: the damping
+  // is a rank-one term of the plant's linear part), each plant linearised once.
+  PlantConfig twice = out;
+  twice.dynamics.pendulum_damping_ratio *= 2;
+  const LoopResponse at_zeta0 = LoopResponder(out, false)(v.frequency_Hz);  // (the angle only: no DC gain)
+  const LoopResponse at_twice = LoopResponder(twice, false)(v.frequency_Hz);
   double zeta = zeta0;
   for (int it = 0; it < 200; ++it) {
-    out.dynamics.pendulum_damping_ratio = zeta;
-    const LoopResponse r = LoopResponder(out, false)(v.frequency_Hz);  // (the angle only: no DC gain)
+    const LoopResponse r = damped_response(at_zeta0, at_twice, zeta / zeta0 - 1);
     const double theta = std::abs(r.angle_rad[0] * w[0] + r.angle_rad[1] * w[1] + r.angle_rad[2] * w[2]);
     const double updated = 0.5 * (zeta + zeta_at(theta));  // damped: the angle falls as the damping rises
     if (std::abs(updated - zeta) < 1e-10 * zeta) {

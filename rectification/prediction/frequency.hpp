@@ -87,18 +87,31 @@ LoopResponse loop_response(const plant::PlantConfig& plant, double frequency_Hz)
 // same at every frequency, solved once): responder(f) equals loop_response(plant, f) bit for
 // bit (loop_response is this). With dc_gain false, the responses' dc_gain is left at 1 (for a
 // caller that needs the current and the angle only).
+//
+// (j w I - A) x = B is solved on the states the current and the angle depend on (the loop's
+// and a kept effect's: the quadrature and the anti-alias filter only follow the output), in
+// the plant's state scales, by Gaussian elimination with partial pivoting on a stack array:
+// the reduced system is the full one's rows for those states exactly (no other state enters
+// them), so only the rounding differs from solving the whole.
 class LoopResponder {
  public:
   explicit LoopResponder(const plant::PlantConfig& plant, bool dc_gain = true);
   LoopResponse operator()(double frequency_Hz) const;
 
+  static constexpr int kMaxStates = 32;  // of the reduced system (the loop's 4 and the kept effects')
+
  private:
   std::vector<std::shared_ptr<const plant::Effect>> kept_;  // the linear effects (their transmissibility)
-  Eigen::VectorXd sc_;
-  Eigen::MatrixXcd a_scaled_, b_scaled_;
-  int n_ = 0;
-  double lead_ratio_ = 0, gain_g_per_rad_ = 0, integrator_rad_per_s_ = 0, dc_gain_ = 1;
-  Eigen::MatrixXcd solve_at(double w_solve, const Eigen::MatrixXcd& rhs) const;
+  // The reduced system, scaled (x = S y, S = diag(state scale)): m states, A (m x m, row-major)
+  // and B (m x 3); the current's row c (i = c . y) and the angle's place and scale.
+  int m_ = 0, theta_ = 0;
+  double angle_scale_ = 1;
+  std::array<double, kMaxStates * kMaxStates> a_{};
+  std::array<double, kMaxStates * 3> b_{};
+  std::array<double, kMaxStates> current_row_{};
+  double dc_gain_ = 1;
+  // The current and the angle per unit input on each axis at w (rad/s).
+  void solve_at(double w_rad_per_s, std::array<std::complex<double>, 3>& current, std::array<std::complex<double>, 3>& angle) const;
 };
 // The same prediction with the response given (its frequency must be v's).
 FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,

@@ -192,19 +192,7 @@ std::complex<double> rho_minus_one(const LoopResponse& at_zeta0, const LoopRespo
 }
 }  // namespace
 
-namespace {
-// One quadrature point of a random part through the loop: its frequency, its weight (df), the
-// responses' transfer to each input axis (rows: F_IA, F_PA, F_OA, I, Theta) and the input's
-// cross-spectral density (turned).
-using ResponseRows = Eigen::Matrix<std::complex<double>, 5, 3>;
-using PointVisitor = std::function<void(double f, double weight, const ResponseRows& hm, const Eigen::Matrix3cd& s)>;
-
-// Visits the quadrature points of random_response (the band's knots, the pieces, the rule) in
-// order, skipping those where the input has no power; returns the band (from, to).
-std::pair<double, double> for_each_point(const vibration::RandomProfile& p, const ResponseAt& response, const RandomQuadrature& q,
-                                         const Eigen::Matrix3d& turn, const PointVisitor& visit, double& dc_gain) {
-  if (!turn.allFinite()) throw std::invalid_argument("random_response: turn must be finite");
-  const bool turned = !turn.isIdentity(0.0);
+RandomGrid random_grid(const vibration::RandomProfile& p, const RandomQuadrature& q) {
   const PreparedTables tables = prepared_tables(p);
   if (!(q.max_log_step > 0)) throw std::invalid_argument("random_response: max_log_step must be positive");
   // Every table's breakpoints: the PSD is a power law between them (smooth in ln f), and
@@ -222,12 +210,13 @@ std::pair<double, double> for_each_point(const vibration::RandomProfile& p, cons
   }
   std::sort(knots.begin(), knots.end());
   knots.erase(std::unique(knots.begin(), knots.end()), knots.end());
-  const double from_Hz = knots.front(), to_Hz = knots.back();
+  RandomGrid grid;
+  grid.from_Hz = knots.front(), grid.to_Hz = knots.back();
   if (q.common_grid && !p.measured) {  // the global grid exp(k h), cut at the band's ends only
-    const double h = q.max_log_step, l0 = std::log(from_Hz), l1 = std::log(to_Hz);
-    knots = {from_Hz};
+    const double h = q.max_log_step, l0 = std::log(grid.from_Hz), l1 = std::log(grid.to_Hz);
+    knots = {grid.from_Hz};
     for (double k = std::floor(l0 / h) + 1; k * h < l1; ++k) knots.push_back(std::exp(k * h));
-    knots.push_back(to_Hz);
+    knots.push_back(grid.to_Hz);
   }
   for (std::size_t k = 0; k + 1 < knots.size(); ++k) {
     const double l0 = std::log(knots[k]), l1 = std::log(knots[k + 1]);
@@ -247,63 +236,117 @@ std::pair<double, double> for_each_point(const vibration::RandomProfile& p, cons
       for (std::size_t n = 0; n < points; ++n) {
         const double f = std::exp(mid + 0.5 * h * (two ? kGl2X[n] : kGlX[n]));
         const double weight = 0.5 * h * (two ? kGl2W[n] : kGlW[n]) * f;  // df = f d(ln f)
-        Eigen::Matrix3cd s = cross_spectral_matrix(p, tables, f);
-        if (turned) s = turn * s * turn.transpose();
-        if (s.isZero(0.0)) continue;
-        const LoopResponse r = response(f);
-        // Rows: the responses' transfer to each input axis.
-        ResponseRows hm = ResponseRows::Zero();
-        for (int j = 0; j < 3; ++j) {
-          const auto sj = static_cast<std::size_t>(j);
-          hm(j, j) = r.mechanical[sj];
-          hm(RandomResponse::kCurrent, j) = r.current[sj];
-          hm(RandomResponse::kAngle, j) = r.angle_rad[sj];
-        }
-        visit(f, weight, hm, s);
-        dc_gain = r.dc_gain;
+        grid.frequency_Hz.push_back(f);
+        grid.weight_Hz.push_back(weight);
+        grid.csd_g2_per_Hz.push_back(cross_spectral_matrix(p, tables, f));
       }
     }
   }
-  return {from_Hz, to_Hz};
+  return grid;
 }
 
+RandomGrid turned_grid(const RandomGrid& grid, const Eigen::Matrix3d& turn) {
+  if (!turn.allFinite()) throw std::invalid_argument("random_response: turn must be finite");
+  const bool turned = !turn.isIdentity(0.0);
+  RandomGrid out;
+  out.from_Hz = grid.from_Hz, out.to_Hz = grid.to_Hz;
+  for (std::size_t k = 0; k < grid.frequency_Hz.size(); ++k) {
+    Eigen::Matrix3cd s = grid.csd_g2_per_Hz[k];
+    if (turned) s = turn * s * turn.transpose();
+    if (s.isZero(0.0)) continue;
+    out.frequency_Hz.push_back(grid.frequency_Hz[k]);
+    out.weight_Hz.push_back(grid.weight_Hz[k]);
+    out.csd_g2_per_Hz.push_back(s);
+  }
+  return out;
+}
+
+namespace {
+// One quadrature point's share of the covariances: the responses' transfer to each input axis
+// (rows: F_IA, F_PA, F_OA, I, Theta) times the input's cross-spectral density. The weighted
+// share w H S H^H is returned (complex) for damped_random_spectrum.
+using ResponseRows = Eigen::Matrix<std::complex<double>, 5, 3>;
+ResponseRows response_rows(const LoopResponse& r) {
+  ResponseRows hm = ResponseRows::Zero();
+  for (int j = 0; j < 3; ++j) {
+    const auto sj = static_cast<std::size_t>(j);
+    hm(j, j) = r.mechanical[sj];
+    hm(RandomResponse::kCurrent, j) = r.current[sj];
+    hm(RandomResponse::kAngle, j) = r.angle_rad[sj];
+  }
+  return hm;
+}
+// C_yz = integral Re(sum_ij H_yi S_ij conj(H_zj)) df: the response y's spectrum row H_y X, its
+// cross-spectrum with z is H_y S H_z^H; a real signal's covariance is the real part of the
+// one-sided cross-spectrum's integral.
+//
+// H's felt rows are diagonal (F_i = T_i x_i), so of H S H^H's terms only those with a nonzero
+// factor are summed: T = H S is T_i. = T_i S_i. on the felt rows, and (H S H^H)_ab =
+// sum_k T_ak conj(H_bk) has one term for a felt b. The terms left out are exact zeros.
+void add_point(RandomResponse& out, double weight, const LoopResponse& r, const Eigen::Matrix3cd& s) {
+  using C = std::complex<double>;
+  ++out.frequencies;
+  std::array<std::array<C, 3>, 5> h{}, t{};  // H and H S, rows F_IA, F_PA, F_OA, I, Theta
+  for (std::size_t j = 0; j < 3; ++j) {
+    h[j][j] = r.mechanical[j];
+    h[RandomResponse::kCurrent][j] = r.current[j];
+    h[RandomResponse::kAngle][j] = r.angle_rad[j];
+  }
+  for (std::size_t a = 0; a < 5; ++a)
+    for (std::size_t b = 0; b < 3; ++b)
+      t[a][b] = a < 3 ? h[a][a] * s(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b))
+                      : h[a][0] * s(0, static_cast<Eigen::Index>(b)) +
+                            (h[a][1] * s(1, static_cast<Eigen::Index>(b)) + h[a][2] * s(2, static_cast<Eigen::Index>(b)));
+  for (std::size_t a = 0; a < 5; ++a)
+    for (std::size_t b = 0; b < 5; ++b) {
+      const double re = b < 3 ? (t[a][b] * std::conj(h[b][b])).real()
+                              : (t[a][0] * std::conj(h[b][0]) + (t[a][1] * std::conj(h[b][1]) + t[a][2] * std::conj(h[b][2]))).real();
+      out.covariance(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) += weight * re;
+    }
+  out.input_covariance_g2 += weight * s.real();
+  out.dc_gain = r.dc_gain;
+}
 }  // namespace
 
 RandomResponse random_response(const vibration::RandomProfile& p, const ResponseAt& response, const RandomQuadrature& q,
                                const Eigen::Matrix3d& turn) {
+  const RandomGrid grid = turned_grid(random_grid(p, q), turn);
   RandomResponse out;
-  const auto band = for_each_point(
-      p, response, q, turn,
-      [&out](double, double weight, const ResponseRows& hm, const Eigen::Matrix3cd& s) {
-        ++out.frequencies;
-        // C_yz = integral Re(sum_ij H_yi S_ij conj(H_zj)) df: the response y's spectrum row
-        // H_y X, its cross-spectrum with z is H_y S H_z^H; a real signal's covariance is the
-        // real part of the one-sided cross-spectrum's integral.
-        out.covariance += weight * (hm * s * hm.adjoint()).real();
-        out.input_covariance_g2 += weight * s.real();
-      },
-      out.dc_gain);
-  out.from_Hz = band.first, out.to_Hz = band.second;
+  for (std::size_t k = 0; k < grid.frequency_Hz.size(); ++k)
+    add_point(out, grid.weight_Hz[k], response(grid.frequency_Hz[k]), grid.csd_g2_per_Hz[k]);
+  out.from_Hz = grid.from_Hz, out.to_Hz = grid.to_Hz;
+  return out;
+}
+
+RandomResponse random_response(const RandomGrid& grid, const std::vector<const LoopResponse*>& responses) {
+  if (responses.size() != grid.frequency_Hz.size())
+    throw std::invalid_argument("random_response: one loop response per grid point is needed");
+  RandomResponse out;
+  for (std::size_t k = 0; k < grid.frequency_Hz.size(); ++k) add_point(out, grid.weight_Hz[k], *responses[k], grid.csd_g2_per_Hz[k]);
+  out.from_Hz = grid.from_Hz, out.to_Hz = grid.to_Hz;
   return out;
 }
 
 DampedRandomSpectrum damped_random_spectrum(const vibration::RandomProfile& p, const ResponseAt& at_zeta0, const ResponseAt& at_twice,
                                             const RandomQuadrature& q, const Eigen::Matrix3d& turn) {
+  const RandomGrid grid = turned_grid(random_grid(p, q), turn);
   DampedRandomSpectrum out;
   RandomResponse& r = out.at_zeta0;
-  const auto band = for_each_point(
-      p, at_zeta0, q, turn,
-      [&](double f, double weight, const ResponseRows& hm, const Eigen::Matrix3cd& s) {
-        ++r.frequencies;
-        const Eigen::Matrix<std::complex<double>, 5, 5> m = weight * (hm * s * hm.adjoint());
-        r.covariance += m.real();
-        r.input_covariance_g2 += weight * s.real();
-        out.frequency_Hz.push_back(f);
-        out.loop_rows.push_back(m.bottomRows<2>());
-        out.rho_minus_1.push_back(rho_minus_one(at_zeta0(f), at_twice(f)));
-      },
-      r.dc_gain);
-  r.from_Hz = band.first, r.to_Hz = band.second;
+  for (std::size_t k = 0; k < grid.frequency_Hz.size(); ++k) {
+    const double f = grid.frequency_Hz[k], weight = grid.weight_Hz[k];
+    const Eigen::Matrix3cd& s = grid.csd_g2_per_Hz[k];
+    const LoopResponse h = at_zeta0(f);
+    ++r.frequencies;
+    const ResponseRows hm = response_rows(h);
+    const Eigen::Matrix<std::complex<double>, 5, 5> m = weight * (hm * s * hm.adjoint());
+    r.covariance += m.real();
+    r.input_covariance_g2 += weight * s.real();
+    r.dc_gain = h.dc_gain;
+    out.frequency_Hz.push_back(f);
+    out.loop_rows.push_back(m.bottomRows<2>());
+    out.rho_minus_1.push_back(rho_minus_one(h, at_twice(f)));
+  }
+  r.from_Hz = grid.from_Hz, r.to_Hz = grid.to_Hz;
   return out;
 }
 
@@ -408,6 +451,7 @@ double random_linearised_damping(const PlantConfig& config, const DampedRandomSp
 namespace {
 
 using R = RandomResponse;
+using Locations = std::array<Location, kNumCoefficients>;
 
 // What the terms of (1) see of the random part: the felt motion's covariance, and the same
 // with IA the current (the loop-placed terms).
@@ -424,11 +468,11 @@ GaussianParts gaussian_parts(const RandomResponse& rr) {
 }
 
 // The output's oscillation U = I + slope . F: the slope of the output-placed cross terms.
-Vec3 readout_slope(const PlantConfig& config, const Vec3& a) {
+Vec3 readout_slope(const Coefficients& coefficients, const Locations& location, const Vec3& a) {
   Coefficients cross_out;
   cross_out[K1] = 1;
   for (int c = delta_OA; c < kNumCoefficients; ++c)
-    if (config.location[c] == Location::output) cross_out[c] = config.coefficients[c];
+    if (location[c] == Location::output) cross_out[c] = coefficients[c];
   return plant::output_gradient(cross_out, a) - Vec3::UnitX();
 }
 double readout_sigma(const RandomResponse& rr, const Vec3& slope) {
@@ -442,13 +486,13 @@ double readout_sigma(const RandomResponse& rr, const Vec3& slope) {
 // K1 = 1, and whether it sees the loop's current on IA (in the loop or at the output: k2..k4
 // not at the input).
 template <class Visit>
-void for_each_rectifying_term(const PlantConfig& config, Visit&& visit) {
+void for_each_rectifying_term(const Coefficients& coefficients, const Locations& location, Visit&& visit) {
   for (int c = k0; c < kNumCoefficients; ++c) {
-    if (c == k0 || c == delta_OA || c == delta_PA || config.coefficients[c] == 0) continue;
+    if (c == k0 || c == delta_OA || c == delta_PA || coefficients[c] == 0) continue;
     Coefficients only;
     only[K1] = 1;
-    only[c] = config.coefficients[c];
-    visit(c, only, c <= k4 && config.location[c] != Location::input);
+    only[c] = coefficients[c];
+    visit(c, only, c <= k4 && location[c] != Location::input);
   }
 }
 
@@ -506,7 +550,7 @@ FrequencyPrediction periodic_on_random(const PlantConfig& config, const Vec3& a,
   const GaussianParts g = gaussian_parts(rr);
   const double dc_gain = out.loop_dc_gain;
   const plant::Basis b0 = plant::basis(a);
-  for_each_rectifying_term(config, [&](int c, const Coefficients& only, bool filtered) {
+  for_each_rectifying_term(config.coefficients, config.location, [&](int c, const Coefficients& only, bool filtered) {
     const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
     const int term = term_of_coefficient(c);
     for (std::size_t k = 0; k < felt_at.size(); ++k) {
@@ -529,7 +573,7 @@ FrequencyPrediction periodic_on_random(const PlantConfig& config, const Vec3& a,
   out.pickoff_g += wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * c5(R::kAngle, R::kAngle);
   if (geometry) out.pendulum_geometry_g += dc_gain * (-c5(R::kF_PA, R::kAngle) - a_mean[IA] * c5(R::kAngle, R::kAngle) / 2);
   if (readout) {  // as PreparedPeriodicRectification's, with U's Gaussian part at every point
-    const Vec3 slope = readout_slope(config, a);
+    const Vec3 slope = readout_slope(config.coefficients, config.location, a);
     const double sigma_u = readout_sigma(rr, slope);
     const double u0 = plant::output_g(config.coefficients, a);
     const double u_mean = u0 + in.mean_g[IA] + slope.dot(in.mean_g);
@@ -553,13 +597,17 @@ FrequencyPrediction periodic_on_random(const PlantConfig& config, const Vec3& a,
 
 }  // namespace
 
-FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const RandomResponse& rr,
-                                                      const std::optional<PeriodicInput>& periodic, const ResponseAt& response,
-                                                      std::optional<double> range_g) {
+PreparedRandomRectification::PreparedRandomRectification(const PlantConfig& config, const Vec3& a, const RandomResponse& rr,
+                                                         const std::optional<PeriodicInput>& periodic, const ResponseAt& response,
+                                                         std::optional<double> range_g)
+    : config_(config), a_(a), rr_(rr) {
   if (periodic && !response) throw std::invalid_argument("random_rectification_at_frequency: a periodic part needs the loop's response");
   if (periodic && !(periodic->frequency_Hz > 0))
     throw std::invalid_argument("random_rectification_at_frequency: the periodic part's frequency_Hz must be positive");
-  if (periodic && !periodic->single_tone()) return periodic_on_random(config, a, rr, *periodic, response);
+  if (periodic && !periodic->single_tone()) {  // several tones: periodic_on_random at each call
+    periodic_ = *periodic, response_ = response;
+    return;
+  }
   // Random alone, or a single tone on it (the sine's terms in closed form, eq3.hpp).
   std::optional<vibration::SineVibration> sine;
   std::optional<LoopResponse> sine_response;
@@ -578,66 +626,80 @@ FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config,
   }
   const auto& c5 = rr.covariance;
   const GaussianParts parts = gaussian_parts(rr);
-  const vibration::RandomVibration &felt = parts.felt, &through_loop = parts.through_loop;
+  felt_ = parts.felt, through_loop_ = parts.through_loop;
 
   // The sine, as in sine_rectification_at_frequency.
-  vibration::SineVibration sine_felt, sine_loop;
   Eigen::Vector3cd Fs = Eigen::Vector3cd::Zero();
   std::complex<double> Is = 0.0, Ths = 0.0;
   if (sine) {
     const LoopResponse& h = *sine_response;
-    sine_felt = *sine;
+    sine_felt_ = *sine;
     for (int i = 0; i < 3; ++i) {
       const auto si = static_cast<std::size_t>(i);
       const std::complex<double> W = std::polar(sine->amplitude_g[i], sine->phase_rad[i]);
       Fs[i] = h.mechanical[si] * W;
       Is += h.current[si] * W;
       Ths += h.angle_rad[si] * W;
-      sine_felt.amplitude_g[i] = std::abs(Fs[i]);
-      sine_felt.phase_rad[i] = std::arg(Fs[i]);
+      sine_felt_.amplitude_g[i] = std::abs(Fs[i]);
+      sine_felt_.phase_rad[i] = std::arg(Fs[i]);
     }
-    sine_loop = sine_felt;
-    sine_loop.amplitude_g[IA] = std::abs(Is);
-    sine_loop.phase_rad[IA] = std::arg(Is);
+    sine_loop_ = sine_felt_;
+    sine_loop_.amplitude_g[IA] = std::abs(Is);
+    sine_loop_.phase_rad[IA] = std::arg(Is);
+    // The sine's phase points once for every term and call (the same numbers as each term's own).
+    points_felt_ = sine_phase_points(a, sine_felt_), points_loop_ = sine_phase_points(a, sine_loop_);
   }
-  const double dc_gain = sine ? sine_response->dc_gain : rr.dc_gain;
-  FrequencyPrediction out;
-  out.loop_dc_gain = dc_gain;
-  out.current_amplitude_g = Is;
-  out.angle_amplitude_rad = Ths;
-  for_each_rectifying_term(config, [&](int c, const Coefficients& only, bool filtered) {
-    const Eq3Terms t = sine ? sine_on_random_rectification(only, a, filtered ? sine_loop : sine_felt,
-                                                           filtered ? through_loop : felt)
-                            : random_rectification(only, a, filtered ? through_loop : felt);
-    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
-    for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
-  });
+  Fs_ = Fs, Is_ = Is;
+  dc_gain_ = sine ? sine_response->dc_gain : rr.dc_gain;
+  fixed_.loop_dc_gain = dc_gain_;
+  fixed_.current_amplitude_g = Is;
+  fixed_.angle_amplitude_rad = Ths;
   if (range_g) {
     Coefficients unit;
     unit[K1] = 1;
-    const Eq3Terms t = sine ? sine_on_random_rectification(unit, a, sine_loop, through_loop, range_g)
-                            : random_rectification(unit, a, through_loop, range_g);
-    out.terms.g[t_clipping] = t.g[t_clipping];
+    const Eq3Terms t = sine ? sine_on_random_rectification(unit, a, sine_loop_, *points_loop_, through_loop_, range_g)
+                            : random_rectification(unit, a, through_loop_, range_g);
+    clipping_g_ = t.g[t_clipping];
   }
   // Effects beyond (1): second moments of the angle (the sine's and the random's add).
   const Dynamics& d = config.dynamics;
   const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
   const double theta2 = c5(R::kAngle, R::kAngle) + std::norm(Ths) / 2;
   const double pa_theta = c5(R::kF_PA, R::kAngle) + std::real(Fs[PA] * std::conj(Ths)) / 2;
-  out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * theta2;
-  if (geometry) out.pendulum_geometry_g = dc_gain * (-pa_theta - a[IA] * theta2 / 2);
+  fixed_.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * theta2;
+  if (geometry) fixed_.pendulum_geometry_g = dc_gain_ * (-pa_theta - a[IA] * theta2 / 2);
+}
+
+FrequencyPrediction PreparedRandomRectification::operator()(const Coefficients& coefficients) const {
+  if (periodic_) {
+    PlantConfig q = config_;
+    q.coefficients = coefficients;
+    return periodic_on_random(q, a_, rr_, *periodic_, response_);
+  }
+  const bool sine = points_felt_.has_value();
+  const Vec3& a = a_;
+  const vibration::RandomVibration &felt = felt_, &through_loop = through_loop_;
+  FrequencyPrediction out = fixed_;
+  for_each_rectifying_term(coefficients, config_.location, [&](int c, const Coefficients& only, bool filtered) {
+    const Eq3Terms t = sine ? sine_on_random_rectification(only, a, filtered ? sine_loop_ : sine_felt_,
+                                                           filtered ? *points_loop_ : *points_felt_, filtered ? through_loop : felt)
+                            : random_rectification(only, a, filtered ? through_loop : felt);
+    const double gain = config_.location[c] == Location::output ? 1.0 : dc_gain_;
+    for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
+  });
+  if (clipping_g_) out.terms.g[t_clipping] = *clipping_g_;
   // A readout polynomial: E over the output's Gaussian part (Gauss-Hermite), averaged over the
   // sine's phase (32 points: exact for a trigonometric polynomial of degree < 32).
   bool readout = false;
-  for (const auto& e : config.effects) readout = readout || e->readout_averaged_in_prediction();
+  for (const auto& e : config_.effects) readout = readout || e->readout_averaged_in_prediction();
   if (readout) {
-    const Vec3 slope = readout_slope(config, a);
-    const double sigma_u = readout_sigma(rr, slope);
-    const std::complex<double> Us = Is + slope[IA] * Fs[IA] + slope[PA] * Fs[PA] + slope[OA] * Fs[OA];
-    const double u0 = plant::output_g(config.coefficients, a);
+    const Vec3 slope = readout_slope(coefficients, config_.location, a);
+    const double sigma_u = readout_sigma(rr_, slope);
+    const std::complex<double> Us = Is_ + slope[IA] * Fs_[IA] + slope[PA] * Fs_[PA] + slope[OA] * Fs_[OA];
+    const double u0 = plant::output_g(coefficients, a);
     const HermiteRule& gh = hermite_rule();
     const int phases = sine ? 32 : 1;
-    for (const auto& e : config.effects) {
+    for (const auto& e : config_.effects) {
       if (!e->readout_averaged_in_prediction()) continue;
       double mean = 0;
       for (int k = 0; k < phases; ++k) {
@@ -648,6 +710,12 @@ FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config,
     }
   }
   return out;
+}
+
+FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const RandomResponse& rr,
+                                                      const std::optional<PeriodicInput>& periodic, const ResponseAt& response,
+                                                      std::optional<double> range_g) {
+  return PreparedRandomRectification(config, a, rr, periodic, response, range_g)(config.coefficients);
 }
 
 FrequencyPrediction random_rectification_at_frequency(const PlantConfig& plant, const Vec3& a, const vibration::RandomProfile& p,

@@ -34,6 +34,7 @@
 // (random_linearised_damping below), the film's harmonics and the angle's departure from a Gaussian
 // left out. Not modelled: clipping beyond the current's Gaussian (range limit of I).
 #include <optional>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -81,6 +82,21 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
 RandomResponse random_response(const plant::PlantConfig& plant, const vibration::RandomProfile& p,
                                const RandomQuadrature& q = {});
 
+// random_response in steps, for many loops and turns of one motion (a diagnosis' hypotheses):
+// the quadrature points (the band's knots, the pieces, the rule; each point's frequency,
+// weight df and the input's cross-spectral density); the same turned, the points where the
+// turned input has no power dropped; then the covariances of a loop given its response at
+// each point (responses[k] at frequency_Hz[k]). random_response(turned_grid(random_grid(p, q),
+// turn), responses) is random_response(p, response, q, turn): the same numbers.
+struct RandomGrid {
+  std::vector<double> frequency_Hz, weight_Hz;
+  std::vector<Eigen::Matrix3cd> csd_g2_per_Hz;
+  double from_Hz = 0, to_Hz = 0;  // the band
+};
+RandomGrid random_grid(const vibration::RandomProfile& p, const RandomQuadrature& q = {});
+RandomGrid turned_grid(const RandomGrid& grid, const Eigen::Matrix3d& turn);
+RandomResponse random_response(const RandomGrid& grid, const std::vector<const LoopResponse*>& responses);
+
 // A random part through the loop at damping zeta0 (at_zeta0) kept so that its covariances at
 // any other damping follow without a loop response (random_response_at_damping): per
 // quadrature point, the current's and the angle's rows of w H S H^H (the point's share of the
@@ -127,6 +143,33 @@ FrequencyPrediction random_rectification_at_frequency(const plant::PlantConfig& 
                                                       const std::optional<PeriodicInput>& periodic = std::nullopt,
                                                       const ResponseAt& response = nullptr,
                                                       std::optional<double> range_limit_g = std::nullopt);
+
+// The same for many coefficient sets of one plant (its dynamics, locations and effects; a
+// diagnosis' gradient): what does not depend on the coefficients (the sine through the loop,
+// the Gaussian parts, the sine's phase points, the angle's moments) computed once.
+// prepared(plant.coefficients) is random_rectification_at_frequency(plant, ...): the same numbers.
+class PreparedRandomRectification {
+ public:
+  PreparedRandomRectification(const plant::PlantConfig& plant, const Vec3& a_static_g, const RandomResponse& random,
+                              const std::optional<PeriodicInput>& periodic = std::nullopt, const ResponseAt& response = nullptr,
+                              std::optional<double> range_limit_g = std::nullopt);
+  FrequencyPrediction operator()(const plant::Coefficients& c) const;
+
+ private:
+  plant::PlantConfig config_;
+  Vec3 a_;
+  RandomResponse rr_;
+  std::optional<PeriodicInput> periodic_;  // several tones (periodic_on_random at each call)
+  ResponseAt response_;
+  vibration::RandomVibration felt_, through_loop_;  // what the terms of (1) see of the random part
+  vibration::SineVibration sine_felt_, sine_loop_;
+  std::optional<SinePhasePoints> points_felt_, points_loop_;  // with a sine
+  Eigen::Vector3cd Fs_ = Eigen::Vector3cd::Zero();
+  std::complex<double> Is_ = 0.0;
+  double dc_gain_ = 1;
+  std::optional<double> clipping_g_;
+  FrequencyPrediction fixed_;  // the parts independent of the coefficients
+};
 
 // Convenience: the loop responses computed here.
 FrequencyPrediction random_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,

@@ -15,20 +15,21 @@ using plant::Coefficients;
 using plant::PlantConfig;
 
 namespace {
-// The fit to the plant's own settled readings (the "without" of taken_up_by_static_test; the
-// same for every effect: diagnose computes it once).
-Coefficients settled_fit(const PlantConfig& plant, const std::vector<Position>& positions, const std::vector<double>& weights,
+// The fit to the plant's own readings at rest (the "without" of taken_up_by_static_test; the
+// same for every effect: diagnose computes it once). A reading is the plant's equilibrium at
+// the position (plant::rest_output_g: what a static test settles to, without the ODE).
+Coefficients rest_fit(const PlantConfig& plant, const std::vector<Position>& positions, const std::vector<double>& weights,
                          const FixedSet& fixed) {
   std::vector<Reading> readings;
   const double K1 = plant.coefficients[plant::K1];
-  // A position read more than once (a static test's repeats) is settled once: the same plant
-  // at the same orientation settles to the same number.
-  std::map<std::array<double, 3>, double> settled;
+  // A position read more than once (a static test's repeats) is solved once: the same plant
+  // at the same orientation rests at the same number.
+  std::map<std::array<double, 3>, double> at_rest;
   for (std::size_t i = 0; i < positions.size(); ++i) {
     const Vec3& g = positions[i].nominal_g;
     const std::array<double, 3> at{g[0], g[1], g[2]};
-    auto it = settled.find(at);
-    if (it == settled.end()) it = settled.emplace(at, plant::settled_output_g(plant, g)).first;
+    auto it = at_rest.find(at);
+    if (it == at_rest.end()) it = at_rest.emplace(at, plant::rest_output_g(plant, g)).first;
     readings.push_back({static_cast<int>(i), K1 * it->second});
   }
   return least_squares(positions, readings, weights, fixed).estimate.value;
@@ -41,8 +42,8 @@ Coefficients taken_up_given_base(const Effect& e, const PlantConfig& plant, cons
   TableMotion unused;
   e.apply(e.fitted().unit_value, with, unused);
   // Least squares is linear in the readings: the difference of the fits to the plant's
-  // settled readings with and without the effect.
-  const Coefficients m = settled_fit(with, positions, weights, fixed);
+  // readings at rest with and without the effect.
+  const Coefficients m = rest_fit(with, positions, weights, fixed);
   Coefficients diff;
   for (int i = 0; i < plant::kNumCoefficients; ++i) diff[i] = (m[i] - b[i]) / (e.fitted().unit_value - e.fitted().nominal);
   return diff;
@@ -52,7 +53,7 @@ Coefficients taken_up_given_base(const Effect& e, const PlantConfig& plant, cons
 Coefficients taken_up_by_static_test(const Effect& e, const PlantConfig& plant, const std::vector<Position>& positions,
                                      const std::vector<double>& weights, const FixedSet& fixed) {
   if (!e.fitted().linear) throw std::logic_error("diagnose: " + e.name + " acts at rest but is not linear");
-  return taken_up_given_base(e, plant, positions, weights, fixed, settled_fit(plant, positions, weights, fixed));
+  return taken_up_given_base(e, plant, positions, weights, fixed, rest_fit(plant, positions, weights, fixed));
 }
 
 namespace internal {
@@ -119,7 +120,7 @@ void nominal_model(const Identified& id, CampaignModel& m) {
     if (!e.acts_at_rest) continue;
     auto it = cache.absorbed_.find(e.name);
     if (it == cache.absorbed_.end()) {
-      if (!base_fit) base_fit = settled_fit(plant, positions, weights, c.fixed);
+      if (!base_fit) base_fit = rest_fit(plant, positions, weights, c.fixed);
       it = cache.absorbed_.emplace(e.name, taken_up_given_base(e, plant, positions, weights, c.fixed, *base_fit)).first;
     }
     absorbed[e.name] = it->second;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <numbers>
 #include <stdexcept>
+#include <vector>
 
 namespace vrelab::validation::internal {
 
@@ -14,7 +15,7 @@ void ResponseCache::bind(const PlantConfig& plant) {
   const bool same = bound_ && plant.coefficients.v == plant_.coefficients.v && key(plant.dynamics) == key(plant_.dynamics);
   if (same) return;
   plant_ = plant, bound_ = true;
-  tables_.clear(), absorbed_.clear(), cache_.clear(), responders_.clear(), random_.clear();
+  tables_.clear(), absorbed_.clear(), cache_.clear(), responders_.clear(), random_.clear(), grids_.clear(), damped_.clear();
 }
 
 std::string ResponseCache::random_key(const std::string& key, const vibration::RandomProfile& p, const Eigen::Matrix3d& turn,
@@ -39,13 +40,19 @@ std::string ResponseCache::random_key(const std::string& key, const vibration::R
   return k;
 }
 
-const rectification::RandomResponse& ResponseCache::random_response(const std::string& key, const vibration::RandomProfile& p,
-                                                                    const Eigen::Matrix3d& turn,
-                                                                    const rectification::RandomQuadrature& q,
-                                                                    const rectification::ResponseAt& h) {
-  // (h asks get() for the responses: made without the lock.)
+const rectification::RandomResponse& ResponseCache::random_response(const PlantConfig& cfg, const std::string& key,
+                                                                    const vibration::RandomProfile& p, const Eigen::Matrix3d& turn,
+                                                                    const rectification::RandomQuadrature& q) {
+  // (Made without the lock: the grid and the responses take it for their look-ups.)
   return find_or_make(mutex_, random_, random_key(key, p, turn, q),
-                      [&] { return RandomEntry{p.measured, rectification::random_response(p, h, q, turn)}; })
+                      [&] {
+                        const rectification::RandomGrid grid = rectification::turned_grid(
+                            find_or_make(mutex_, grids_, random_key(std::string(), p, Eigen::Matrix3d::Identity(), q),
+                                         [&] { return GridEntry{p.measured, rectification::random_grid(p, q)}; })
+                                .grid,
+                            turn);
+                        return RandomEntry{p.measured, rectification::random_response(grid, responses(cfg, key, grid.frequency_Hz))};
+                      })
       .response;
 }
 
@@ -80,16 +87,40 @@ const rectification::LoopResponse& ResponseCache::get(const PlantConfig& cfg, co
   }
   // Computed without the lock, so that other threads' look-ups go on meanwhile.
   if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
-  rectification::LoopResponse response;
-  if (cfg.servo) {
-    response = responder(cfg, key)(f);
-  } else {
-    PlantConfig with_servo = cfg;
-    with_servo.servo = servo(cfg.dynamics);
-    response = responder(with_servo, key)(f);
-  }
+  rectification::LoopResponse response = responder_with_servo(cfg, key)(f);
   const std::lock_guard<std::mutex> g(mutex_);
   return cache_[key].try_emplace(f, std::move(response)).first->second;
+}
+
+std::vector<const rectification::LoopResponse*> ResponseCache::responses(const PlantConfig& cfg, const std::string& key,
+                                                                         const std::vector<double>& frequency_Hz) {
+  std::vector<const rectification::LoopResponse*> out(frequency_Hz.size(), nullptr);
+  std::vector<std::size_t> missing;
+  {
+    const std::lock_guard<std::mutex> g(mutex_);
+    const auto by_key = cache_.find(key);
+    for (std::size_t k = 0; k < frequency_Hz.size(); ++k) {
+      if (by_key != cache_.end())
+        if (const auto it = by_key->second.find(frequency_Hz[k]); it != by_key->second.end()) {
+          out[k] = &it->second;
+          continue;
+        }
+      missing.push_back(k);
+    }
+  }
+  if (missing.empty()) return out;
+  std::vector<rectification::LoopResponse> computed;
+  computed.reserve(missing.size());
+  const rectification::LoopResponder& responder = responder_with_servo(cfg, key);
+  for (const std::size_t k : missing) {
+    if (!(frequency_Hz[k] > 0)) throw std::invalid_argument("frequency_Hz must be positive");
+    computed.push_back(responder(frequency_Hz[k]));
+  }
+  const std::lock_guard<std::mutex> g(mutex_);
+  auto& by_f = cache_[key];
+  for (std::size_t m = 0; m < missing.size(); ++m)
+    out[missing[m]] = &by_f.try_emplace(frequency_Hz[missing[m]], std::move(computed[m])).first->second;
+  return out;
 }
 
 ResponseCache::DynamicsKey ResponseCache::key(const plant::Dynamics& d) {
@@ -121,6 +152,13 @@ std::vector<double> ResponseCache::linear_part(const PlantConfig& cfg) {
       }
     }
   return v;
+}
+
+const rectification::LoopResponder& ResponseCache::responder_with_servo(const PlantConfig& cfg, const std::string& key) {
+  if (cfg.servo) return responder(cfg, key);
+  PlantConfig with_servo = cfg;
+  with_servo.servo = servo(cfg.dynamics);
+  return responder(with_servo, key);
 }
 
 const rectification::LoopResponder& ResponseCache::responder(const PlantConfig& cfg, const std::string& key) {

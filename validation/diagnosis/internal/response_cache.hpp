@@ -78,13 +78,14 @@ class ResponseCache {
   const rectification::LoopResponse& get(const plant::PlantConfig& cfg, const std::string& key, double f);
 
   // A random part's covariances through the loop (rectification::random_response of `p`,
-  // turned by `turn`, with the responses `h` of `key`), computed once per (key, profile, turn,
-  // quadrature): every table of an effect that leaves the dynamics alone (the empty key), at
-  // every value, gradient point and fold, takes the same one. `h` must be get(., key, .): the
-  // responses are fixed per key, so the result is the same numbers as computed afresh.
-  const rectification::RandomResponse& random_response(const std::string& key, const vibration::RandomProfile& p,
-                                                       const Eigen::Matrix3d& turn, const rectification::RandomQuadrature& q,
-                                                       const rectification::ResponseAt& h);
+  // turned by `turn`, with the responses get(cfg, key, .)), computed once per (key, profile,
+  // turn, quadrature): every table of an effect that leaves the dynamics alone (the empty key),
+  // at every value, gradient point and fold, takes the same one. The quadrature's points are
+  // kept per (profile, quadrature), turned per call, and the responses asked for all at once (one look-up
+  // of the key, the plant linearised once): the same numbers as computed afresh.
+  const rectification::RandomResponse& random_response(const plant::PlantConfig& cfg, const std::string& key,
+                                                       const vibration::RandomProfile& p, const Eigen::Matrix3d& turn,
+                                                       const rectification::RandomQuadrature& q);
   // The same kept for any damping of a film (rectification::damped_random_spectrum, h and
   // h_twice the responses of `key` without the film and with its damping doubled): every
   // value of the film and every table take the same one per run.
@@ -102,6 +103,11 @@ class ResponseCache {
   // What loop_response reads of a plant (with its servo).
   static std::vector<double> linear_part(const plant::PlantConfig& cfg);
   const rectification::LoopResponder& responder(const plant::PlantConfig& cfg, const std::string& key);
+  // The same with the servo cfg's dynamics imply when cfg has none (servo()).
+  const rectification::LoopResponder& responder_with_servo(const plant::PlantConfig& cfg, const std::string& key);
+  // get(cfg, key, f) for every f, the key looked up once and the missing ones computed together.
+  std::vector<const rectification::LoopResponse*> responses(const plant::PlantConfig& cfg, const std::string& key,
+                                                            const std::vector<double>& frequency_Hz);
   std::map<std::string, std::map<double, rectification::LoopResponse>, std::less<>> cache_;
   std::map<std::pair<std::string, std::vector<double>>, std::unique_ptr<rectification::LoopResponder>> responders_;
   std::map<DynamicsKey, plant::Servo> servos_;
@@ -112,6 +118,11 @@ class ResponseCache {
     rectification::RandomResponse response;
   };
   std::map<std::string, RandomEntry, std::less<>> random_;
+  struct GridEntry {
+    std::shared_ptr<const vibration::CrossSpectralMatrix> measured;
+    rectification::RandomGrid grid;
+  };
+  std::map<std::string, GridEntry, std::less<>> grids_;
   struct DampedEntry {
     std::shared_ptr<const vibration::CrossSpectralMatrix> measured;
     rectification::DampedRandomSpectrum spectrum;

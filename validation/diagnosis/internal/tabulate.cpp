@@ -207,9 +207,10 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     std::optional<rectification::RandomResponse> rr;
     std::optional<rectification::PeriodicInput> sine;
     if (r.random) {
-      // (A film's are this run's and value's own.)
+      // (A film's are this run's and value's own; without a film a random run's plant is
+      // cfg, whose responses h takes from the cache: !own.)
       rr = film ? rectification::random_response_at_damping(*film_spectrum, film->x())
-                : cache.random_response(key, run_random(r), m.random_turn, kRandomRunQuadrature, h);
+                : cache.random_response(cfg, key, run_random(r), m.random_turn, kRandomRunQuadrature);
       if (r.sine_part) sine = motion_of(r, m);
     }
     // Coefficients as identified, then the effect's own change of them (if any) on top.
@@ -221,19 +222,17 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       }
       return z;
     }();
-    // A periodic run: what does not depend on the coefficients (the motion through the loop,
-    // the period's averages) once for the gradient's 12 evaluations (the same numbers).
+    // What does not depend on the coefficients (the motion through the loop, the period's
+    // averages, a random part's Gaussian moments) once for the gradient's 12 evaluations (the
+    // same numbers).
     std::optional<rectification::PreparedPeriodicRectification> periodic;
-    if (!rr) periodic.emplace(cfg, r.orientation_g, input, h);
+    std::optional<rectification::PreparedRandomRectification> random;
+    if (rr) random.emplace(cfg, r.orientation_g, *rr, sine, h);
+    else periodic.emplace(cfg, r.orientation_g, input, h);
     const auto f = [&](const Coefficients& co) {
-      if (rr) {
-        PlantConfig q = cfg;
-        for (int i = 0; i < plant::kNumCoefficients; ++i) q.coefficients[i] = co[i] + shift[i];
-        return rectification::random_rectification_at_frequency(q, r.orientation_g, *rr, sine, h).total_g();
-      }
       Coefficients q;
       for (int i = 0; i < plant::kNumCoefficients; ++i) q[i] = co[i] + shift[i];
-      return (*periodic)(q).total_g();
+      return random ? (*random)(q).total_g() : (*periodic)(q).total_g();
     };
     const CoefArray g = rectification::prediction_gradient(f, nominal.coefficients);
     for (int i = 0; i < plant::kNumCoefficients; ++i) t.G(k, i) = g[i];
