@@ -3,6 +3,7 @@
 #include <complex>
 #include <cstdint>
 #include <numbers>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -46,11 +47,16 @@ const rectification::RandomResponse& ResponseCache::random_response(const PlantC
   // (Made without the lock: the grid and the responses take it for their look-ups.)
   return find_or_make(mutex_, random_, random_key(key, p, turn, q),
                       [&] {
-                        const rectification::RandomGrid grid = rectification::turned_grid(
-                            find_or_make(mutex_, grids_, random_key(std::string(), p, Eigen::Matrix3d::Identity(), q),
-                                         [&] { return GridEntry{p.measured, rectification::random_grid(p, q)}; })
-                                .grid,
-                            turn);
+                        const GridEntry& entry =
+                            find_or_make(mutex_, grids_, random_key(std::string(), p, Eigen::Matrix3d::Identity(), q), [&] {
+                              rectification::RandomGrid raw = rectification::random_grid(p, q);
+                              rectification::RandomGrid untouched = rectification::turned_grid(raw, Eigen::Matrix3d::Identity());
+                              return GridEntry{p.measured, std::move(raw), std::move(untouched)};
+                            });
+                        // (Most effects leave the motion unturned: their grid is kept as it is.)
+                        std::optional<rectification::RandomGrid> turned;
+                        if (!turn.isIdentity(0.0)) turned = rectification::turned_grid(entry.grid, turn);
+                        const rectification::RandomGrid& grid = turned ? *turned : entry.unturned;
                         return RandomEntry{p.measured, rectification::random_response(grid, responses(cfg, key, grid.frequency_Hz))};
                       })
       .response;

@@ -120,7 +120,8 @@ class ResponseCache {
   std::map<std::string, RandomEntry, std::less<>> random_;
   struct GridEntry {
     std::shared_ptr<const vibration::CrossSpectralMatrix> measured;
-    rectification::RandomGrid grid;
+    rectification::RandomGrid grid;      // every point (random_grid)
+    rectification::RandomGrid unturned;  // turned_grid(grid, identity): the points with power
   };
   std::map<std::string, GridEntry, std::less<>> grids_;
   struct DampedEntry {
