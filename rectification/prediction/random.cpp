@@ -262,9 +262,7 @@ RandomGrid turned_grid(const RandomGrid& grid, const Eigen::Matrix3d& turn) {
 }
 
 namespace {
-// One quadrature point's share of the covariances: the responses' transfer to each input axis
-// (rows: F_IA, F_PA, F_OA, I, Theta) times the input's cross-spectral density. The weighted
-// share w H S H^H is returned (complex) for damped_random_spectrum.
+// The responses' transfer to each input axis at one point (rows: F_IA, F_PA, F_OA, I, Theta).
 using ResponseRows = Eigen::Matrix<std::complex<double>, 5, 3>;
 ResponseRows response_rows(const LoopResponse& r) {
   ResponseRows hm = ResponseRows::Zero();
@@ -336,14 +334,10 @@ DampedRandomSpectrum damped_random_spectrum(const vibration::RandomProfile& p, c
     const double f = grid.frequency_Hz[k], weight = grid.weight_Hz[k];
     const Eigen::Matrix3cd& s = grid.csd_g2_per_Hz[k];
     const LoopResponse h = at_zeta0(f);
-    ++r.frequencies;
+    add_point(r, weight, h, s);
     const ResponseRows hm = response_rows(h);
-    const Eigen::Matrix<std::complex<double>, 5, 5> m = weight * (hm * s * hm.adjoint());
-    r.covariance += m.real();
-    r.input_covariance_g2 += weight * s.real();
-    r.dc_gain = h.dc_gain;
     out.frequency_Hz.push_back(f);
-    out.loop_rows.push_back(m.bottomRows<2>());
+    out.loop_rows.push_back(weight * (hm.bottomRows<2>() * s * hm.adjoint()));
     out.rho_minus_1.push_back(rho_minus_one(h, at_twice(f)));
   }
   r.from_Hz = grid.from_Hz, r.to_Hz = grid.to_Hz;
@@ -623,6 +617,7 @@ PreparedRandomRectification::PreparedRandomRectification(const PlantConfig& conf
   for (const auto& e : config.effects) {
     p2 += e->pickoff_p2_per_rad();
     geometry = geometry || e->vibropendulous();
+    readout_ = readout_ || e->readout_averaged_in_prediction();
   }
   const auto& c5 = rr.covariance;
   const GaussianParts parts = gaussian_parts(rr);
@@ -690,9 +685,7 @@ FrequencyPrediction PreparedRandomRectification::operator()(const Coefficients& 
   if (clipping_g_) out.terms.g[t_clipping] = *clipping_g_;
   // A readout polynomial: E over the output's Gaussian part (Gauss-Hermite), averaged over the
   // sine's phase (32 points: exact for a trigonometric polynomial of degree < 32).
-  bool readout = false;
-  for (const auto& e : config_.effects) readout = readout || e->readout_averaged_in_prediction();
-  if (readout) {
+  if (readout_) {
     const Vec3 slope = readout_slope(coefficients, config_.location, a);
     const double sigma_u = readout_sigma(rr_, slope);
     const std::complex<double> Us = Is_ + slope[IA] * Fs_[IA] + slope[PA] * Fs_[PA] + slope[OA] * Fs_[OA];

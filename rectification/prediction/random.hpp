@@ -167,6 +167,7 @@ class PreparedRandomRectification {
   Eigen::Vector3cd Fs_ = Eigen::Vector3cd::Zero();
   std::complex<double> Is_ = 0.0;
   double dc_gain_ = 1;
+  bool readout_ = false;  // an effect averaged on the readout
   std::optional<double> clipping_g_;
   FrequencyPrediction fixed_;  // the parts independent of the coefficients
 };
