@@ -619,6 +619,14 @@ PYBIND11_MODULE(_core, m) {
         if (!r.s.at_frequency) return py::none();
         return terms_dict(r.s.at_frequency->terms);
       }, "With frequency_dependent=True: each term at the frequency, g.")
+      .def_property_readonly("second_order_g", [](const PredictResult& r) -> std::optional<double> {
+        if (!r.s.at_frequency) return std::nullopt;
+        return r.s.at_frequency->second_order_g;
+      }, "With frequency_dependent=True: the pickoff nonlinearity beyond first order (included in frequency_dependent_g), g; else None.")
+      .def_property_readonly("second_order_error_g", [](const PredictResult& r) -> std::optional<double> {
+        if (!r.s.at_frequency) return std::nullopt;
+        return r.s.at_frequency->second_order_error_g;
+      }, "With frequency_dependent=True: second_order_g's own uncertainty (random motion; 0 where exact), g; else None.")
       .def("report", [](const PredictResult& r) { return io::predict_report(r.c, r.s); }, "The text `vrelab predict` prints.")
       .def("to_dict", [](const PredictResult& r) { return to_py(io::predict_json(r.c, r.s)); }, "`vrelab predict --json` as a dict.");
 

@@ -186,6 +186,7 @@ json predict_json(const Case& c, const PredictStudy& s) {
     json ft = terms_json(fp.terms);
     ft["pickoff_nonlinearity"] = fp.pickoff_g;
     ft["pendulum_geometry"] = fp.pendulum_geometry_g;
+    ft["pickoff_second_order"] = fp.second_order_g;
     const bool random = c.vibration->type == VibrationKind::random;
     j["frequency_dependent"] = {{"frequency_Hz", random ? json(nullptr) : json(c.vibration->sine.frequency_Hz)},
                                 {"total_g", fp.total_g()},
@@ -193,6 +194,9 @@ json predict_json(const Case& c, const PredictStudy& s) {
                                 {"terms", ft},
                                 {"current_amplitude_g", std::abs(fp.current_amplitude_g)},
                                 {"angle_amplitude_rad", std::abs(fp.angle_amplitude_rad)},
+                                {"second_order_share", fp.total_g() != 0 ? json(fp.second_order_g / fp.total_g()) : json(nullptr)},
+                                {"second_order_left_out", fp.second_order_left_out},
+                                {"second_order_error_g", fp.second_order_error_g},
                                 {"plant", plant_json(c.plant, c.physical.has_value())}};
   }
   j["units"] = {{"total_g", "g"}, {"terms", "g"}, {"input_rms_g", "g"}, {"vrc_ug_per_g2", "ug/g^2"}};

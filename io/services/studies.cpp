@@ -29,6 +29,7 @@
 #include "io/formats/series.hpp"
 #include "rectification/measurement/vrc.hpp"
 #include "rectification/prediction/random.hpp"
+#include "rectification/prediction/second_order.hpp"
 #include "rectification/simulation/sweep.hpp"
 #include "vrelab_version.hpp"
 
@@ -303,7 +304,20 @@ std::string predict_at_frequency_report(const Case& c, const PredictStudy& s) {
   }
   out += fmt::format("  {:<20}{:>14}{:>13.6f} ug\n", "pickoff_nonlinearity", "-", fp.pickoff_g * 1e6);
   out += fmt::format("  {:<20}{:>14}{:>13.6f} ug\n", "pendulum_geometry", "-", fp.pendulum_geometry_g * 1e6);
+  const bool pickoff = rectification::pickoff_p2_per_rad(c.plant) != 0;
+  if (pickoff) out += fmt::format("  {:<20}{:>14}{:>13.6f} ug\n", "pickoff_2nd_order", "-", fp.second_order_g * 1e6);
   out += fmt::format("  {:<20}{:>11.6f} ug{:>13.6f} ug\n", "total", s.terms.total_g() * 1e6, fp.total_g() * 1e6);
+  if (fp.second_order_left_out)
+    out += "  The pickoff nonlinearity's second order is not computed for this motion (sine on random): first order only.\n";
+  else if (pickoff)
+    out += fmt::format("  pickoff_2nd_order: the pickoff's error through the loop and its IA terms beyond first order "
+                       "(docs/frequency.md), {:.2f} % of the total; {}\n",
+                       100 * fp.second_order_g / fp.total_g(),
+                       vs.type == VibrationKind::sine
+                           ? std::string("a harmonic balance, exact")
+                           : fmt::format("second order in the pickoff's error, uncertain by about {:.3g} ug ({:.2f} % of the total){}",
+                                         fp.second_order_error_g * 1e6, 100 * fp.second_order_error_g / std::abs(fp.total_g()),
+                                         fp.second_order_error_g > 0.01 * std::abs(fp.total_g()) ? " -- large: check with `vrelab shake`" : ""));
   return out;
 }
 

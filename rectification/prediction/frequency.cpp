@@ -1,5 +1,7 @@
 #include "rectification/prediction/frequency.hpp"
 
+#include "rectification/prediction/second_order.hpp"
+
 #include <cstdint>
 
 #include <algorithm>
@@ -221,7 +223,13 @@ FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, c
                                                     std::optional<double> range_g) {
   vibration::validate(v);
   const PlantConfig lin = amplitude_linearised(config, v);
-  return sine_rectification_at_frequency(lin, a, v, range_g, loop_response(lin, v.frequency_Hz));
+  if (pickoff_p2_per_rad(lin) == 0) return sine_rectification_at_frequency(lin, a, v, range_g, loop_response(lin, v.frequency_Hz));
+  // A pickoff nonlinearity: its current at 2 f rectified too (second_order.hpp).
+  const LoopResponder responder(lin);
+  FrequencyPrediction out = sine_rectification_at_frequency(lin, a, v, range_g, responder(v.frequency_Hz));
+  out.second_order_g = PeriodicPickoffBalance(lin, a[IA], out.pickoff_g, out.loop_dc_gain, v.frequency_Hz,
+                                              {{1, out.current_amplitude_g, out.angle_amplitude_rad}}, std::cref(responder))(lin.coefficients);
+  return out;
 }
 
 FrequencyPrediction sine_rectification_at_frequency(const PlantConfig& config, const Vec3& a, const vibration::SineVibration& v,
@@ -612,6 +620,12 @@ PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& 
     const Eigen::Vector3cd& w = in.tones.front().second;
     for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(w[i]), v.phase_rad[i] = std::arg(w[i]);
     closed_form_.emplace(config, a, v, std::nullopt, response(in.frequency_Hz));
+    if (pickoff_p2_per_rad(config) != 0) {
+      const FrequencyPrediction f = (*closed_form_)(config.coefficients);
+      balance_ = std::make_shared<const PeriodicPickoffBalance>(config, a[IA], f.pickoff_g, f.loop_dc_gain, in.frequency_Hz,
+                                                                std::vector<PeriodicTone>{{1, f.current_amplitude_g, f.angle_amplitude_rad}}, response);
+      fixed_.loop_dc_gain = f.loop_dc_gain;
+    }
     return;
   }
   double p2 = 0.0;
@@ -699,11 +713,26 @@ PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& 
   for (const Harmonic& x : hs_) theta2 += std::norm(x.Theta) / 2, pa_theta += std::real(x.F[PA] * std::conj(x.Theta)) / 2;
   out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * theta2;
   if (geometry) out.pendulum_geometry_g = dc_gain * (-pa_theta - a_mean[IA] * theta2 / 2);
+  if (p2 != 0) {
+    std::vector<PeriodicTone> tones;
+    for (const Harmonic& x : hs_) tones.push_back({x.h, x.I, x.Theta});
+    if (positive) balance_ = std::make_shared<const PeriodicPickoffBalance>(config, a_mean[IA], out.pickoff_g, dc_gain, in.frequency_Hz, tones, response);
+    else out.second_order_left_out = true;
+  }
+}
+
+void PreparedPeriodicRectification::add_second_order(FrequencyPrediction& out, const Coefficients& c) const {
+  if (balance_) out.second_order_g = (*balance_)(c);
 }
 
 FrequencyPrediction PreparedPeriodicRectification::operator()(const Coefficients& coefficients) const {
-  if (closed_form_) return (*closed_form_)(coefficients);
+  if (closed_form_) {
+    FrequencyPrediction out = (*closed_form_)(coefficients);
+    add_second_order(out, coefficients);
+    return out;
+  }
   FrequencyPrediction out = fixed_;
+  add_second_order(out, coefficients);
   const double dc_gain = fixed_.loop_dc_gain;
   for (int c = k1_asym; c < kNumCoefficients; ++c) {
     if (coefficients[c] == 0) continue;

@@ -4,7 +4,9 @@
 // Takes: a plant (plant/accelerometer.hpp), the static orientation (g), a sine vibration
 //        (g peak, per-axis phase, frequency in Hz).
 // Gives: the vibration error per term (g) to first order in the nonlinearities, each term
-//        seen through the plant's linear dynamics at that frequency (docs/frequency.md):
+//        seen through the plant's linear dynamics at that frequency (docs/frequency.md);
+//        a pickoff nonlinearity beyond first order in second_order_g (second_order.hpp). The
+//        first order:
 //  - terms at the input (mechanical) and the cross terms: the vibration itself (eq. (3));
 //  - IA terms in the loop or at the output: eq. (3) with the IA amplitude replaced by the
 //    amplitude |I| of the rebalance current, I = sum_j H_ij(jw) W_j (W_j = w_j e^{j phi_j});
@@ -51,7 +53,15 @@ struct FrequencyPrediction {
   // a_IA's mean plus the misalignments' share of the other axes' means. Not a rectification
   // of the sensor but the measured error contains it (e.g. a rocking fixture's centripetal part).
   double input_mean_g = 0.0;
-  double total_g() const { return terms.total_g() + pickoff_g + pendulum_geometry_g + readout_g + input_mean_g; }
+  // The pickoff nonlinearity's current rectified by the IA terms in the loop or at the output
+  // (second_order.hpp): second order, p2 times k1'..k4 and p2^2 times k2..k4. Left out (the
+  // flag set) where a plant with a pickoff nonlinearity meets a motion it is not computed for.
+  double second_order_g = 0.0;
+  bool second_order_left_out = false;
+  // Its own error where it is an expansion (Gaussian motion: PickoffSecondOrder::error_g); 0
+  // where it is exact (periodic motion) or absent.
+  double second_order_error_g = 0.0;
+  double total_g() const { return terms.total_g() + pickoff_g + pendulum_geometry_g + readout_g + input_mean_g + second_order_g; }
 };
 
 FrequencyPrediction sine_rectification_at_frequency(const plant::PlantConfig& plant, const Vec3& a_static_g,
@@ -228,7 +238,9 @@ class PreparedPeriodicRectification {
   std::vector<std::complex<double>> phasors_;  // e^{j h phi_k}, per point and harmonic (a readout only)
   std::array<double, plant::kNumCoefficients> at_input_{}, in_loop_{};
   plant::Basis b0_{};
+  std::shared_ptr<const class PeriodicPickoffBalance> balance_;  // with a pickoff nonlinearity (second_order.hpp)
   FrequencyPrediction fixed_;  // the parts independent of the coefficients
+  void add_second_order(FrequencyPrediction& out, const plant::Coefficients& c) const;
 };
 
 }  // namespace vrelab::rectification

@@ -177,6 +177,14 @@ Eigen::Matrix3cd cross_spectral_matrix_g2_per_Hz(const vibration::RandomProfile&
   return cross_spectral_matrix(p, p.measured ? PreparedTables{} : prepared_tables(p), f);
 }
 
+std::vector<Eigen::Matrix3cd> cross_spectral_matrices_g2_per_Hz(const vibration::RandomProfile& p, const std::vector<double>& f) {
+  const PreparedTables tables = p.measured ? PreparedTables{} : prepared_tables(p);
+  std::vector<Eigen::Matrix3cd> out;
+  out.reserve(f.size());
+  for (const double x : f) out.push_back(cross_spectral_matrix(p, tables, x));
+  return out;
+}
+
 Eigen::Matrix3d cross_spectrum_g2_per_Hz(const vibration::RandomProfile& p, double f) {
   return cross_spectral_matrix_g2_per_Hz(p, f).real();
 }
@@ -314,6 +322,12 @@ RandomResponse random_response(const vibration::RandomProfile& p, const Response
     add_point(out, grid.weight_Hz[k], response(grid.frequency_Hz[k]), grid.csd_g2_per_Hz[k]);
   out.from_Hz = grid.from_Hz, out.to_Hz = grid.to_Hz;
   return out;
+}
+
+RandomResponse with_pickoff_moments(RandomResponse rr, const PlantConfig& plant, const vibration::RandomProfile& p,
+                                    const ResponseAt& response, const Eigen::Matrix3d& turn) {
+  if (pickoff_p2_per_rad(plant) != 0) rr.pickoff = gaussian_pickoff_moments(plant, p, response, turn);
+  return rr;
 }
 
 RandomResponse random_response(const RandomGrid& grid, const std::vector<const LoopResponse*>& responses) {
@@ -504,6 +518,8 @@ FrequencyPrediction periodic_on_random(const PlantConfig& config, const Vec3& a,
                                        const ResponseAt& response) {
   FrequencyPrediction out = periodic_rectification(config, a, in, response);
   out.terms = {};
+  out.second_order_g = 0;  // (the periodic part's alone: not computed on random)
+  out.second_order_left_out = pickoff_p2_per_rad(config) != 0;
   struct Tone {
     int h;
     Eigen::Vector3cd F;
@@ -663,6 +679,12 @@ PreparedRandomRectification::PreparedRandomRectification(const PlantConfig& conf
   const double pa_theta = c5(R::kF_PA, R::kAngle) + std::real(Fs[PA] * std::conj(Ths)) / 2;
   fixed_.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * theta2;
   if (geometry) fixed_.pendulum_geometry_g = dc_gain_ * (-pa_theta - a[IA] * theta2 / 2);
+  if (p2 != 0) {
+    if (!sine && rr.pickoff)
+      second_order_ = gaussian_second_order(*rr.pickoff, config.dynamics, p2, c5(R::kCurrent, R::kCurrent), c5(R::kAngle, R::kAngle), a[IA]);
+    else
+      fixed_.second_order_left_out = true;
+  }
 }
 
 FrequencyPrediction PreparedRandomRectification::operator()(const Coefficients& coefficients) const {
@@ -683,6 +705,10 @@ FrequencyPrediction PreparedRandomRectification::operator()(const Coefficients& 
     for (int k = 0; k < kNumTerms; ++k) out.terms.g[k] += gain * t.g[k];
   });
   if (clipping_g_) out.terms.g[t_clipping] = *clipping_g_;
+  if (second_order_) {
+    out.second_order_g = second_order_->g(coefficients, config_.location, dc_gain_);
+    out.second_order_error_g = second_order_->error_g(coefficients, config_.location, dc_gain_);
+  }
   // A readout polynomial: E over the output's Gaussian part (Gauss-Hermite), averaged over the
   // sine's phase (32 points: exact for a trigonometric polynomial of degree < 32).
   if (readout_) {
@@ -713,7 +739,10 @@ FrequencyPrediction random_rectification_at_frequency(const PlantConfig& config,
 
 FrequencyPrediction random_rectification_at_frequency(const PlantConfig& plant, const Vec3& a, const vibration::RandomProfile& p,
                                                       std::optional<double> range_g) {
-  return random_rectification_at_frequency(plant, a, random_response(plant, p), std::nullopt, nullptr, range_g);
+  const LoopResponder responder(plant);
+  const ResponseAt h = std::cref(responder);
+  return random_rectification_at_frequency(plant, a, with_pickoff_moments(random_response(p, h), plant, p, h), std::nullopt, nullptr,
+                                           range_g);
 }
 
 FrequencyPrediction sine_on_random_rectification_at_frequency(const PlantConfig& plant, const Vec3& a,

@@ -6,7 +6,9 @@
 //        (vibration/random.hpp: one-sided PSD per sensor axis in g^2/Hz and the axes'
 //        coupling) and, for sine-on-random, the sine (g peak, phase, Hz).
 // Gives: the vibration error per term of model (1) and per effect (g), to first order in the
-//        nonlinearities, in the FrequencyPrediction of frequency.hpp (the same fields).
+//        nonlinearities, in the FrequencyPrediction of frequency.hpp (the same fields); a
+//        pickoff nonlinearity's second order (second_order.hpp) where RandomResponse::pickoff
+//        holds its moments (with_pickoff_moments), random motion alone.
 //
 // The random motion x(t) is zero-mean Gaussian with the one-sided cross-spectral density
 // S_ij(f) (g^2/Hz): S_ii = G_i, and between axes S_ij = sqrt(G_i G_j) for `common` phases,
@@ -40,6 +42,7 @@
 
 #include "plant/accelerometer.hpp"
 #include "rectification/prediction/frequency.hpp"
+#include "rectification/prediction/second_order.hpp"
 #include "vibration/random.hpp"
 
 namespace vrelab::rectification {
@@ -53,7 +56,14 @@ struct RandomResponse {
   double dc_gain = 1;
   double from_Hz = 0, to_Hz = 0;
   int frequencies = 0;  // loop responses evaluated
+  // A plant with a pickoff nonlinearity: the moments its second order needs (second_order.hpp,
+  // gaussian_pickoff_moments; with_pickoff_moments sets them). Without them such a plant's
+  // random prediction is first order (FrequencyPrediction::second_order_left_out).
+  std::optional<GaussianPickoffMoments> pickoff;
 };
+// rr with the pickoff moments of `plant` set when it has a pickoff nonlinearity (else rr).
+RandomResponse with_pickoff_moments(RandomResponse rr, const plant::PlantConfig& plant, const vibration::RandomProfile& p,
+                                    const ResponseAt& response, const Eigen::Matrix3d& turn = Eigen::Matrix3d::Identity());
 
 // Quadrature settings: each interval between table breakpoints is cut into pieces no wider
 // than max_log_step in ln f, each integrated by 8-point Gauss-Legendre.
@@ -71,6 +81,8 @@ struct RandomQuadrature {
 // measured; else from the tables, real (the synthesis uses zero relative phase for common
 // coupling, none for independent axes).
 Eigen::Matrix3cd cross_spectral_matrix_g2_per_Hz(const vibration::RandomProfile& p, double frequency_Hz);
+// The same at many frequencies (the profile's tables prepared once).
+std::vector<Eigen::Matrix3cd> cross_spectral_matrices_g2_per_Hz(const vibration::RandomProfile& p, const std::vector<double>& frequency_Hz);
 // Its real part (the covariance density of the input itself).
 Eigen::Matrix3d cross_spectrum_g2_per_Hz(const vibration::RandomProfile& p, double frequency_Hz);
 
@@ -169,6 +181,7 @@ class PreparedRandomRectification {
   double dc_gain_ = 1;
   bool readout_ = false;  // an effect averaged on the readout
   std::optional<double> clipping_g_;
+  std::optional<PickoffSecondOrder> second_order_;  // with a pickoff nonlinearity (second_order.hpp)
   FrequencyPrediction fixed_;  // the parts independent of the coefficients
 };
 

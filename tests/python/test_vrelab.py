@@ -99,6 +99,18 @@ def test_frequency_dependent_predict_equals_cli(tmp_path):
     assert r.frequency_dependent_g is not None and r.printed_g is not None
 
 
+def test_second_order_is_the_clis_and_in_the_total(tmp_path):
+    # The pickoff beyond first order (docs/frequency.md): the CLI's numbers, in the total.
+    path = case("shake-second-order-navmat.toml")
+    r = vrelab.predict(path, frequency_dependent=True)
+    j = cli_json(tmp_path, "predict", path, "--frequency-dependent")["frequency_dependent"]
+    assert r.second_order_g == j["terms"]["pickoff_second_order"] and r.frequency_dependent_g == j["total_g"]
+    assert r.second_order_error_g == j["second_order_error_g"] and not j["second_order_left_out"]
+    assert -1e-3 < r.second_order_g < -7e-4 and 0 < r.second_order_error_g < 1e-5
+    assert vrelab.predict(case("shake-sine.toml"), frequency_dependent=True).second_order_g == 0.0
+    assert vrelab.predict(path).second_order_g is None
+
+
 def test_identify_equals_cli(tmp_path):
     path = case("paper-static.toml")
     r = vrelab.identify(path)

@@ -254,16 +254,17 @@ TEST(DiagnoseCampaign, HiddenPickoffNonlinearityIsFoundFittedAndRemoved) {
   // first-order model's own error, ~0.1 %, dominates).
   EXPECT_NEAR(d.effects.front().value, -12.0, 0.24);
   // The reported sigma: the statistical one and the hypothesis' own accuracy f = 1 % in
-  // quadrature. The prediction is linear in p, so the data shifted by +-f Delta (Delta = the
-  // effect's change, p times the unit slope) refit to p (1 +- f): b = f p, analytically (the
-  // refit's V moves with p through the coefficients' columns G, far below 1 % of b). So
-  // sigma >= f |p| (1 % short of it at most), and sigma^2 - (f p)^2 is the statistical
-  // variance (printed: 0.013 /rad): below 0.03^2, which bounds b at 1.03 f |p|; above 0.005^2.
+  // quadrature. The prediction is linear in p to first order, so the data shifted by +-f Delta
+  // (Delta = the effect's change, p times the unit slope) refit to p (1 +- f): b = f p (the
+  // refit's V moves with p through the coefficients' columns G, far below 1 % of b; the
+  // pickoff's second order, docs/frequency.md, bends the prediction by its share, ~1 % of b).
+  // So sigma >= f |p| (1 % short of it at most), and sigma^2 - (f p)^2, the statistical
+  // variance (0.013 /rad at first order), is below 0.03^2. (Its lower side is not resolved:
+  // b's 1 % hides 0.017 /rad of it.)
   const double fp = 0.01 * std::abs(d.effects.front().value), sp = d.effects.front().sigma;
   std::printf("  sigma %.5f /rad, f p %.5f /rad: statistical part %.5f /rad\n", sp, fp, std::sqrt(std::max(0.0, sp * sp - fp * fp)));
   EXPECT_GE(sp, 0.99 * fp);
   EXPECT_LE(sp, std::hypot(fp, 0.03));
-  EXPECT_GE(sp, std::hypot(fp, 0.005));
   // The bar: >= 80 % of the held-out gap rms removed.
   EXPECT_LT(d.rms_after_g, 0.2 * d.rms_before_g);
   // The gap grows as amplitude^2 (the pendulum angle squared); the power is that of the gap

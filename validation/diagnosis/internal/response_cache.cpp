@@ -16,7 +16,7 @@ void ResponseCache::bind(const PlantConfig& plant) {
   const bool same = bound_ && plant.coefficients.v == plant_.coefficients.v && key(plant.dynamics) == key(plant_.dynamics);
   if (same) return;
   plant_ = plant, bound_ = true;
-  tables_.clear(), absorbed_.clear(), cache_.clear(), responders_.clear(), random_.clear(), grids_.clear(), damped_.clear();
+  tables_.clear(), absorbed_.clear(), cache_.clear(), responders_.clear(), random_.clear(), grids_.clear(), damped_.clear(), pickoff_.clear();
 }
 
 std::string ResponseCache::random_key(const std::string& key, const vibration::RandomProfile& p, const Eigen::Matrix3d& turn,
@@ -68,6 +68,15 @@ const rectification::DampedRandomSpectrum& ResponseCache::damped_random_spectrum
   return find_or_make(mutex_, damped_, random_key(key, p, turn, q),
                       [&] { return DampedEntry{p.measured, rectification::damped_random_spectrum(p, h, h_twice, q, turn)}; })
       .spectrum;
+}
+
+const rectification::GaussianPickoffMoments& ResponseCache::pickoff_moments(const PlantConfig& cfg, const std::string& key,
+                                                                            const vibration::RandomProfile& p,
+                                                                            const Eigen::Matrix3d& turn, const rectification::ResponseAt& h) {
+  // (The key's dynamics are cfg's; the quadrature's place in the key holds the grid's size.)
+  return find_or_make(mutex_, pickoff_, random_key(key, p, turn, {4096, false}),
+                      [&] { return PickoffEntry{p.measured, rectification::gaussian_pickoff_moments(cfg, p, h, turn)}; })
+      .moments;
 }
 
 std::shared_ptr<const Table> ResponseCache::table(const std::string& key) {

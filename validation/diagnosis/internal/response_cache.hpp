@@ -95,6 +95,12 @@ class ResponseCache {
                                                                     const rectification::ResponseAt& h,
                                                                     const rectification::ResponseAt& h_twice);
 
+  // A pickoff nonlinearity's moments for its second order (rectification::gaussian_pickoff_moments
+  // with the responses h of `key`), once per (key, profile, turn): they do not depend on p2.
+  const rectification::GaussianPickoffMoments& pickoff_moments(const plant::PlantConfig& cfg, const std::string& key,
+                                                               const vibration::RandomProfile& p, const Eigen::Matrix3d& turn,
+                                                               const rectification::ResponseAt& h);
+
  private:
   // Every field of plant::Dynamics (design_servo's only input).
   using DynamicsKey = std::tuple<double, double, double, double, double, bool, double, double>;
@@ -129,6 +135,11 @@ class ResponseCache {
     rectification::DampedRandomSpectrum spectrum;
   };
   std::map<std::string, DampedEntry, std::less<>> damped_;
+  struct PickoffEntry {
+    std::shared_ptr<const vibration::CrossSpectralMatrix> measured;
+    rectification::GaussianPickoffMoments moments;
+  };
+  std::map<std::string, PickoffEntry, std::less<>> pickoff_;
   static std::string random_key(const std::string& key, const vibration::RandomProfile& p, const Eigen::Matrix3d& turn,
                                 const rectification::RandomQuadrature& q);
   std::map<std::string, std::shared_ptr<const Table>> tables_;

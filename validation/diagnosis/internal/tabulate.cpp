@@ -212,6 +212,11 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       rr = film ? rectification::random_response_at_damping(*film_spectrum, film->x())
                 : cache.random_response(cfg, key, run_random(r), m.random_turn, kRandomRunQuadrature);
       if (r.sine_part) sine = motion_of(r, m);
+      // A pickoff nonlinearity (its hypothesis): its second order's moments (second_order.hpp),
+      // the same at every value of it (a film's loop is this run's own).
+      else if (rectification::pickoff_p2_per_rad(cfg) != 0)
+        rr->pickoff = film ? rectification::gaussian_pickoff_moments(cfg, run_random(r), h, m.random_turn)
+                           : cache.pickoff_moments(cfg, key, run_random(r), m.random_turn, h);
     }
     // Coefficients as identified, then the effect's own change of them (if any) on top.
     const Coefficients shift = [&] {
@@ -357,11 +362,11 @@ double predict_values(const PlantConfig& nominal, const RunRecord& r, const Effe
     return it->second;
   };
   if (r.random) {
-    const rectification::RandomResponse rr =
-        film ? rectification::random_response_at_damping(*film_spectrum, film->x())
-             : rectification::random_response(run_random(r), h, kRandomRunQuadrature, m.random_turn);
+    rectification::RandomResponse rr = film ? rectification::random_response_at_damping(*film_spectrum, film->x())
+                                            : rectification::random_response(run_random(r), h, kRandomRunQuadrature, m.random_turn);
     std::optional<rectification::PeriodicInput> sine;
     if (r.sine_part) sine = run_input(r, m);
+    else rr = rectification::with_pickoff_moments(std::move(rr), cfg, run_random(r), h, m.random_turn);
     return rectification::random_rectification_at_frequency(cfg, r.orientation_g, rr, sine, h).total_g();
   }
   return rectification::periodic_rectification(cfg, r.orientation_g, rectification::film_harmonic_balance(with_films, cfg, run_input(r, m), h), h)
