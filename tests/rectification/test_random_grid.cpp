@@ -21,34 +21,22 @@
 #include "rectification/prediction/frequency.hpp"
 #include "rectification/prediction/random.hpp"
 #include "support/instrument.hpp"
+#include "support/vibrations.hpp"
 #include "vibration/random.hpp"
 
 namespace test_random_grid {
 
 using namespace vrelab;
 
-namespace {
-
-vibration::PsdTable flat_band(double from_Hz, double to_Hz, double level_g2_per_Hz) {
-  vibration::PsdTable t;
-  vibration::PsdRow a, b;
-  a.frequency_Hz = from_Hz, a.psd_g2_per_Hz = level_g2_per_Hz;
-  b.frequency_Hz = to_Hz, b.psd_g2_per_Hz = level_g2_per_Hz;
-  t.rows = {a, b};
-  return t;
-}
-
-}  // namespace
-
 TEST(RandomGrid, TheCovariancesOfAGridAreTheIntegralWrittenOut) {
   plant::PlantConfig cfg = test::paper_like_linear_plant();
   cfg.effects.push_back(std::make_shared<plant::MechanicalMode>(900.0, 0.03, Vec3(1, 1, 0)));
   const rectification::LoopResponder responder(cfg);
   vibration::RandomProfile along_ia;
-  along_ia.psd[0] = flat_band(20, 2000, 0.04);
+  along_ia.psd[0] = test::flat_psd(20, 2000, 0.04);
   vibration::RandomProfile three = along_ia;
-  three.psd[1] = flat_band(50, 1500, 0.01);
-  three.psd[2] = flat_band(20, 800, 0.02);
+  three.psd[1] = test::flat_psd(50, 1500, 0.01);
+  three.psd[2] = test::flat_psd(20, 800, 0.02);
   three.coupling = vibration::AxisCoupling::common;
   const Eigen::Matrix3d identity = Eigen::Matrix3d::Identity();
   const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.03, Eigen::Vector3d(0.2, 1, -0.4).normalized()).toRotationMatrix();

@@ -22,6 +22,7 @@
 #include "rectification/prediction/second_order.hpp"
 #include "rectification/simulation/shake.hpp"
 #include "support/instrument.hpp"
+#include "support/vibrations.hpp"
 #include "vibration/random.hpp"
 
 namespace test_second_order {
@@ -30,15 +31,6 @@ using namespace vrelab;
 using cd = std::complex<double>;
 
 namespace {
-
-vibration::PsdTable flat_band(double from_Hz, double to_Hz, double level_g2_per_Hz) {
-  vibration::PsdTable t;
-  vibration::PsdRow a, b;
-  a.frequency_Hz = from_Hz, a.psd_g2_per_Hz = level_g2_per_Hz;
-  b.frequency_Hz = to_Hz, b.psd_g2_per_Hz = level_g2_per_Hz;
-  t.rows = {a, b};
-  return t;
-}
 
 plant::PlantConfig pickoff_plant(double p2) {
   plant::PlantConfig cfg = test::paper_like_linear_plant();
@@ -78,7 +70,7 @@ TEST(GaussianPickoffMoments, TheConvolutionIntegralsAreTheMonteCarloMoments) {
   cfg.servo = plant::design_servo(cfg.dynamics);
   const rectification::LoopResponder responder(cfg);
   vibration::RandomProfile profile;
-  profile.psd[0] = flat_band(20, 2000, 0.03);
+  profile.psd[0] = test::flat_psd(20, 2000, 0.03);
   const rectification::GaussianPickoffMoments m = rectification::gaussian_pickoff_moments(cfg, profile, std::cref(responder));
   const rectification::GaussianPickoffMoments fine =
       rectification::gaussian_pickoff_moments(cfg, profile, std::cref(responder), Eigen::Matrix3d::Identity(), 8192);
