@@ -606,12 +606,13 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
 
 
 FrequencyPrediction periodic_rectification(const PlantConfig& config, const Vec3& a, const PeriodicInput& in,
-                                           const ResponseAt& response, bool allow_closed_form) {
-  return PreparedPeriodicRectification(config, a, in, response, allow_closed_form)(config.coefficients);
+                                           const ResponseAt& response, bool allow_closed_form, bool second_order) {
+  return PreparedPeriodicRectification(config, a, in, response, allow_closed_form, second_order)(config.coefficients);
 }
 
 PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& config, const Vec3& a, const PeriodicInput& in,
-                                                             const ResponseAt& response, bool allow_closed_form)
+                                                             const ResponseAt& response, bool allow_closed_form,
+                                                             bool second_order)
     : location_(config.location), a_(a), mean_g_(in.mean_g) {
   if (!(in.frequency_Hz > 0)) throw std::invalid_argument("periodic_rectification: frequency_Hz must be positive");
   if (allow_closed_form && in.single_tone()) {
@@ -620,7 +621,7 @@ PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& 
     const Eigen::Vector3cd& w = in.tones.front().second;
     for (int i = 0; i < 3; ++i) v.amplitude_g[i] = std::abs(w[i]), v.phase_rad[i] = std::arg(w[i]);
     closed_form_.emplace(config, a, v, std::nullopt, response(in.frequency_Hz));
-    if (pickoff_p2_per_rad(config) != 0) {
+    if (second_order && pickoff_p2_per_rad(config) != 0) {
       const FrequencyPrediction f = (*closed_form_)(config.coefficients);
       balance_ = std::make_shared<const PeriodicPickoffBalance>(config, a[IA], f.pickoff_g, f.loop_dc_gain, in.frequency_Hz,
                                                                 std::vector<PeriodicTone>{{1, f.current_amplitude_g, f.angle_amplitude_rad}}, response);
@@ -713,7 +714,7 @@ PreparedPeriodicRectification::PreparedPeriodicRectification(const PlantConfig& 
   for (const Harmonic& x : hs_) theta2 += std::norm(x.Theta) / 2, pa_theta += std::real(x.F[PA] * std::conj(x.Theta)) / 2;
   out.pickoff_g = wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * theta2;
   if (geometry) out.pendulum_geometry_g = dc_gain * (-pa_theta - a_mean[IA] * theta2 / 2);
-  if (p2 != 0) {
+  if (second_order && p2 != 0) {
     std::vector<PeriodicTone> tones;
     for (const Harmonic& x : hs_) tones.push_back({x.h, x.I, x.Theta});
     if (positive) balance_ = std::make_shared<const PeriodicPickoffBalance>(config, a_mean[IA], out.pickoff_g, dc_gain, in.frequency_Hz, tones, response);

@@ -158,13 +158,15 @@ PeriodicInput periodic_input(const vibration::Excitation& e, double frequency_Hz
 // polynomial, of degree <= 6; the |a_IA| of k1' converges as 1 / points^2). Cross-harmonic products are what a distorted tone adds: e.g.
 // <a^3> = -(3/4) h2 sin(phi2) w^3 for w (sin t + h2 sin(2t + phi2)). The
 // input's mean adds its first-order output (input_mean_g). With allow_closed_form, a single
-// tone without mean goes to sine_rectification_at_frequency (the same number, faster).
+// tone without mean goes to sine_rectification_at_frequency (the same number, faster). With
+// second_order, a pickoff nonlinearity's part beyond first order (second_order.hpp); without
+// it (a caller that adds a random part, where it is not computed) second_order_g stays 0.
 // Clipping is not modelled here.
 // (By value: a reference-returning std::function would let a by-value lambda dangle.)
 using ResponseAt = std::function<LoopResponse(double frequency_Hz)>;
 FrequencyPrediction periodic_rectification(const plant::PlantConfig& plant, const Vec3& a_static_g,
                                            const PeriodicInput& input, const ResponseAt& response,
-                                           bool allow_closed_form = true);
+                                           bool allow_closed_form = true, bool second_order = true);
 
 // The squeeze film by harmonic balance. `linearised` is amplitude_linearised(with_films, ...):
 // the films replaced by their describing function, a damping the loop responses `response`
@@ -220,7 +222,7 @@ class PreparedSineRectification {
 class PreparedPeriodicRectification {
  public:
   PreparedPeriodicRectification(const plant::PlantConfig& plant, const Vec3& a_static_g, const PeriodicInput& input,
-                                const ResponseAt& response, bool allow_closed_form = true);
+                                const ResponseAt& response, bool allow_closed_form = true, bool second_order = true);
   FrequencyPrediction operator()(const plant::Coefficients& c) const;
 
  private:

@@ -516,9 +516,8 @@ void for_each_rectifying_term(const Coefficients& coefficients, const Locations&
 // in U).
 FrequencyPrediction periodic_on_random(const PlantConfig& config, const Vec3& a, const RandomResponse& rr, const PeriodicInput& in,
                                        const ResponseAt& response) {
-  FrequencyPrediction out = periodic_rectification(config, a, in, response);
+  FrequencyPrediction out = periodic_rectification(config, a, in, response, true, false);  // (no second order on random)
   out.terms = {};
-  out.second_order_g = 0;  // (the periodic part's alone: not computed on random)
   out.second_order_left_out = pickoff_p2_per_rad(config) != 0;
   struct Tone {
     int h;
