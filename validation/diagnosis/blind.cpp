@@ -154,6 +154,16 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
         k.effect_max_sigma =
             std::max(k.effect_max_sigma, std::abs(camp.runs[j].measured_g - clean.runs[j].measured_g) / camp.runs[j].sigma_g);
       k.effect_gap_sigma = nominal_gap_significance(camp, clean, settings);
+    } else if (k.category == "two") {
+      // Each effect's need: the gap the campaign with both shows over the campaign with the
+      // other alone (the same noise draws), as the nominal model sees it; the smaller of the two
+      // is the pair's size (scored as a pair when >= 5 sigma: both are then needed).
+      double need = INFINITY;
+      for (std::size_t e = 0; e < 2; ++e) {
+        const Campaign other = simulate_campaign(truth, {k.hidden[1 - e]}, design, k.seed, 1);
+        need = std::min(need, nominal_gap_significance(camp, other, settings));
+      }
+      k.effect_gap_sigma = need;
     }
     const std::vector<double> lab_g = hand_to_lab(camp, k);
     k.simulate_s = seconds_since(t0);
@@ -273,8 +283,8 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
   // Single effects below 5 sigma are a family apart (the issue scores >= 5 sigma); so are
   // out-of-library effects whose gap the design leaves below 5 sigma (no gap to call
   // unexplained: a proof mass's torsion without OA runs).
-  const bool small =
-      (k.category == "single" || k.category == "natural" || k.category == "out_of_library") && k.error.empty() && size < 5;
+  const bool small = (k.category == "single" || k.category == "natural" || k.category == "out_of_library" || k.category == "two") &&
+                     k.error.empty() && size < 5;
   FamilyScore& f = families[small ? k.category + "_below_5_sigma" : k.category];
   ++f.n;
   if (!k.error.empty()) {
@@ -295,6 +305,7 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
   if (k.category == "single" || k.category == "natural" || k.category == "out_of_library")
     key += fmt::format(" (its gap {:.1f} sigma as the nominal model sees it, {:.1f} in the largest run)", k.effect_gap_sigma,
                        k.effect_max_sigma);
+  if (k.category == "two") key += fmt::format(" (the weaker one's gap over the other's {:.1f} sigma as the nominal model sees it)", k.effect_gap_sigma);
   if (k.category == "sigma_understated") key += fmt::format(" (scatter x{:.2f})", k.noise_scale);
   if (k.category == "dynamics_off")
     key += fmt::format(" (manifest: crossover x{:.3f}, pendulum x{:.3f}, margin {:+.1f} deg)", k.manifest_crossover_ratio,
@@ -444,6 +455,9 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
     ++s.out_of_library;
     s.out_of_library_unexplained += called == "unexplained";
 
+  } else if (k.error.empty() && k.effect_gap_sigma < 5) {
+    // A pair whose weaker effect adds less than 5 sigma to the other's gap: one of them needed
+    // only; in its family apart (two_below_5_sigma), not in the pair rates.
   } else {
     ++s.two;
     // The effects of an unambiguous "explained" verdict (what `called` names).
@@ -715,6 +729,8 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
   if (f.size() != gap_at + kGapFields || f[gap_at] != "gap")
     throw bad(fmt::format("{} parameters of {} fields, then \"gap\" and 5 numbers expected", n_parameters, kParameterFields));
   k.effect_gap_sigma = num(gap_at + 1), k.gap_rms_before_g = num(gap_at + 2), k.gap_rms_after_g = num(gap_at + 3);
+  if (k.category == "two" && std::isnan(k.effect_gap_sigma) && unescaped(f[10]).empty())
+    throw OutdatedCampaignResult("blind: a pair campaign's result written before blind sized each effect's need: diagnose it again");
   d.rms_floor_g = num(gap_at + 4), d.rms_floor_sigma = num(gap_at + 5);
   if (n_parameters > 0 && d.effects.empty()) throw bad("parameters without a top effect");
   for (std::size_t i = 0; i < n_parameters; ++i) {
@@ -816,6 +832,8 @@ std::vector<BlindCriterion> BlindResult::Criteria() const {
   add("out of library: unexplained", right("out_of_library"), 0.90, true);
   add("sigma understated: flagged, no effect called", right("sigma_understated"), 0.90, true);
   add("drift: reported as drift", right("drift"), 0.90, true);
+  add("two, each needed >= 5 sigma: both named", {scores.two_by_both, scores.two}, 0.60, true);
+  add("two, each needed >= 5 sigma: one of them named at least", {scores.two_by_both + scores.two_by_one, scores.two}, 0.95, true);
   add("detection at the limit (expected chi^2 deviate >= 5): gap found", {scores.at_limit_found, scores.at_limit}, 0.95, true);
   add("clean: false alarm (a gap or a nuisance flagged)", {scores.false_alarms, scores.clean}, 0.02, false);
   int confidently_wrong = 0, all = 0;
@@ -860,8 +878,8 @@ std::string BlindResult::BriefReport() const {
   t += fmt::format("  false alarms on clean campaigns: {}/{}\n", s.false_alarms, s.clean);
   t += fmt::format("  out-of-library called unexplained: {}/{} (gap >= 5 sigma; {} below, not scored)\n",
                    s.out_of_library_unexplained, s.out_of_library, s.out_of_library_small);
-  t += fmt::format("  two effects: explained by both (a pair) {}/{}, by one of them {}/{}\n", s.two_by_both, s.two, s.two_by_one,
-                   s.two);
+  t += fmt::format("  two effects, each needed >= 5 sigma (its gap over the other's): explained by both (a pair) {}/{}, by one of them {}/{}\n",
+                   s.two_by_both, s.two, s.two_by_one, s.two);
   t += fmt::format("  median held-out shrinkage of the gap rms (the lab's noise removed; {} single campaigns): {:.0f} %\n",
                    s.gap_shrinkage_campaigns, 100 * s.median_gap_shrinkage);
   t += fmt::format("  median held-out shrinkage of the residual rms (with each run's noise): {:.0f} %, in each run's sigma "
@@ -885,7 +903,7 @@ std::string BlindResult::BriefReport() const {
 }
 
 std::string BlindResult::FamilyTable() const {
-  return family_rows(scores.families, {"single", "single_below_5_sigma", "natural", "natural_below_5_sigma", "two", "out_of_library", "out_of_library_below_5_sigma",
+  return family_rows(scores.families, {"single", "single_below_5_sigma", "natural", "natural_below_5_sigma", "two", "two_below_5_sigma", "out_of_library", "out_of_library_below_5_sigma",
                                        "dynamics_off", "sigma_understated", "drift", "clean"});
 }
 

@@ -141,7 +141,7 @@ struct EffectFit {
   std::string not_ranked;        // why the effect is no candidate (listed after the ranked ones); empty: ranked
 };
 
-// Two effects fitted together (additive to first order), when no one effect explains the gap.
+// Two effects fitted together (additive to first order), when one leaves a gap or a second is still needed.
 struct PairFit {
   std::string a, b;
   double pa = 0, pb = 0;         // their parameters, fitted on all runs
@@ -219,7 +219,7 @@ struct Diagnosis {
   std::vector<std::pair<std::string, double>> rms_z_by_direction;
   double odd_in_a_IA_fraction = NAN;
   std::vector<EffectFit> effects;  // best first (evidence)
-  std::vector<PairFit> pairs;      // tried when no one effect explains a significant gap; best first
+  std::vector<PairFit> pairs;      // tried when a significant gap needs a second effect (docs/diagnose.md); best first
   double pair_evidence_margin = 0;  // a pair is chosen only when its evidence beats the best single effect's by this
   ChosenEffects chosen;            // the best effect, or the pair that explains the gap
   std::string folds;               // the cross-validation used

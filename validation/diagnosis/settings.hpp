@@ -41,7 +41,7 @@ struct DiagnoseSettings {
     v(field("resimulate_runs", &S::resimulate_runs, "runs", core::closed(0, 1000000),
             "Runs (largest gaps first) re-simulated on the ODE plant; 0: none"));
     v(field("try_pairs", &S::try_pairs, "", core::any_value(),
-            "Try two effects at once when no one effect explains the gap", "no-pairs"));
+            "Try two effects at once when one leaves a gap or a second is still needed", "no-pairs"));
     // Stated sigma too small: gaps that no effect explains, not alike between neighbouring
     // runs (the correlation of the gaps of runs one frequency or one amplitude step apart, as
     // a normal deviate, below this) and whose means and spreads depend on no frequency,

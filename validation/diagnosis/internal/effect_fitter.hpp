@@ -63,6 +63,10 @@ class EffectFitter {
   // Maximum likelihood of the first parameter over the runs `idx`, the others nominal; sigma
   // from the curvature of -2 log L.
   std::pair<double, double> fit(const Data& d, const std::vector<int>& idx) const { return fit_first(d, idx, nominal_values_); }
+  // The first parameter's fit with the others at base's values. A function of its inputs
+  // alone: kept per (data, runs, base), bit for bit (the folds' fits, the final fit, the
+  // pairs' and the natural forms' starts ask for the same fits again).
+  std::pair<double, double> fit_first(const Data& d, const std::vector<int>& idx, const std::vector<double>& base) const;
 
   // Every parameter the runs `idx` pin (docs/diagnose.md, "Natural forms"): the first
   // parameter's fit at each start of the further ones (their `starts`, the nominal first); a
@@ -239,10 +243,6 @@ class EffectFitter {
   // Levenberg-Marquardt on -2 ln L + the further parameters' priors over `free`, from v.
   std::vector<double> levenberg_marquardt(const Data& d, const std::vector<int>& idx, std::vector<double> v,
                                           const std::vector<int>& free) const;
-  // The first parameter's fit with the others at base's values. A function of its inputs
-  // alone: kept per (data, runs, base), bit for bit (the folds' fits, the final fit, the
-  // pairs' and the natural forms' starts ask for the same fits again).
-  std::pair<double, double> fit_first(const Data& d, const std::vector<int>& idx, const std::vector<double>& base) const;
   std::pair<double, double> fit_first_uncached(const Data& d, const std::vector<int>& idx, const std::vector<double>& base) const;
 
   const Effect& e_;

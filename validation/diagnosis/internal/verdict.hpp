@@ -7,7 +7,7 @@
 //        the levels a verdict is judged by (VerdictOptions).
 // Gives: in the Diagnosis, the targeted test (an effect's held-out evidence beyond the
 //        significance level makes the gap significant), the shrinkage before and after, the
-//        pairs tried when no one effect explains a significant gap, the chosen effect(s) (none
+//        pairs tried when a significant gap needs a second effect, the chosen effect(s) (none
 //        when no effect is ranked), the verdict (no significant gap, explained, not explained,
 //        ambiguous), the effects tied with the chosen one, and the
 //        reported effects' sigma widened by their held parameters. Returns the chosen
@@ -26,7 +26,7 @@ using Chosen = std::vector<std::pair<const Effect*, std::vector<double>>>;
 struct VerdictOptions {
   double threshold_sigma = 5;    // held-out evidence beyond its square: a gap, and needed to explain one
   double min_rms_removed = 0.9;  // share of the held-out gap rms an effect that explains the gap removes (or chi^2)
-  bool try_two_effects = true;   // two effects at once when no one effect explains a significant gap
+  bool try_two_effects = true;   // two effects at once when one leaves a gap or a second is still needed
   double tie_evidence = 6;       // explaining effects whose evidence is closer than this: ambiguous
 };
 
