@@ -457,7 +457,8 @@ void score(const BlindCampaign& k, BlindResult& r, Shrinkages& sh) {
 
   } else if (k.error.empty() && k.effect_gap_sigma < 5) {
     // A pair whose weaker effect adds less than 5 sigma to the other's gap: one of them needed
-    // only; in its family apart (two_below_5_sigma), not in the pair rates.
+    // only; in its family apart (two_below_5_sigma), not in the pair rates. (A line without the
+    // size, NaN, is scored as a pair: as blind scored it before it sized pairs.)
   } else {
     ++s.two;
     // The effects of an unambiguous "explained" verdict (what `called` names).
@@ -729,8 +730,6 @@ void read_campaign_result(const std::string& text, BlindCampaign& k) {
   if (f.size() != gap_at + kGapFields || f[gap_at] != "gap")
     throw bad(fmt::format("{} parameters of {} fields, then \"gap\" and 5 numbers expected", n_parameters, kParameterFields));
   k.effect_gap_sigma = num(gap_at + 1), k.gap_rms_before_g = num(gap_at + 2), k.gap_rms_after_g = num(gap_at + 3);
-  if (k.category == "two" && std::isnan(k.effect_gap_sigma) && unescaped(f[10]).empty())
-    throw OutdatedCampaignResult("blind: a pair campaign's result written before blind sized each effect's need: diagnose it again");
   d.rms_floor_g = num(gap_at + 4), d.rms_floor_sigma = num(gap_at + 5);
   if (n_parameters > 0 && d.effects.empty()) throw bad("parameters without a top effect");
   for (std::size_t i = 0; i < n_parameters; ++i) {
