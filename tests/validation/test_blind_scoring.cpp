@@ -424,6 +424,59 @@ TEST(BlindScoring, TheIssuesCriteriaAreCountedFromTheFamilies) {
   EXPECT_FALSE(by["all families"].met());  // 3.0 % > 1 %
   EXPECT_EQ(by["drift"].n, 0);
   EXPECT_FALSE(by["drift"].met());  // no campaigns: nothing shown
+  // The pairs' two rates (issue 34): both named, and at least one named alone or in the pair.
+  r.scores.two = 10, r.scores.two_by_both = 6, r.scores.two_by_one = 3;
+  by.clear();
+  for (const BlindCriterion& c : r.Criteria()) by[c.name.substr(0, c.name.find(':'))] = c;
+  ASSERT_TRUE(by.count("two, each needed >= 5 sigma"));
+  std::vector<BlindCriterion> two;
+  for (const BlindCriterion& c : r.Criteria())
+    if (c.name.rfind("two,", 0) == 0) two.push_back(c);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_EQ(two[0].k, 6);
+  EXPECT_EQ(two[0].n, 10);
+  EXPECT_TRUE(two[0].met());  // 60 % >= 60 %
+  EXPECT_EQ(two[1].k, 9);
+  EXPECT_EQ(two[1].n, 10);
+  EXPECT_FALSE(two[1].met());  // 90 % < 95 %
+}
+
+// A pair campaign is scored in the pair rates when each effect adds >= 5 sigma to the other's
+// gap (its size: the smaller); below, in two_below_5_sigma, out of the rates. A line without a
+// size (NaN, written before pairs were sized) is scored as a pair. Campaign 3 of a draw is its
+// pair (slot 3); nothing simulated: every line read back.
+TEST(BlindScoring, APairIsScoredWhenEachEffectIsNeeded) {
+  const auto score = [](double size) {
+    BlindSettings s;
+    s.n = 4, s.seed = 77, s.threads = 1;
+    std::map<int, std::string> done;
+    for (int i = 0; i < s.n; ++i) {
+      BlindCampaign k = blind_key(i, s.seed);
+      k.called = "clean";
+      if (i == 3) {
+        EXPECT_EQ(k.category, "two");
+        k.effect_gap_sigma = size;
+        Diagnosis& d = k.diagnosis;
+        d.gap_significant = true, d.verdict = Verdict::explained;
+        d.chosen.names = {k.hidden.at(0).name};
+        EffectFit e;
+        e.name = k.hidden.at(0).name;
+        d.effects = {e};
+        k.called = e.name, k.top = e.name;
+      }
+      done[i] = campaign_result_text(k);
+    }
+    return run_blind(s, {}, done, {}).scores;
+  };
+  const BlindScores needed = score(12.0), small = score(3.0), unsized = score(NAN);
+  EXPECT_EQ(needed.two, 1);
+  EXPECT_EQ(needed.two_by_one, 1);
+  EXPECT_EQ(needed.families.at("two").n, 1);
+  EXPECT_EQ(needed.families.at("two").family, 1);  // one of them: right physics
+  EXPECT_EQ(small.two, 0);
+  EXPECT_EQ(small.families.count("two"), 0u);
+  EXPECT_EQ(small.families.at("two_below_5_sigma").n, 1);
+  EXPECT_EQ(unsized.two, 1);
 }
 
 // blind --mixed: each campaign on a design of its own, drawn from its seed in a stream apart
