@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <sstream>
 #include <string>
@@ -11,6 +12,60 @@
 
 namespace vrelab::validation::internal {
 namespace {
+
+// The minimum of f along one parameter, from x0 (f(x0) = f0) within [lo, hi]: over the whole
+// grid first where one is given (a valley the start missed), else from a step h downhill,
+// doubling until f rises; then golden-section refinement of the bracket. Returns {x, f(x)}.
+std::pair<double, double> line_minimum(const std::function<double(double)>& f, double x0, double f0, double h, double lo,
+                                       double hi, const std::vector<double>* grid) {
+  double dir = 1;
+  double b = std::clamp(x0 + h, lo, hi), fb = f(b);
+  if (!(fb < f0)) {
+    dir = -1;
+    b = std::clamp(x0 - h, lo, hi), fb = f(b);
+  }
+  double xm = x0, fm = f0, xl = dir > 0 ? std::clamp(x0 - h, lo, hi) : b, xr = dir > 0 ? b : std::clamp(x0 + h, lo, hi);
+  bool bracketed = false;
+  if (grid && grid->size() > 2) {
+    const std::vector<double>& g = *grid;
+    std::vector<double> fg(g.size());
+    for (std::size_t k = 0; k < g.size(); ++k) fg[k] = f(g[k]);
+    const std::size_t k = static_cast<std::size_t>(std::min_element(fg.begin(), fg.end()) - fg.begin());
+    if (fg[k] < fm && fg[k] < fb) {  // the grid's neighbours bracket it
+      xm = g[k], fm = fg[k], xl = g[k > 0 ? k - 1 : 0], xr = g[std::min(k + 1, g.size() - 1)];
+      bracketed = true;
+    }
+  }
+  if (!bracketed && fb < f0) {
+    double prev = x0, step = h;
+    xm = b, fm = fb;
+    for (int k = 0; k < 20; ++k) {
+      step *= 2;
+      const double x = std::clamp(xm + dir * step, lo, hi);
+      if (x == xm) break;
+      const double fx = f(x);
+      if (!(fx < fm)) {
+        xl = dir > 0 ? prev : x, xr = dir > 0 ? x : prev;
+        break;
+      }
+      prev = xm, xm = x, fm = fx;
+      xl = dir > 0 ? prev : x, xr = dir > 0 ? x : prev;
+    }
+  }
+  for (int k = 0; k < 25 && xr - xl > 1e-6 * std::max(std::abs(xm), std::abs(h)); ++k) {
+    const double x = xm - xl > xr - xm ? xm - 0.381966 * (xm - xl) : xm + 0.381966 * (xr - xm);
+    const double fx = f(x);
+    if (fx < fm) {
+      if (x < xm) xr = xm;
+      else xl = xm;
+      xm = x, fm = fx;
+    } else {
+      if (x < xm) xl = x;
+      else xr = x;
+    }
+  }
+  return {xm, fm};
+}
 
 // Two effects at once (docs/diagnose.md, step 8): the best effect A with a second B, additive
 // to first order (T = T_A + T_B - T_0), where A leaves a significant gap unexplained or, where
@@ -77,57 +132,10 @@ const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer
         const double hi = q[c]->linear ? q[c]->upper : std::min(q[c]->upper, q[c]->grid.empty() ? q[c]->upper : q[c]->grid.back());
         double h = std::isfinite(sig[c]) && sig[c] > 0 ? 2 * sig[c] : 0.05 * std::max(std::abs(p[c]), 1e-12);
         if (std::isfinite(hi - lo)) h = std::min(h, 0.25 * (hi - lo));
-        // Bracket: step downhill, doubling, until J rises (or a bound).
-        double a = p[c], fa = f;
-        double dir = 1;
-        double b = std::clamp(a + h, lo, hi), fb = along(c, b);
-        if (!(fb < fa)) {
-          dir = -1;
-          b = std::clamp(a - h, lo, hi), fb = along(c, b);
-        }
-        double xm = a, fm = fa, xl = dir > 0 ? std::clamp(a - h, lo, hi) : b, xr = dir > 0 ? b : std::clamp(a + h, lo, hi);
-        if (round == 0 && !q[c]->linear && q[c]->grid.size() > 2) {
-          // A parameter with a grid (a mode's frequency, a film's gap): the whole grid first,
-          // so a valley the start missed (A's fit alone pulled by B's part) is reached.
-          const std::vector<double>& g = q[c]->grid;
-          std::vector<double> fg(g.size());
-          for (std::size_t k = 0; k < g.size(); ++k) fg[k] = along(c, g[k]);
-          const std::size_t k = static_cast<std::size_t>(std::min_element(fg.begin(), fg.end()) - fg.begin());
-          if (fg[k] < fm && fg[k] < fb) {
-            xm = g[k], fm = fg[k], xl = g[k > 0 ? k - 1 : 0], xr = g[std::min(k + 1, g.size() - 1)];
-            fb = fm;  // (no stepping: the grid's neighbours bracket it)
-            fa = fm;
-          }
-        }
-        if (fb < fa) {
-          double prev = a, step = h;
-          xm = b, fm = fb;
-          for (int k = 0; k < 20; ++k) {
-            step *= 2;
-            const double x = std::clamp(xm + dir * step, lo, hi);
-            if (x == xm) break;
-            const double fx = along(c, x);
-            if (!(fx < fm)) {
-              xl = dir > 0 ? prev : x, xr = dir > 0 ? x : prev;
-              break;
-            }
-            prev = xm, xm = x, fm = fx;
-            xl = dir > 0 ? prev : x, xr = dir > 0 ? x : prev;
-          }
-        }
-        // Golden-section refinement of the bracket [xl, xr] about xm.
-        for (int k = 0; k < 25 && xr - xl > 1e-6 * std::max(std::abs(xm), std::abs(h)); ++k) {
-          const double x = xm - xl > xr - xm ? xm - 0.381966 * (xm - xl) : xm + 0.381966 * (xr - xm);
-          const double fx = along(c, x);
-          if (fx < fm) {
-            if (x < xm) xr = xm;
-            else xl = xm;
-            xm = x, fm = fx;
-          } else {
-            if (x < xm) xl = x;
-            else xr = x;
-          }
-        }
+        // (A parameter with a grid, a mode's frequency or a film's gap: its whole grid in the
+        // first round, so a valley A's fit alone missed, pulled by B's part, is reached.)
+        const bool scan = round == 0 && !q[c]->linear;
+        const auto [xm, fm] = line_minimum([&](double x) { return along(c, x); }, p[c], f, h, lo, hi, scan ? &q[c]->grid : nullptr);
         moved = std::max(moved, std::abs(xm - p[c]) / std::max(std::abs(h), 1e-300));
         if (c == 0) at_bound = false;
         at_bound = at_bound || xm <= lo || xm >= hi;
