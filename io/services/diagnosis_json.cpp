@@ -423,7 +423,8 @@ json to_json(const validation::BlindResult& r) {
           {"at_limit_campaigns", s.at_limit},
           {"at_limit_gap_found", BlindScores::rate(s.at_limit_found, s.at_limit)},
           {"family_size", "effect_gap_sigma: sqrt(g^T V^-1 g), the effect's gap as the nominal model sees it against the "
-                          "diagnosis' covariance (static-test coefficient uncertainty included); scored when >= 5"},
+                          "diagnosis' covariance (static-test coefficient uncertainty included); scored when >= 5; a pair's: the "
+                          "smaller of each effect's gap over the other's alone"},
           {"median_gap_shrinkage_noise_removed", s.median_gap_shrinkage},
           {"gap_shrinkage_campaigns", s.gap_shrinkage_campaigns},
           {"median_shrinkage", s.median_shrinkage},
