@@ -109,6 +109,9 @@ struct BlindOptions {
   validation::BlindSettings settings;
   std::string out_dir = "out/blind";
   bool progress = true;  // on stderr
+  // Then the next-run advice checked on the ambiguous and unexplained campaigns
+  // (validation/diagnosis/advice_check.hpp): DIR/advice.txt, a rerun resumes.
+  bool check_advice = false;
 };
 void run_blind(const BlindOptions& o, std::ostream& out);
 

@@ -5,12 +5,15 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <algorithm>
 #include <map>
+#include <vector>
 
 #include <fmt/format.h>
 
 #include "app/commands.hpp"
 #include "core/dispatch.hpp"
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "io/services/batch.hpp"
 #include "io/services/blind_report.hpp"
@@ -18,6 +21,7 @@
 #include "io/services/diagnosis_json.hpp"
 #include "io/services/diagnosis_report.hpp"
 #include "io/formats/output.hpp"
+#include "validation/diagnosis/advice_check.hpp"
 #include "validation/diagnosis/blind.hpp"
 #include "vrelab_version.hpp"
 
@@ -106,6 +110,57 @@ std::map<int, std::string> blind_done(const std::string& path, const std::string
   return done;
 }
 
+// The advice checked (--check-advice) on the ambiguous and unexplained campaigns of r:
+// DIR/advice.txt keeps a line per campaign checked under blind's header, appended as each
+// finishes; a rerun reads them back.
+void check_blind_advice(const BlindOptions& o, const validation::BlindResult& r, std::ostream& out) {
+  const std::string path = o.out_dir + "/advice.txt", header = blind_header(o.settings);
+  bool stale = false;
+  std::map<int, std::string> done = blind_done(path, header, &stale);
+  std::vector<const validation::BlindCampaign*> todo;
+  std::vector<validation::AdviceCheck> checks;
+  for (const auto& k : r.campaigns) {
+    if (k.called != "ambiguous" && k.called != "unexplained") continue;
+    if (const auto it = done.find(k.index); it != done.end()) try {
+        checks.push_back(validation::read_advice_check(it->second));
+        continue;
+      } catch (const std::invalid_argument&) {  // checked again
+      }
+    todo.push_back(&k);
+  }
+  std::string kept = header;
+  for (const auto& c : checks) {
+    const std::string body = fmt::format("{}\t{}", c.index, validation::advice_check_text(c));
+    kept += body + "\t" + line_checksum(body) + "\n";
+  }
+  io::write_atomic(path, kept);
+  std::ofstream append(path, std::ios::app);
+  std::vector<validation::AdviceCheck> fresh(todo.size());
+  core::Progress bar(std::cerr, "advice", todo.size(), o.progress);
+  core::parallel_for(
+      todo.size(), core::thread_count(o.settings.threads),
+      [&](std::size_t i) { fresh[i] = validation::check_advice(*todo[i], o.settings.diagnose); },
+      [&](std::size_t i) {
+        const std::string body = fmt::format("{}\t{}", fresh[i].index, validation::advice_check_text(fresh[i]));
+        append << body << "\t" << line_checksum(body) << "\n" << std::flush;
+        bar.tick();
+      });
+  bar.finish();
+  checks.insert(checks.end(), fresh.begin(), fresh.end());
+  std::sort(checks.begin(), checks.end(), [](const auto& a, const auto& b) { return a.index < b.index; });
+  for (const auto& c : checks) {
+    out << fmt::format("  advice, campaign {} [{}]: {} -> {} ({} -> {})\n", c.index, c.category, c.called_before, c.called_after,
+                       c.outcome_before, c.outcome_after);
+    for (const auto& x : c.runs)
+      out << fmt::format("    {:g} Hz {:g} g [{:.2g} {:.2g} {:.2g}] at [{:.2g} {:.2g} {:.2g}] g, {} ({}): promised {:.1f}, obtained {:.1f}; {}\n",
+                         x.advised.frequency_Hz, x.advised.amplitude_g, x.advised.direction[0], x.advised.direction[1],
+                         x.advised.direction[2], x.advised.orientation_g[0], x.advised.orientation_g[1], x.advised.orientation_g[2],
+                         x.advised.purpose, x.advised.between, x.promised_sigma, x.obtained_sigma, x.called);
+    if (!c.error.empty()) out << "    error: " << c.error << "\n";
+  }
+  out << validation::advice_summary(checks);
+}
+
 }  // namespace
 
 void run_blind(const BlindOptions& o, std::ostream& out) {
@@ -152,6 +207,7 @@ void run_blind(const BlindOptions& o, std::ostream& out) {
   io::write_atomic(o.out_dir + "/report.html", io::blind_report(r, plot).html(o.out_dir));
   out << "Wrote " << o.out_dir << "/scores.json, report.html and confusion.csv"
       << (plot.empty() ? ", confusion.png/svg" : "; figure skipped: " + plot) << "\n";
+  if (o.check_advice) check_blind_advice(o, r, out);
 }
 
 }  // namespace vrelab::app

@@ -269,6 +269,9 @@ Command add_blind(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag_callback(
       "--no-progress", [&o] { o.progress = false; }, "No progress bar");
+  cmd->add_flag("--check-advice", o.check_advice,
+                "Then simulate each ambiguous or unexplained campaign's advised runs under its truth, append them and "
+                "diagnose again (advice.txt; docs/blind.md)");
   return {cmd,
           [owned] {
             run_blind(*owned, std::cout);

@@ -229,8 +229,11 @@ json next_runs_json(const validation::Diagnosis& d) {
                  {"amplitude_g", x.amplitude_g},
                  {"direction", {x.direction[0], x.direction[1], x.direction[2]}},
                  {"orientation_g", {x.orientation_g[0], x.orientation_g[1], x.orientation_g[2]}},
-                 {"separation_sigma", x.separation_sigma},
-                 {"between", x.between}});
+                 {"separation_sigma", std::isfinite(x.separation_sigma) ? json(x.separation_sigma) : json(nullptr)},
+                 {"between", x.between},
+                 {"purpose", x.purpose},
+                 {"if_first_sigma", std::isfinite(x.if_first_sigma) ? json(x.if_first_sigma) : json(nullptr)},
+                 {"if_second_sigma", std::isfinite(x.if_second_sigma) ? json(x.if_second_sigma) : json(nullptr)}});
   return a;
 }
 

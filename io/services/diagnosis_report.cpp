@@ -42,8 +42,10 @@ void summary(Report& rep, const FolderDiagnosis& f) {
                                   x.unit == "1" ? "" : " " + x.unit));
   if (!d.next_runs.empty()) {
     const auto& r = d.next_runs.front();
-    lines.push_back(fmt::format("Next run to tell {} apart: {:g} Hz, {:g} g ({:.1f} sigma between them).", r.between,
-                                r.frequency_Hz, r.amplitude_g, r.separation_sigma));
+    lines.push_back(r.purpose == "locates"
+                        ? fmt::format("Next run to locate the gap ({}): {:g} Hz, {:g} g.", r.between, r.frequency_Hz, r.amplitude_g)
+                        : fmt::format("Next run to tell {} apart: {:g} Hz, {:g} g ({:.1f} sigma between them).", r.between,
+                                      r.frequency_Hz, r.amplitude_g, r.separation_sigma));
   }
   const auto tone = d.verdict == validation::Verdict::explained || d.verdict == validation::Verdict::no_significant_gap
                         ? Report::Tone::good
@@ -135,14 +137,16 @@ void nuisances(Report& rep, const validation::Diagnosis& d) {
 
 void next_runs(Report& rep, const validation::Diagnosis& d) {
   if (d.next_runs.empty()) return;
-  rep.heading("Runs to add next (what tells the candidates apart best)");
-  std::vector<std::vector<std::string>> rows = {
-      {"between", "frequency (Hz)", "amplitude (g)", "direction [IA, PA, OA]", "static a [IA, PA, OA] (g)", "separation (sigma)"}};
+  const bool locates = d.next_runs.front().purpose == "locates";
+  rep.heading(locates ? "Runs to add next (where the gap lies)" : "Runs to add next (what tells the candidates apart best)");
+  std::vector<std::vector<std::string>> rows = {{locates ? "locates" : "between", "frequency (Hz)", "amplitude (g)",
+                                                 "direction [IA, PA, OA]", "static a [IA, PA, OA] (g)",
+                                                 locates ? "gap expected (sigma)" : "separation (sigma)"}};
   for (const auto& r : d.next_runs)
     rows.push_back({r.between, fmt::format("{:g}", r.frequency_Hz), fmt::format("{:g}", r.amplitude_g),
                     fmt::format("[{:.2g}, {:.2g}, {:.2g}]", r.direction[0], r.direction[1], r.direction[2]),
                     fmt::format("[{:.2g}, {:.2g}, {:.2g}]", r.orientation_g[0], r.orientation_g[1], r.orientation_g[2]),
-                    fmt::format("{:.1f}", r.separation_sigma)});
+                    std::isfinite(r.separation_sigma) ? fmt::format("{:.1f}", r.separation_sigma) : "-"});
   rep.table(rows);
 }
 

@@ -186,11 +186,7 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
   }
   k.wall_s = seconds_since(t0);
   const Diagnosis& d = k.diagnosis;
-  k.called = !k.error.empty()           ? "error"
-             : !d.ambiguous_with.empty() ? "ambiguous"
-             : !d.gap_significant        ? "clean"
-             : d.explained()             ? to_string(d.chosen)
-                                         : "unexplained";
+  k.called = !k.error.empty() ? "error" : blind_called(d);
   k.top = k.error.empty() && d.effects.front().not_ranked.empty() ? d.effects.front().name : "";
 }
 
@@ -378,6 +374,25 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
   }
   note(k.category == "clean" && !d.gap_significant ? why + " (a nuisance flagged on a clean campaign)" : why);
 }
+
+}  // namespace
+
+std::string blind_called(const Diagnosis& d) {
+  return !d.ambiguous_with.empty() ? "ambiguous"
+         : !d.gap_significant      ? "clean"
+         : d.explained()           ? to_string(d.chosen)
+                                   : "unexplained";
+}
+
+std::string blind_outcome(const BlindCampaign& k) {
+  std::map<std::string, FamilyScore> one;
+  score_family(k, k.effect_gap_sigma, one, nullptr);
+  const FamilyScore& f = one.begin()->second;
+  return f.right ? "right" : f.family ? "family" : f.unexplained ? "unexplained" : f.no_gap ? "no_gap" : f.wrong ? "wrong"
+         : f.ambiguous ? "ambiguous" : f.parameters_off ? "parameters_off" : "error";
+}
+
+namespace {
 
 // Scores one campaign against its key into r (counts, confusion, the wrong ones).
 // The held-out shrinkages 1 - after / before of the single campaigns: of the residuals' rms

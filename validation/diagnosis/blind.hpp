@@ -238,6 +238,12 @@ bool parameters_match(const HiddenEffect& truth, const Diagnosis& d, std::string
 // leaves). Throws std::invalid_argument when the sizes differ or there are no runs.
 std::pair<double, double> gap_rms_without_lab_noise(const Diagnosis& d, const std::vector<double>& gap_before_g);
 
+// The campaign's outcome in its blind family (FamilyScore's fields: right, family,
+// unexplained, no_gap, wrong, ambiguous, parameters_off, error) from k.diagnosis and k.error.
+std::string blind_outcome(const BlindCampaign& k);
+// What blind calls a diagnosis: clean, <effect>, "<A> + <B>", ambiguous, unexplained.
+std::string blind_called(const Diagnosis& d);
+
 // Invalid settings throw std::invalid_argument naming the key. A campaign whose simulation or
 // diagnosis fails is kept with its error (called "error").
 BlindResult run_blind(const BlindSettings& settings, const BlindProgress& progress = {});

@@ -83,7 +83,7 @@ Diagnosis diagnose_once(const Campaign& c, const internal::StageOptions& o, inte
   score_effects(m, scorer, ev, d, threads, progress);
   // 4-5. The verdict (pairs, ambiguity) and the held-out shrinkage.
   const Chosen chosen = judge(m, ev, scorer, o.verdict, d);
-  if (o.next_runs) suggest_next_runs(m.plant, c, o.simulation_rel_accuracy, d);  // for an ambiguous or unexplained gap
+  if (o.next_runs) suggest_next_runs(m, d);  // for an ambiguous or unexplained gap
   // 6. Confirmation on the ODE.
   confirm_on_ode(m, chosen, r, o.max_resimulated_runs, d);
   return d;

@@ -166,13 +166,20 @@ struct Nuisance {
   std::string note;
 };
 
-// A run to add (what it would tell apart): the candidates' predictions differ there by
-// separation_sigma of a run's sigma (the campaign's median sigma and the model accuracy).
+// A run to add (docs/diagnose.md, "11. Next runs"). purpose "separates": where the tied
+// effects are furthest apart; `between` ("A vs B") the pair it separates least; what it
+// promises is the rise of the rival's -2 ln L over the truth's when appended, as a normal
+// deviate (internal/next_runs.hpp): if_first_sigma with A the truth, if_second_sigma with B,
+// separation_sigma the smaller. purpose "locates" (an unexplained gap): `between` says what
+// it locates (which axis, frequency band, amplitude law); separation_sigma the gap (|z|) the
+// campaign's scaling laws expect there (NaN: none expected).
 struct NextRun {
   double frequency_Hz = 0, amplitude_g = 0;
   Vec3 direction = Vec3::UnitX(), orientation_g = Vec3::UnitX();
   double separation_sigma = 0;
-  std::string between;  // "A vs B"
+  std::string between;  // "A vs B", or what the run locates
+  std::string purpose;  // separates, locates
+  double if_first_sigma = NAN, if_second_sigma = NAN;  // separates: the rival's rise with A, with B the truth
 };
 
 // The effects a diagnosis chose: the best one, or two fitted together when a pair explains the

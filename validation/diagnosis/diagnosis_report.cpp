@@ -38,11 +38,15 @@ std::string nuisance_lines(const Diagnosis& d) {
 // The runs that would tell the candidates apart best.
 std::string next_run_lines(const Diagnosis& d) {
   if (d.next_runs.empty()) return "";
-  std::string t = "Next runs (what tells the candidates apart best):\n";
+  const bool locates = d.next_runs.front().purpose == "locates";
+  std::string t = locates ? "Next runs (where the gap lies; the gap the campaign's laws expect there):\n"
+                          : "Next runs (what tells the candidates apart best; the rival's rise in -2 ln L as sigma):\n";
   for (const auto& r : d.next_runs)
-    t += fmt::format("  {:g} Hz, {:g} g along [{:.2g}, {:.2g}, {:.2g}], static a = [{:.2g}, {:.2g}, {:.2g}] g: {:.1f} sigma ({})\n",
+    t += fmt::format("  {:g} Hz, {:g} g along [{:.2g}, {:.2g}, {:.2g}], static a = [{:.2g}, {:.2g}, {:.2g}] g: {} ({})\n",
                      r.frequency_Hz, r.amplitude_g, r.direction[0], r.direction[1], r.direction[2], r.orientation_g[0],
-                     r.orientation_g[1], r.orientation_g[2], r.separation_sigma, r.between);
+                     r.orientation_g[1], r.orientation_g[2],
+                     std::isfinite(r.separation_sigma) ? fmt::format("{:.1f} sigma", r.separation_sigma) : "no expectation",
+                     r.between);
   return t;
 }
 
