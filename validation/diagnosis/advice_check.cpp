@@ -197,9 +197,10 @@ std::string advice_summary(const std::vector<AdviceCheck>& checks) {
                      ratio.size(), q(0.5), q(0.25), q(0.75),
                      std::count_if(ratio.begin(), ratio.end(), [](double r) { return r >= 0.5 && r <= 2; }));
   }
-  for (const auto& [before, m] : turned) {
-    const auto get = [&](const char* w) { return m.count(w) ? m.at(w) : 0; };
-    t += fmt::format("  {}: turned right {}, turned wrong {}, left {}\n", before, get("right"), get("wrong"), get("left"));
+  for (const auto& entry : turned) {
+    const std::map<std::string, int>& m = entry.second;
+    const auto get = [&m](const char* w) { return m.count(w) ? m.at(w) : 0; };
+    t += fmt::format("  {}: turned right {}, turned wrong {}, left {}\n", entry.first, get("right"), get("wrong"), get("left"));
   }
   for (const std::string& l : locate) t += "  locating run: " + l + "\n";
   return t;

@@ -91,8 +91,8 @@ class EffectFitter {
 
   // A natural form with a discrete parameter, fitted in each of its forms (a mode on each
   // axis): what a fold's training runs say when they cannot choose (docs/diagnose.md, "Natural
-  // forms", step 5). Each form whose best start's -2 ln L is within kSeen of the best start's is
-  // fitted as fit_all fits its chosen one; m2logl is its objective at its fit (-2 ln L with the
+  // forms", step 5). Each form (its best start) is fitted as fit_all fits its chosen one,
+  // whatever its start's -2 ln L; m2logl is its objective at its fit (-2 ln L with the
   // further parameters' priors) plus -2 ln of its prior odds against the default form
   // (kDiscreteGain for any other form, the choice's own Bayes factor). An effect without a
   // discrete parameter: fit_all's fit alone.
