@@ -35,6 +35,7 @@ Effect effect_shaker_transverse_motion() {
   // Its frequency law: ratio x (f / 1 kHz)^power (nominal 1), continuous.
   EffectParameter pw("frequency_power", "1");
   pw.nominal = 1, pw.lower = 0, pw.upper = 3, pw.example = 2, pw.prior_sigma = 0.75, pw.step = 2e-3;
+  pw.starts = {1, 0};
   // The transverse axis: 0 the next (IA -> PA -> OA -> IA, nominal), 1 the other (IA -> OA -> PA -> IA).
   EffectParameter cy("axis_cycle", "0 next, 1 other");
   cy.nominal = 0, cy.lower = 0, cy.upper = 1, cy.example = 1;
