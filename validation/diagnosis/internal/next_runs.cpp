@@ -57,19 +57,18 @@ Conditional conditional(const CampaignModel& m, const Effect* e, const EffectFit
     if (q.status != ParameterStatus::fitted || !(q.sigma > 0) || !std::isfinite(q.sigma)) continue;
     Eigen::VectorXd side[2];
     int sides = 0;
-    double span = 0;
-    for (int s : {-1, 1}) {
+    for (int sign : {-1, 1}) {
       std::vector<double> w = v;
-      w[j] = v[j] + s * q.sigma;
+      w[j] = v[j] + sign * q.sigma;
       if (w[j] < q.lower || w[j] > q.upper) continue;
       try {
-        side[sides++] = best_at(m, e, w, at, at_cache);
-        span += q.sigma;
+        Eigen::VectorXd there = best_at(m, e, w, at, at_cache);
+        side[sides++] = std::move(there);
       } catch (const std::invalid_argument&) {  // the plant refuses the value: the other side alone
       }
     }
     if (sides == 2) out.variance += ((side[1] - side[0]) / 2).array().square().matrix();
-    else if (sides == 1) out.variance += ((side[0] - out.mean) * (q.sigma / span)).array().square().matrix();
+    else if (sides == 1) out.variance += (side[0] - out.mean).array().square().matrix();
   }
   return out;
 }
