@@ -6,6 +6,7 @@
 #include <random>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -26,19 +27,23 @@ RunRecord simulate_advised_run(const BlindCampaign& k, const NextRun& advised, i
   one.random_runs.clear();
   const std::uint64_t seed = k.seed * 1000003u + 7919u * static_cast<std::uint64_t>(which + 1);
   RunRecord r = simulate_campaign(truth, k.hidden, one, seed, 1).runs.at(0);
-  // The lab log as blind's (apply_lab_log): the run's time after the campaign's, its rest
-  // reading, the drift and the extra scatter.
+  // The lab's log as blind's: the run's time after the campaign's, its rest reading, the
+  // drift and the extra scatter.
   std::mt19937_64 log_rng(seed + 29);
   std::normal_distribution<double> n01;
   r.id = fmt::format("advised{}", which + 1);
-  r.time_h = 0.05 * runs_before;
-  const double drift = k.drift_g_per_h * r.time_h;
-  r.rest_g = drift + 0.3e-6 * n01(log_rng);
-  r.measured_g += drift + std::sqrt(k.noise_scale * k.noise_scale - 1) * r.sigma_g * n01(log_rng);
+  log_run(r, k, static_cast<std::size_t>(runs_before), log_rng, n01);
   return r;
 }
 
 namespace {
+
+// The two effects a separating run's `between` names ("A vs B"); empty without them.
+std::pair<std::string, std::string> pair_of(const NextRun& x) {
+  const std::size_t vs = x.between.find(" vs ");
+  if (x.purpose != "separates" || vs == std::string::npos) return {};
+  return {x.between.substr(0, vs), x.between.substr(vs + 4)};
+}
 
 const EffectFit* effect_named(const Diagnosis& d, const std::string& name) {
   for (const EffectFit& f : d.effects)
@@ -46,11 +51,10 @@ const EffectFit* effect_named(const Diagnosis& d, const std::string& name) {
   return nullptr;
 }
 
-// sqrt |change of chi^2_B - chi^2_A| from `before` to `after` (A vs B as `between` names them).
-double obtained_separation(const std::string& between, const Diagnosis& before, const Diagnosis& after) {
-  const std::size_t vs = between.find(" vs ");
-  if (vs == std::string::npos) return NAN;
-  const std::string a = between.substr(0, vs), b = between.substr(vs + 4);
+// sqrt |change of chi^2_B - chi^2_A| from `before` to `after` (A vs B as the run names them).
+double obtained_separation(const NextRun& x, const Diagnosis& before, const Diagnosis& after) {
+  const auto [a, b] = pair_of(x);
+  if (a.empty()) return NAN;
   const EffectFit *a0 = effect_named(before, a), *b0 = effect_named(before, b), *a1 = effect_named(after, a), *b1 = effect_named(after, b);
   if (!a0 || !b0 || !a1 || !b1) return NAN;
   const double change = (b1->insample_chi2 - a1->insample_chi2) - (b0->insample_chi2 - a0->insample_chi2);
@@ -60,12 +64,12 @@ double obtained_separation(const std::string& between, const Diagnosis& before, 
 // A separating run's promise when the truth is one of its pair (the rival's rise then), else
 // the smaller side; a locating run's expected gap.
 double promised_under_truth(const NextRun& x, const BlindCampaign& k) {
-  const std::size_t vs = x.between.find(" vs ");
-  if (x.purpose != "separates" || vs == std::string::npos) return x.separation_sigma;
-  const auto hidden = [&](const std::string& name) {
+  const std::pair<std::string, std::string> names = pair_of(x);
+  if (names.first.empty()) return x.separation_sigma;
+  const auto hidden = [&k](const std::string& name) {
     return std::any_of(k.hidden.begin(), k.hidden.end(), [&](const HiddenEffect& h) { return h.name == name; });
   };
-  const bool a = hidden(x.between.substr(0, vs)), b = hidden(x.between.substr(vs + 4));
+  const bool a = hidden(names.first), b = hidden(names.second);
   return a && !b ? x.if_first_sigma : b && !a ? x.if_second_sigma : x.separation_sigma;
 }
 
@@ -93,7 +97,7 @@ AdviceCheck check_advice(const BlindCampaign& key, const DiagnoseSettings& s) {
       const Diagnosis d = diagnose(with, s);
       rc.called = blind_called(d);
       rc.promised_sigma = promised_under_truth(rc.advised, k);
-      rc.obtained_sigma = rc.advised.purpose == "separates" ? obtained_separation(rc.advised.between, before, d) : std::abs(d.runs.back().z);
+      rc.obtained_sigma = rc.advised.purpose == "separates" ? obtained_separation(rc.advised, before, d) : std::abs(d.runs.back().z);
       out.runs.push_back(rc);
       all.runs.push_back(run);
     }

@@ -110,16 +110,8 @@ BlindCampaign draw_campaign(int i, std::uint64_t seed, const std::vector<std::st
 std::vector<double> apply_lab_log(Campaign& camp, const BlindCampaign& k) {
   std::mt19937_64 rng(k.seed + 29);
   std::normal_distribution<double> n01;
-  constexpr double kRunTime_h = 0.05, kRestSigma_g = 0.3e-6;
   std::vector<double> added(camp.runs.size());
-  for (std::size_t j = 0; j < camp.runs.size(); ++j) {
-    RunRecord& r = camp.runs[j];
-    r.time_h = kRunTime_h * static_cast<double>(j);
-    const double drift = k.drift_g_per_h * r.time_h;
-    r.rest_g = drift + kRestSigma_g * n01(rng);
-    added[j] = drift + std::sqrt(k.noise_scale * k.noise_scale - 1) * r.sigma_g * n01(rng);
-    r.measured_g += added[j];
-  }
+  for (std::size_t j = 0; j < camp.runs.size(); ++j) added[j] = log_run(camp.runs[j], k, j, rng, n01);
   return added;
 }
 
@@ -191,6 +183,17 @@ void simulate_and_diagnose(BlindCampaign& k, const DiagnoseSettings& settings) {
 }
 
 }  // namespace
+
+double log_run(RunRecord& r, const BlindCampaign& k, std::size_t position, std::mt19937_64& rng,
+               std::normal_distribution<double>& n01) {
+  constexpr double kRunTime_h = 0.05, kRestSigma_g = 0.3e-6;
+  r.time_h = kRunTime_h * static_cast<double>(position);
+  const double drift = k.drift_g_per_h * r.time_h;
+  r.rest_g = drift + kRestSigma_g * n01(rng);
+  const double added = drift + std::sqrt(k.noise_scale * k.noise_scale - 1) * r.sigma_g * n01(rng);
+  r.measured_g += added;
+  return added;
+}
 
 Campaign blind_lab_campaign(const BlindCampaign& k) {
   std::mt19937_64 rng(k.seed + 17);

@@ -220,6 +220,13 @@ CampaignDesign blind_design(const BlindCampaign& k);
 // result text does not carry: diagnose(blind_lab_campaign(k), BlindSettings{}.diagnose).
 Campaign blind_lab_campaign(const BlindCampaign& k);
 
+// The lab's log of one run of campaign k at `position` in the campaign's order: its time
+// (3 min a run), a rest reading before it (sigma 0.3 ug), the drift in both and the scatter
+// beyond the stated sigma, drawn from rng through n01 (blind's own log draws every run of a
+// campaign from one stream). Returns what it added to measured_g (g).
+double log_run(RunRecord& r, const BlindCampaign& k, std::size_t position, std::mt19937_64& rng,
+               std::normal_distribution<double>& n01);
+
 // A natural form's scoring: the diagnosis' top effect is the hidden one and each of its
 // parameters the data pinned is within 3 sigma of the truth (a phase's difference wrapped to
 // [-pi, pi); a discrete one, the mode's axis, equal, chosen or held); a held continuous
