@@ -154,6 +154,33 @@ TEST(EffectFitter, OneParameterEqualsGeneralisedLeastSquares) {
   EXPECT_EQ(s, mf.sigma[0]);
 }
 
+// Beside another effect that changes the coefficients' gradient (a pair's G_A - G_0): the fit
+// with dG added to every table's G is GLS with V = diag(s2) + (G + dG) Sigma (G + dG)^T, the
+// pair's covariance; here dG moves the estimate by half its sigma (1.197 against 1.267 alone,
+// sigma 0.145), so a fit that left dG out fails by 10^5 times the tolerance of 1e-6 sigma (the
+// one-parameter test's above).
+TEST(EffectFitter, AFitBesideAnotherEffectTakesItsGradient) {
+  Eigen::MatrixXd S(20, 1);
+  for (Eigen::Index k = 0; k < 20; ++k) S(k, 0) = 0.1 * std::sin(0.7 * static_cast<double>(k)) + 0.02 * static_cast<double>(k);
+  Eigen::VectorXd truth(1);
+  truth << 1.5;
+  const Problem p = make_problem(S, truth, 11);
+  Eigen::MatrixXd dG = Eigen::MatrixXd::Zero(p.nominal.G.rows(), p.nominal.G.cols());
+  for (Eigen::Index k = 0; k < dG.rows(); ++k) dG(k, 0) = 2 * static_cast<double>(k) / 19, dG(k, 1) = -0.5 * p.nominal.G(k, 1) * (k % 2);
+  const Effect e = effect_of({linear_first(-100, 100)});
+  const EffectFitter fitter(e, p.nominal, model_of(p));
+  Problem q = p;
+  q.nominal.G += dG;
+  const Gls beside = gls(q, {0}, {0}), alone = gls(p, {0}, {0});
+  const double sigma = std::sqrt(static_cast<double>(beside.cov(0, 0)));
+  const auto [value, s] = fitter.fit_beside(p.data, p.all, dG);
+  std::printf("  beside %.6f +- %.6f (GLS %.6f +- %.6f; alone %.6f)\n", value, s, static_cast<double>(beside.theta(0)), sigma,
+              static_cast<double>(alone.theta(0)));
+  EXPECT_GT(std::abs(static_cast<double>(beside.theta(0) - alone.theta(0))), 0.3 * sigma);  // the case tests something
+  EXPECT_NEAR(value, static_cast<double>(beside.theta(0)), 1e-6 * sigma);
+  EXPECT_NEAR(s, sigma, 1e-6 * sigma);
+}
+
 // Two parameters (the first linear, a further continuous one with a weak prior): Levenberg-
 // Marquardt's end and the Hessian covariance against GLS with the prior. Tolerances: the
 // descent stops when every move is below 1e-3 of the parameter's conditional sigma, and each of

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -66,6 +67,69 @@ TEST(PairCampaign, AStrongSingleEffectTakesInNoSecond) {
     EXPECT_TRUE(d.explained()) << verdict_text(d);
     EXPECT_EQ(to_string(d.chosen), k.hidden.at(0).name) << verdict_text(d);
   }
+}
+
+namespace {
+
+Diagnosis diagnosed(int index, std::uint64_t seed, const char* first, const char* second) {
+  const BlindCampaign k = blind_key(index, seed);
+  EXPECT_EQ(k.category, "two");
+  EXPECT_EQ(k.hidden.at(0).name, first);
+  EXPECT_EQ(k.hidden.at(1).name, second);
+  Diagnosis d = diagnose(blind_lab_campaign(k), BlindSettings{}.diagnose);
+  std::printf("  %s\n", verdict_text(d).c_str());
+  for (const PairFit& p : d.pairs)
+    std::printf("  pair %s %.4g + %s %.4g: evidence %.1f, held-out chi2 %.1f, all-run chi2 %.1f\n", p.a.c_str(), p.pa, p.b.c_str(),
+                p.pb, p.evidence, p.heldout_chi2, p.insample_chi2);
+  return d;
+}
+
+bool names(const Diagnosis& d, const std::string& a, const std::string& b) {
+  const auto& c = d.chosen.names;
+  return c.size() == 2 && ((c[0] == a && c[1] == b) || (c[0] == b && c[1] == a));
+}
+
+}  // namespace
+
+// Seed 12801, campaign 183: a pickoff nonlinearity (7.56 /rad) with k1'..k4 wholly at the input
+// (732 sigma). Alone, `servo_dynamics` leads (evidence 9.3e5; the pickoff is eighth), and with
+// it as the first effect no second explains: "not explained". Each of the three best singles is
+// now a first effect in turn, and the input placement's seconds are fitted along its gradient.
+TEST(PairCampaign, APairWhoseBestSingleIsAThirdEffectIsFound) {
+  const Diagnosis d = diagnosed(183, 12801, "pickoff_nonlinearity", "nonlinearity_at_input");
+  EXPECT_EQ(d.verdict, Verdict::explained);
+  EXPECT_TRUE(names(d, "pickoff_nonlinearity", "nonlinearity_at_input")) << verdict_text(d);
+}
+
+// Seed 12801, campaign 75: a 2nd harmonic (ratio 0.165) with k_PP (7.25e-7 /g). The pair was
+// tried and fits (held-out chi^2 163 for 168 runs) but took the held-out rms from 2.42 to 1.63
+// ug only: the floor (noise and the coefficients' extrapolation) is most of that. Judged above
+// the floor, in the runs' sigma, it is the verdict; the harmonic's ratio within 3 % of the key's.
+TEST(PairCampaign, APairThatLeavesOnlyTheFloorIsTheVerdict) {
+  const Diagnosis d = diagnosed(75, 12801, "shaker_harmonic_distortion", "quadratic_cross_axis");
+  EXPECT_EQ(d.verdict, Verdict::explained);
+  ASSERT_TRUE(names(d, "quadratic_cross_axis", "shaker_harmonic_distortion")) << verdict_text(d);
+  const PairFit& p = d.pairs.front();
+  ASSERT_EQ(p.b, "shaker_harmonic_distortion");
+  EXPECT_NEAR(p.pb, 0.1648, 0.03 * 0.1648);
+}
+
+// Seed 12801, campaign 15: k6 (1.44e-8 /g^5) with a misalignment of -0.0387 rad about OA. The
+// second was fitted to what the misalignment leaves along the nominal gradient, where the
+// misalignment turns the table's motion and so the coefficients' gradient: k6's drop fell
+// behind a 3rd harmonic's and the servo's, and the pair was never tried ("not explained").
+// Fitted along G_A + G_B - G_0, k6 ranks first. (A transverse motion IA -> OA with k6 comes
+// within 1 of the pair's evidence, the two motions no sine run separates: docs/diagnose.md,
+// "Known misses"; it does not halve the held-out gap above its floor, so no ambiguity.)
+TEST(PairCampaign, ASecondIsFittedAlongTheFirstsGradient) {
+  const Diagnosis d = diagnosed(15, 12801, "higher_order_k6", "mounting_misalignment");
+  EXPECT_EQ(d.verdict, Verdict::explained);
+  EXPECT_TRUE(names(d, "mounting_misalignment", "higher_order_k6")) << verdict_text(d);
+  const PairFit& p = d.pairs.front();
+  ASSERT_EQ(p.b, "higher_order_k6");
+  // Within 15 %: the pair's two parameters trade over the 4 g runs (the angle fitted 13 % large,
+  // k6 10 % small), and the pair reports no sigma to judge them by.
+  EXPECT_NEAR(p.pb, 1.444e-8, 0.15 * 1.444e-8);
 }
 
 }  // namespace test_pair_misses

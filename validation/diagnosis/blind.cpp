@@ -314,7 +314,12 @@ void score_family(const BlindCampaign& k, double size, std::map<std::string, Fam
                                       verdict_text(d), k.top);
   if (!d.ambiguous_with.empty()) {
     ++f.ambiguous;
-    const bool among = std::any_of(d.ambiguous_with.begin(), d.ambiguous_with.end(), is_truth);
+    // Among them: the truth's effect, or (an ambiguity between pairs, "A + B") a pair of the truth's.
+    const auto names_truth = [&](const std::string& n) {
+      const std::size_t plus = n.find(" + ");
+      return plus == std::string::npos ? is_truth(n) : is_truth(n.substr(0, plus)) && is_truth(n.substr(plus + 3));
+    };
+    const bool among = std::any_of(d.ambiguous_with.begin(), d.ambiguous_with.end(), names_truth);
     f.right_among += among;
     if (!among) note(why + " (ambiguous, the truth not among them)");
     return;

@@ -348,9 +348,14 @@ std::pair<double, double> EffectFitter::fit_first(const Data& d, const std::vect
   return f;
 }
 
-std::pair<double, double> EffectFitter::fit_first_uncached(const Data& d, const std::vector<int>& idx, const std::vector<double>& base) const {
+std::pair<double, double> EffectFitter::fit_first_uncached(const Data& d, const std::vector<int>& idx, const std::vector<double>& base,
+                                                           const Eigen::MatrixXd* dG) const {
   const bool nominal_base = further_nominal(base);
-  const auto at_p = [&](double p) { return nominal_base ? at(p) : at(with_first(base, p)); };
+  const auto at_p = [&](double p) {
+    Table t = nominal_base ? at(p) : at(with_first(base, p));
+    if (dG) t.G += *dG;
+    return t;
+  };
   auto L = [&](double p) {  // a value the plant refuses (a servo the design cannot build) is no fit
     try {
       const Table t = at_p(p);
@@ -362,8 +367,8 @@ std::pair<double, double> EffectFitter::fit_first_uncached(const Data& d, const 
   std::vector<double> xs;
   if (e_.fitted().linear) {
     // A bracket from the fixed-covariance (nominal V) estimate, then a scan and a refinement.
-    const Table t0 = nominal_base ? nominal_ : at_p(e_.fitted().nominal);
-    const Table t1 = nominal_base ? unit_ : at_p(e_.fitted().unit_value);
+    const Table t0 = nominal_base && !dG ? nominal_ : at_p(e_.fitted().nominal);
+    const Table t1 = nominal_base && !dG ? unit_ : at_p(e_.fitted().unit_value);
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(covariance(d, t0.G, idx));
     const double du = e_.fitted().unit_value - e_.fitted().nominal;
     const Eigen::VectorXd s = sub(t1.pred, idx) - sub(t0.pred, idx);

@@ -53,6 +53,8 @@ class EffectFitter {
   // unit value, a nonlinear one on its grid.
   EffectFitter(const Effect& e, const Table& nominal, TableAt table_at);
   const Effect& effect() const { return e_; }
+  // A nonlinear first parameter's grid (the values the plant takes; empty for a linear one).
+  const std::vector<double>& grid() const { return values_; }
   Table at(double p) const;
   // At every parameter's value (the further ones nominal: the tables above). A linear first
   // parameter stays linear at any value of the others.
@@ -67,6 +69,12 @@ class EffectFitter {
   // alone: kept per (data, runs, base), bit for bit (the folds' fits, the final fit, the
   // pairs' and the natural forms' starts ask for the same fits again).
   std::pair<double, double> fit_first(const Data& d, const std::vector<int>& idx, const std::vector<double>& base) const;
+  // The first parameter's fit (the others nominal) beside another effect that changes the
+  // coefficients' gradient: every table's G with dG added (a pair's G_A - G_0), as the pair's
+  // likelihood takes it. Not kept.
+  std::pair<double, double> fit_beside(const Data& d, const std::vector<int>& idx, const Eigen::MatrixXd& dG) const {
+    return fit_first_uncached(d, idx, nominal_values_, &dG);
+  }
 
   // Every parameter the runs `idx` pin (docs/diagnose.md, "Natural forms"): the first
   // parameter's fit at each start of the further ones (their `starts`, the nominal first); a
@@ -243,7 +251,8 @@ class EffectFitter {
   // Levenberg-Marquardt on -2 ln L + the further parameters' priors over `free`, from v.
   std::vector<double> levenberg_marquardt(const Data& d, const std::vector<int>& idx, std::vector<double> v,
                                           const std::vector<int>& free) const;
-  std::pair<double, double> fit_first_uncached(const Data& d, const std::vector<int>& idx, const std::vector<double>& base) const;
+  std::pair<double, double> fit_first_uncached(const Data& d, const std::vector<int>& idx, const std::vector<double>& base,
+                                               const Eigen::MatrixXd* dG = nullptr) const;
 
   const Effect& e_;
   const Table& nominal_;

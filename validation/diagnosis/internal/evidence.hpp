@@ -84,6 +84,11 @@ class Scorer {
     double m2logl = 0;
   };
   void score_forms(const std::function<std::vector<Form>(const std::vector<int>&)>& fit_on, Scored& sc) const;
+  // A fold whose training runs do not see the effect: its forms over the first parameter's
+  // grid, each weighted by the training runs' likelihood there (docs/diagnose.md, "Held-out
+  // evidence"); empty where the fold's fit stands (see evidence.cpp).
+  std::vector<Form> unseen_forms(const EffectFitter& fitter, const EffectFitter::Multi& mf, const Data& dd,
+                                 const std::vector<int>& train) const;
   // A fitted effect with its slope (none at a bound: sp not finite).
   Fitted fitted_at(const EffectFitter& fitter, double p, double sp) const;
   // Every parameter the runs pin (EffectFitter::fit_all): the one-parameter fit when the
