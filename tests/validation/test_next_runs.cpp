@@ -220,15 +220,16 @@ TEST(AdviceCampaign, AnAmbiguousMisalignmentIsResolvedAsPromised) {
   EXPECT_EQ(a.turned(), "right");
 }
 
-// Seed 12401, campaign 22: a squeeze film (918.9 /rad, 19.7 sigma) "not explained"
-// (shaker_third_harmonic on top). The advice locates the gap beside its largest run instead of
-// separating candidates that do not explain it: along an axis the campaign lacks or a
-// diagonal, the neighbouring band, another amplitude. Appended, they let the film be named
-// (the amplitude run beyond the campaign's 4 g shows the film's amplitude law).
-TEST(AdviceCampaign, AnUnexplainedFilmGetsRunsThatLocateItAndIsNamed) {
-  const BlindCampaign k = blind_key(22, 12401);
-  ASSERT_EQ(k.category, "single");
-  ASSERT_EQ(k.hidden.at(0).name, "squeeze_film_damping");
+// Seed 12401, campaign 199: a 3rd harmonic (ratio 0.198 at -2.37 rad, 64 sigma), "not
+// explained". The advice locates the gap beside its largest run instead of separating
+// candidates that do not explain it: along an axis the campaign lacks or a diagonal, the
+// neighbouring band, another amplitude. Appended, the three let the harmonic be named. (This
+// test had a squeeze film, seed 12401 campaign 22, which the diagnosis now names without
+// advice: docs/diagnose.md, section 7.)
+TEST(AdviceCampaign, AnUnexplainedHarmonicGetsRunsThatLocateItAndIsNamed) {
+  const BlindCampaign k = blind_key(199, 12401);
+  ASSERT_EQ(k.category, "natural");
+  ASSERT_EQ(k.hidden.at(0).name, "shaker_third_harmonic");
   const AdviceCheck a = check_advice(k, BlindSettings{}.diagnose);
   ASSERT_TRUE(a.error.empty()) << a.error;
   EXPECT_EQ(a.called_before, "unexplained");
@@ -242,7 +243,7 @@ TEST(AdviceCampaign, AnUnexplainedFilmGetsRunsThatLocateItAndIsNamed) {
     EXPECT_EQ(r.advised.purpose, "locates");
     EXPECT_EQ(r.advised.between, what[i]);
   }
-  EXPECT_EQ(a.called_after, "squeeze_film_damping");
+  EXPECT_EQ(a.called_after, "shaker_third_harmonic");
   EXPECT_EQ(a.turned(), "right");
 }
 
