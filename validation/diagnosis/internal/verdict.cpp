@@ -141,6 +141,19 @@ const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer
       v.front() = pA;
       return v;
     };
+    // B's fit to what A (fitted on idx) leaves, along G_A + G_B - G_0 (EffectFitter::fit_beside):
+    // the seconds' ranking and the pair's start, kept per (runs, B).
+    std::map<std::pair<std::vector<int>, const EffectFitter*>, std::pair<double, double>> b_fits;
+    const auto b_beside = [&](const EffectFitter& B, const std::vector<int>& idx) {
+      auto it = b_fits.find({idx, &B});
+      if (it == b_fits.end()) {
+        const Table ta = A.at(a_base(idx));
+        Data rest = data;
+        rest.measured -= ta.pred - nominal.pred;
+        it = b_fits.emplace(std::make_pair(idx, &B), B.fit_beside(rest, idx, ta.G - nominal.G)).first;
+      }
+      return it->second;
+    };
     // The pair fitted on its own objective J(pA, pB) = -2 ln L of T_A + T_B - T_0 (the
     // coefficients' errors taken out with G_A + G_B - G_0): from A's fit alone and B's fit to
     // what A leaves, coordinate descent on J (each coordinate a bracketed line search), so the
@@ -158,10 +171,7 @@ const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer
           return static_cast<double>(INFINITY);
         }
       };
-      Data rest = data;
-      const Table ta0 = A.at(base);
-      rest.measured -= ta0.pred - nominal.pred;
-      const auto [pb0, sb0] = B.fit_beside(rest, idx, ta0.G - nominal.G);
+      const auto [pb0, sb0] = b_beside(B, idx);
       double p[2] = {base.front(), pb0}, sig[2] = {NAN, sb0};
       const EffectParameter* q[2] = {&ea.fitted(), &eb.fitted()};
       double f = J(p[0], p[1]);
@@ -215,7 +225,6 @@ const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer
       // belongs can rank last: seed 12801, campaign 63, a 2nd harmonic with k6, k6's drop
       // -1474.)
       const Table ta = A.at(a_base(idx));
-      const Eigen::MatrixXd dG = ta.G - nominal.G;
       Data rest = data;
       rest.measured -= ta.pred - nominal.pred;
       const double l_rest = likelihood(rest, nominal.pred, ta.G, idx).m2logl;
@@ -223,7 +232,7 @@ const Scored* best_pair(const CampaignModel& m, const Evidence& ev, const Scorer
       for (const Effect& eb : effect_library()) {
         if (eb.name == ea.name || !fitters.count(eb.name)) continue;
         const EffectFitter& B = *fitters.at(eb.name);
-        const Table tb = B.at(B.fit_beside(rest, idx, dG).first);
+        const Table tb = B.at(b_beside(B, idx).first);
         const double fall = l_rest - likelihood(rest, tb.pred, ta.G + tb.G - nominal.G, idx).m2logl;
         drop.emplace_back(std::isfinite(fall) ? fall : -INFINITY, &eb);  // (not finite: last)
       }
