@@ -290,23 +290,34 @@ ResponseRows response_rows(const LoopResponse& r) {
 // factor are summed: T = H S is T_i. = T_i S_i. on the felt rows, and (H S H^H)_ab =
 // sum_k T_ak conj(H_bk) has one term for a felt b. The terms left out are exact zeros.
 void add_point(RandomResponse& out, double weight, const LoopResponse& r, const Eigen::Matrix3cd& s) {
-  using C = std::complex<double>;
   ++out.frequencies;
-  std::array<std::array<C, 3>, 5> h{}, t{};  // H and H S, rows F_IA, F_PA, F_OA, I, Theta
+  // In real arithmetic, as the complex products compute them (x y: Re = xr yr - xi yi, Im =
+  // xr yi + xi yr; Re(x conj(y)) = xr yr + xi yi), without their NaN checks or the imaginary
+  // parts only the real part is taken of: the same numbers.
+  double hr[5][3] = {}, hi[5][3] = {}, tr[5][3], ti[5][3];  // H and H S, rows F_IA, F_PA, F_OA, I, Theta
   for (std::size_t j = 0; j < 3; ++j) {
-    h[j][j] = r.mechanical[j];
-    h[RandomResponse::kCurrent][j] = r.current[j];
-    h[RandomResponse::kAngle][j] = r.angle_rad[j];
+    hr[j][j] = r.mechanical[j].real(), hi[j][j] = r.mechanical[j].imag();
+    hr[RandomResponse::kCurrent][j] = r.current[j].real(), hi[RandomResponse::kCurrent][j] = r.current[j].imag();
+    hr[RandomResponse::kAngle][j] = r.angle_rad[j].real(), hi[RandomResponse::kAngle][j] = r.angle_rad[j].imag();
+  }
+  double sr[3][3], si[3][3];
+  for (Eigen::Index a = 0; a < 3; ++a)
+    for (Eigen::Index b = 0; b < 3; ++b) sr[a][b] = s(a, b).real(), si[a][b] = s(a, b).imag();
+  for (std::size_t b = 0; b < 3; ++b) {
+    for (std::size_t a = 0; a < 3; ++a)
+      tr[a][b] = hr[a][a] * sr[a][b] - hi[a][a] * si[a][b], ti[a][b] = hr[a][a] * si[a][b] + hi[a][a] * sr[a][b];
+    for (std::size_t a = 3; a < 5; ++a) {
+      const double r0 = hr[a][0] * sr[0][b] - hi[a][0] * si[0][b], i0 = hr[a][0] * si[0][b] + hi[a][0] * sr[0][b];
+      const double r1 = hr[a][1] * sr[1][b] - hi[a][1] * si[1][b], i1 = hr[a][1] * si[1][b] + hi[a][1] * sr[1][b];
+      const double r2 = hr[a][2] * sr[2][b] - hi[a][2] * si[2][b], i2 = hr[a][2] * si[2][b] + hi[a][2] * sr[2][b];
+      tr[a][b] = r0 + (r1 + r2), ti[a][b] = i0 + (i1 + i2);
+    }
   }
   for (std::size_t a = 0; a < 5; ++a)
-    for (std::size_t b = 0; b < 3; ++b)
-      t[a][b] = a < 3 ? h[a][a] * s(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b))
-                      : h[a][0] * s(0, static_cast<Eigen::Index>(b)) +
-                            (h[a][1] * s(1, static_cast<Eigen::Index>(b)) + h[a][2] * s(2, static_cast<Eigen::Index>(b)));
-  for (std::size_t a = 0; a < 5; ++a)
     for (std::size_t b = 0; b < 5; ++b) {
-      const double re = b < 3 ? (t[a][b] * std::conj(h[b][b])).real()
-                              : (t[a][0] * std::conj(h[b][0]) + (t[a][1] * std::conj(h[b][1]) + t[a][2] * std::conj(h[b][2]))).real();
+      const double re = b < 3 ? tr[a][b] * hr[b][b] + ti[a][b] * hi[b][b]
+                              : (tr[a][0] * hr[b][0] + ti[a][0] * hi[b][0]) +
+                                    ((tr[a][1] * hr[b][1] + ti[a][1] * hi[b][1]) + (tr[a][2] * hr[b][2] + ti[a][2] * hi[b][2]));
       out.covariance(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) += weight * re;
     }
   out.input_covariance_g2 += weight * s.real();
@@ -514,97 +525,127 @@ void for_each_rectifying_term(const Coefficients& coefficients, const Locations&
 // moments of the periodic part) as periodic_rectification has it; the random part's angle
 // moments add; a readout polynomial is averaged jointly (the period's points, Gauss-Hermite
 // in U).
-FrequencyPrediction periodic_on_random(const PlantConfig& config, const Vec3& a, const RandomResponse& rr, const PeriodicInput& in,
-                                       const ResponseAt& response) {
-  FrequencyPrediction out = periodic_rectification(config, a, in, response, true, false);  // (no second order on random)
-  out.terms = {};
-  out.second_order_left_out = pickoff_p2_per_rad(config) != 0;
-  struct Tone {
-    int h;
-    Eigen::Vector3cd F;
-    std::complex<double> I;
-  };
-  std::vector<Tone> tones;
-  int h_max = 1;
-  for (const auto& [h, W] : in.tones) {
-    const LoopResponse r = response(h * in.frequency_Hz);
-    Tone t{h, Eigen::Vector3cd::Zero(), 0.0};
-    for (int j = 0; j < 3; ++j) {
-      const auto sj = static_cast<std::size_t>(j);
-      t.F[j] = r.mechanical[sj] * W[j];
-      t.I += r.current[sj] * W[j];
+}  // namespace
+
+// (What does not depend on the coefficients prepared once: the periodic part's rectification
+// and its points, the random part's Gaussian description.)
+class PreparedRandomRectification::PeriodicOnRandom {
+ public:
+  PeriodicOnRandom(const PlantConfig& config, const Vec3& a, const RandomResponse& rr, const PeriodicInput& in,
+                   const ResponseAt& response)
+      : periodic_(config, a, in, response, true, false),  // (no second order on random)
+        location_(config.location),
+        effects_(config.effects),
+        dynamics_(config.dynamics),
+        a_(a),
+        rr_(rr),
+        mean_g_(in.mean_g),
+        g_(gaussian_parts(rr)),
+        b0_(plant::basis(a)) {
+    struct Tone {
+      int h;
+      Eigen::Vector3cd F;
+      std::complex<double> I;
+    };
+    std::vector<Tone> tones;
+    int h_max = 1;
+    for (const auto& [h, W] : in.tones) {
+      const LoopResponse r = response(h * in.frequency_Hz);
+      Tone t{h, Eigen::Vector3cd::Zero(), 0.0};
+      for (int j = 0; j < 3; ++j) {
+        const auto sj = static_cast<std::size_t>(j);
+        t.F[j] = r.mechanical[sj] * W[j];
+        t.I += r.current[sj] * W[j];
+      }
+      tones.push_back(t);
+      h_max = std::max(h_max, h);
     }
-    tones.push_back(t);
-    h_max = std::max(h_max, h);
-  }
-  for (const PeriodicInput::LoopTone& l : in.loop) tones.push_back({l.h, Eigen::Vector3cd::Zero(), l.current_g}), h_max = std::max(h_max, l.h);
-  const int points = std::max(64, 6 * h_max + 1);
-  const Vec3 a_mean = a + in.mean_g;
-  std::vector<Vec3> felt_at(static_cast<std::size_t>(points)), loop_at(felt_at.size());
-  std::vector<double> current_at(felt_at.size());
-  for (int k = 0; k < points; ++k) {
-    const double phi = 2 * std::numbers::pi * k / points;
-    Vec3 felt = a_mean;
-    double current = 0;
-    for (const Tone& t : tones) {
-      const std::complex<double> e = std::polar(1.0, t.h * phi);
-      for (int i = 0; i < 3; ++i) felt[i] += std::imag(t.F[i] * e);
-      current += std::imag(t.I * e);
+    for (const PeriodicInput::LoopTone& l : in.loop) tones.push_back({l.h, Eigen::Vector3cd::Zero(), l.current_g}), h_max = std::max(h_max, l.h);
+    points_ = std::max(64, 6 * h_max + 1);
+    a_mean_ = a + in.mean_g;
+    felt_at_.resize(static_cast<std::size_t>(points_)), loop_at_.resize(felt_at_.size()), current_at_.resize(felt_at_.size());
+    for (int k = 0; k < points_; ++k) {
+      const double phi = 2 * std::numbers::pi * k / points_;
+      Vec3 felt = a_mean_;
+      double current = 0;
+      for (const Tone& t : tones) {
+        const std::complex<double> e = std::polar(1.0, t.h * phi);
+        for (int i = 0; i < 3; ++i) felt[i] += std::imag(t.F[i] * e);
+        current += std::imag(t.I * e);
+      }
+      const auto sk = static_cast<std::size_t>(k);
+      felt_at_[sk] = loop_at_[sk] = felt;
+      loop_at_[sk][IA] = a_mean_[IA] + current;
+      current_at_[sk] = current;
     }
-    const auto sk = static_cast<std::size_t>(k);
-    felt_at[sk] = loop_at[sk] = felt;
-    loop_at[sk][IA] = a_mean[IA] + current;
-    current_at[sk] = current;
   }
-  const GaussianParts g = gaussian_parts(rr);
-  const double dc_gain = out.loop_dc_gain;
-  const plant::Basis b0 = plant::basis(a);
-  for_each_rectifying_term(config.coefficients, config.location, [&](int c, const Coefficients& only, bool filtered) {
-    const double gain = config.location[c] == Location::output ? 1.0 : dc_gain;
-    const int term = term_of_coefficient(c);
-    for (std::size_t k = 0; k < felt_at.size(); ++k) {
-      const Vec3& x = filtered ? loop_at[k] : felt_at[k];
-      Eq3Terms t = random_rectification(only, x, filtered ? g.through_loop : g.felt);
-      t.g[term] += config.coefficients[c] * (plant::basis(x)[c] - b0[c]);
-      for (int j = 0; j < kNumTerms; ++j) out.terms.g[j] += gain * t.g[j] / points;
+
+  FrequencyPrediction operator()(const Coefficients& coefficients) const {
+    FrequencyPrediction out = periodic_(coefficients);
+    out.terms = {};
+    double p2 = 0.0;
+    bool geometry = false, readout = false;
+    for (const auto& e : effects_) {
+      p2 += e->pickoff_p2_per_rad();
+      geometry = geometry || e->vibropendulous();
+      readout = readout || e->readout_averaged_in_prediction();
     }
-  });
-  double p2 = 0.0;
-  bool geometry = false, readout = false;
-  for (const auto& e : config.effects) {
-    p2 += e->pickoff_p2_per_rad();
-    geometry = geometry || e->vibropendulous();
-    readout = readout || e->readout_averaged_in_prediction();
-  }
-  const auto& c5 = rr.covariance;
-  const Dynamics& d = config.dynamics;
-  const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
-  out.pickoff_g += wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * c5(R::kAngle, R::kAngle);
-  if (geometry) out.pendulum_geometry_g += dc_gain * (-c5(R::kF_PA, R::kAngle) - a_mean[IA] * c5(R::kAngle, R::kAngle) / 2);
-  if (readout) {  // as PreparedPeriodicRectification's, with U's Gaussian part at every point
-    const Vec3 slope = readout_slope(config.coefficients, config.location, a);
-    const double sigma_u = readout_sigma(rr, slope);
-    const double u0 = plant::output_g(config.coefficients, a);
-    const double u_mean = u0 + in.mean_g[IA] + slope.dot(in.mean_g);
-    const HermiteRule& gh = hermite_rule();
-    out.readout_g = 0;
-    for (std::size_t k = 0; k < felt_at.size(); ++k) {
-      const double u = u_mean + current_at[k] + slope.dot(felt_at[k] - a_mean);
-      for (const auto& e : config.effects) {
-        if (!e->readout_averaged_in_prediction()) continue;
-        for (std::size_t n = 0; n < gh.x.size(); ++n) {
-          const double un = u + sigma_u * gh.x[n];
-          out.readout_g += gh.w[n] * (e->readout(un) - un) / points;
+    out.second_order_left_out = p2 != 0;
+    const int points = points_;
+    const double dc_gain = out.loop_dc_gain;
+    for_each_rectifying_term(coefficients, location_, [&](int c, const Coefficients& only, bool filtered) {
+      const double gain = location_[c] == Location::output ? 1.0 : dc_gain;
+      const int term = term_of_coefficient(c);
+      for (std::size_t k = 0; k < felt_at_.size(); ++k) {
+        const Vec3& x = filtered ? loop_at_[k] : felt_at_[k];
+        Eq3Terms t = random_rectification(only, x, filtered ? g_.through_loop : g_.felt);
+        t.g[term] += coefficients[c] * (plant::basis(x)[c] - b0_[c]);
+        for (int j = 0; j < kNumTerms; ++j) out.terms.g[j] += gain * t.g[j] / points;
+      }
+    });
+    const auto& c5 = rr_.covariance;
+    const Dynamics& d = dynamics_;
+    const double wp = 2 * std::numbers::pi * d.pendulum_frequency_Hz;
+    out.pickoff_g += wp * wp / d.angle_gain_rad_per_s2_per_g * p2 * c5(R::kAngle, R::kAngle);
+    if (geometry) out.pendulum_geometry_g += dc_gain * (-c5(R::kF_PA, R::kAngle) - a_mean_[IA] * c5(R::kAngle, R::kAngle) / 2);
+    if (readout) {  // as PreparedPeriodicRectification's, with U's Gaussian part at every point
+      const Vec3 slope = readout_slope(coefficients, location_, a_);
+      const double sigma_u = readout_sigma(rr_, slope);
+      const double u0 = plant::output_g(coefficients, a_);
+      const double u_mean = u0 + mean_g_[IA] + slope.dot(mean_g_);
+      const HermiteRule& gh = hermite_rule();
+      out.readout_g = 0;
+      for (std::size_t k = 0; k < felt_at_.size(); ++k) {
+        const double u = u_mean + current_at_[k] + slope.dot(felt_at_[k] - a_mean_);
+        for (const auto& e : effects_) {
+          if (!e->readout_averaged_in_prediction()) continue;
+          for (std::size_t n = 0; n < gh.x.size(); ++n) {
+            const double un = u + sigma_u * gh.x[n];
+            out.readout_g += gh.w[n] * (e->readout(un) - un) / points;
+          }
         }
       }
+      for (const auto& e : effects_)
+        if (e->readout_averaged_in_prediction()) out.readout_g -= e->readout(u0) - u0;
     }
-    for (const auto& e : config.effects)
-      if (e->readout_averaged_in_prediction()) out.readout_g -= e->readout(u0) - u0;
+    return out;
   }
-  return out;
-}
 
-}  // namespace
+ private:
+  PreparedPeriodicRectification periodic_;
+  Locations location_;
+  std::vector<std::shared_ptr<const plant::Effect>> effects_;
+  Dynamics dynamics_;
+  Vec3 a_;
+  RandomResponse rr_;
+  Vec3 mean_g_;
+  GaussianParts g_;
+  plant::Basis b0_;
+  Vec3 a_mean_;
+  int points_ = 0;
+  std::vector<Vec3> felt_at_, loop_at_;
+  std::vector<double> current_at_;
+};
 
 PreparedRandomRectification::PreparedRandomRectification(const PlantConfig& config, const Vec3& a, const RandomResponse& rr,
                                                          const std::optional<PeriodicInput>& periodic, const ResponseAt& response,
@@ -613,8 +654,8 @@ PreparedRandomRectification::PreparedRandomRectification(const PlantConfig& conf
   if (periodic && !response) throw std::invalid_argument("random_rectification_at_frequency: a periodic part needs the loop's response");
   if (periodic && !(periodic->frequency_Hz > 0))
     throw std::invalid_argument("random_rectification_at_frequency: the periodic part's frequency_Hz must be positive");
-  if (periodic && !periodic->single_tone()) {  // several tones: periodic_on_random at each call
-    periodic_ = *periodic, response_ = response;
+  if (periodic && !periodic->single_tone()) {  // several tones: prepared once (PeriodicOnRandom)
+    periodic_ = std::make_shared<const PeriodicOnRandom>(config, a, rr, *periodic, response);
     return;
   }
   // Random alone, or a single tone on it (the sine's terms in closed form, eq3.hpp).
@@ -687,11 +728,7 @@ PreparedRandomRectification::PreparedRandomRectification(const PlantConfig& conf
 }
 
 FrequencyPrediction PreparedRandomRectification::operator()(const Coefficients& coefficients) const {
-  if (periodic_) {
-    PlantConfig q = config_;
-    q.coefficients = coefficients;
-    return periodic_on_random(q, a_, rr_, *periodic_, response_);
-  }
+  if (periodic_) return (*periodic_)(coefficients);
   const bool sine = points_felt_.has_value();
   const Vec3& a = a_;
   const vibration::RandomVibration &felt = felt_, &through_loop = through_loop_;

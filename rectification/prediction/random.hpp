@@ -35,6 +35,7 @@
 // A squeeze film's amplitude-dependent damping: by statistical linearisation
 // (random_linearised_damping below), the film's harmonics and the angle's departure from a Gaussian
 // left out. Not modelled: clipping beyond the current's Gaussian (range limit of I).
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -171,8 +172,9 @@ class PreparedRandomRectification {
   plant::PlantConfig config_;
   Vec3 a_;
   RandomResponse rr_;
-  std::optional<PeriodicInput> periodic_;  // several tones (periodic_on_random at each call)
-  ResponseAt response_;
+  // Several tones on random: each term averaged at the period's points (random.cpp).
+  class PeriodicOnRandom;
+  std::shared_ptr<const PeriodicOnRandom> periodic_;
   vibration::RandomVibration felt_, through_loop_;  // what the terms of (1) see of the random part
   vibration::SineVibration sine_felt_, sine_loop_;
   std::optional<SinePhasePoints> points_felt_, points_loop_;  // with a sine

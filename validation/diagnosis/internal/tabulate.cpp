@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 #include <numbers>
 #include <optional>
 #include <stdexcept>
@@ -183,7 +184,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     // responses are kept for the run only, not in the cache (the same numbers: the plant
     // linearised once, each frequency solved once).
     const bool own = !film && cfg.dynamics.pendulum_damping_ratio != with_films.dynamics.pendulum_damping_ratio && cfg.servo;
-    std::optional<rectification::LoopResponder> own_responder;
+    std::unique_ptr<const rectification::LoopResponder> own_responder;  // (~9 kB: made only where needed)
     std::map<double, rectification::LoopResponse> own_responses;
     const rectification::ResponseAt h = [&](double f) {
       if (film)
@@ -193,7 +194,7 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       auto it = own_responses.find(f);
       if (it == own_responses.end()) {
         if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
-        if (!own_responder) own_responder.emplace(cfg);
+        if (!own_responder) own_responder = std::make_unique<const rectification::LoopResponder>(cfg);
         it = own_responses.emplace(f, (*own_responder)(f)).first;
       }
       return it->second;
