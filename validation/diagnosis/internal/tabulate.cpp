@@ -125,7 +125,18 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
   const double p = values.empty() ? 0.0 : values.front();
   const int n = static_cast<int>(runs.size());
   Table t{Eigen::VectorXd(n), Eigen::MatrixXd(n, plant::kNumCoefficients)};
-  std::map<std::string, std::pair<PlantConfig, rectification::PeriodicInput>> film_memo;
+  // A film's linearised plant, balance and loop responses per (plant, motion): runs that differ
+  // only in orientation share them (the same function of the same numbers).
+  struct OwnLoop {  // the linearised plant's own loop (its damping is the run's)
+    std::unique_ptr<const rectification::LoopResponder> responder;  // (~9 kB: made only where needed)
+    std::map<double, rectification::LoopResponse> responses;
+  };
+  struct FilmMemo {
+    PlantConfig cfg;
+    rectification::PeriodicInput input;
+    std::shared_ptr<OwnLoop> own;
+  };
+  std::map<std::string, FilmMemo> film_memo;
   // A distorted or rocking table's period resolved into harmonics once per motion in the
   // table: runs that differ only in orientation shake alike (the same function of the same
   // numbers).
@@ -143,12 +154,12 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
     TableMotion m = table_motion(r);
     apply_effect(e, values, r, cfg, m);
     const PlantConfig with_films = cfg;
-    // A film's linearisation and balance once per (plant, motion) in the table: runs that
-    // differ only in orientation share them (the same function of the same numbers).
+    // A film's linearisation, balance and own loop once per (plant, motion) in the table
+    // (film_memo).
     const rectification::PeriodicInput motion = r.random ? rectification::PeriodicInput{} : motion_of(r, m);
     const std::string film_key = r.random ? std::string() : rectification::film_balance_key(with_films, m.sine, motion);
     const auto memo = film_key.empty() ? film_memo.end() : film_memo.find(film_key);
-    if (memo != film_memo.end()) cfg = memo->second.first;
+    if (memo != film_memo.end()) cfg = memo->second.cfg;
     else if (!r.random) cfg = rectification::amplitude_linearised(cfg, m.sine);
     // A film on a random run: the loop without it at its damping and twice it, by keys of the
     // effect's further values alone (the same plants at every value of the film), so every
@@ -181,28 +192,26 @@ Table tabulate_runs(const PlantConfig& nominal, const std::vector<RunRecord>& ru
       for (std::size_t j = 1; j < values.size(); ++j) put(values[j]);
     }
     // A squeeze film's linearised plant is this run's own (its damping is in the key): its
-    // responses are kept for the run only, not in the cache (the same numbers: the plant
-    // linearised once, each frequency solved once).
+    // responses are kept with its balance (film_memo), not in the cache.
     const bool own = !film && cfg.dynamics.pendulum_damping_ratio != with_films.dynamics.pendulum_damping_ratio && cfg.servo;
-    std::unique_ptr<const rectification::LoopResponder> own_responder;  // (~9 kB: made only where needed)
-    std::map<double, rectification::LoopResponse> own_responses;
+    const std::shared_ptr<OwnLoop> own_loop = memo != film_memo.end() ? memo->second.own : std::make_shared<OwnLoop>();
     const rectification::ResponseAt h = [&](double f) {
       if (film)
         return rectification::damped_response(cache.get(film->base, film_key0, f), cache.get(film->twice, film_key2, f),
                                               film->x());
       if (!own) return cache.get(cfg, key, f);
-      auto it = own_responses.find(f);
-      if (it == own_responses.end()) {
+      auto it = own_loop->responses.find(f);
+      if (it == own_loop->responses.end()) {
         if (!(f > 0)) throw std::invalid_argument("frequency_Hz must be positive");
-        if (!own_responder) own_responder = std::make_unique<const rectification::LoopResponder>(cfg);
-        it = own_responses.emplace(f, (*own_responder)(f)).first;
+        if (!own_loop->responder) own_loop->responder = std::make_unique<const rectification::LoopResponder>(cfg);
+        it = own_loop->responses.emplace(f, (*own_loop->responder)(f)).first;
       }
       return it->second;
     };
     const rectification::PeriodicInput input = r.random                  ? rectification::PeriodicInput{}
-                                               : memo != film_memo.end() ? memo->second.second
+                                               : memo != film_memo.end() ? memo->second.input
                                                                          : rectification::film_harmonic_balance(with_films, cfg, motion, h);
-    if (!film_key.empty() && memo == film_memo.end()) film_memo.emplace(film_key, std::make_pair(cfg, input));
+    if (!film_key.empty() && memo == film_memo.end()) film_memo.emplace(film_key, FilmMemo{cfg, input, own_loop});
     // A random or sine-on-random run: the random part's covariances through the loop, once;
     // the sine part as the table makes it (harmonics, rocking: motion_of).
     std::optional<rectification::RandomResponse> rr;
