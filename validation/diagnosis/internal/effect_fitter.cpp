@@ -140,8 +140,27 @@ bool EffectFitter::any_discrete() const {
 }
 
 std::vector<EffectFitter::Form> EffectFitter::fit_forms(const Data& d, const std::vector<int>& idx) const {
-  if (!any_discrete()) return {Form{fit_all(d, idx), 0.0}};
-  return fit_forms(d, idx, starts(d, idx));
+  if (any_discrete()) return fit_forms(d, idx, starts(d, idx));
+  if (e_.parameters.size() == 1) return {Form{fit_all(d, idx), 0.0}};
+  // Without a discrete form: fit_all's fit, or where its starts' descents end in distinct
+  // valleys (a phase on either side of the circle), each valley (see fit_forms in the header).
+  const Starts s = starts(d, idx);
+  std::vector<Form> valleys;
+  Multi best = fit_from(d, idx, s, static_cast<std::size_t>(std::min_element(s.l.begin(), s.l.end()) - s.l.begin()), &valleys);
+  if (valleys.size() > 1) return valleys;
+  return {Form{std::move(best), 0.0}};
+}
+
+bool EffectFitter::same_valley(const Multi& a, const Multi& b) const {
+  if (a.free != b.free) return false;
+  for (std::size_t k = 0; k < a.free.size(); ++k) {
+    const auto j = static_cast<std::size_t>(a.free[k]);
+    double by = a.values[j] - b.values[j];
+    if (wraps(static_cast<int>(j))) by = std::remainder(by, range(static_cast<int>(j)).second - range(static_cast<int>(j)).first);
+    const double width = std::max(a.sigma[j], b.sigma[j]);
+    if (!(std::abs(by) <= 3 * width)) return false;  // (a NaN sigma: not the same)
+  }
+  return true;
 }
 
 std::vector<EffectFitter::Form> EffectFitter::fit_forms(const Data& d, const std::vector<int>& idx, const Starts& s) const {
@@ -172,7 +191,8 @@ std::vector<EffectFitter::Form> EffectFitter::fit_forms(const Data& d, const std
   return forms;
 }
 
-EffectFitter::Multi EffectFitter::fit_from(const Data& d, const std::vector<int>& idx, const Starts& s, std::size_t best) const {
+EffectFitter::Multi EffectFitter::fit_from(const Data& d, const std::vector<int>& idx, const Starts& s, std::size_t best,
+                                            std::vector<Form>* valleys) const {
   const std::size_t m = e_.parameters.size();
   Multi out;
   out.values = nominal_values_;
@@ -197,12 +217,24 @@ EffectFitter::Multi EffectFitter::fit_from(const Data& d, const std::vector<int>
       // other start of the same form whose -2 ln L is within kSeen of this one's descends
       // too; the lowest objective wins.
       double f_best = objective_at(d, idx, res.values, res.free);
+      // Each descent's end, a valley unless one found before holds it (the lower kept).
+      const auto keep = [&](const Multi& r, double f) {
+        if (!valleys) return;
+        for (Form& v : *valleys)
+          if (same_valley(v.mf, r)) {
+            if (f < v.m2logl) v = Form{r, f};
+            return;
+          }
+        valleys->push_back(Form{r, f});
+      };
+      keep(res, f_best);
       for (std::size_t b = 0; b < s.v.size(); ++b) {
         if (b == best || s.l[b] - s.l[best] > kSeen || !same_form(s.v[b], start)) continue;
         std::vector<int> fb = free;
         Multi rb = out;
         if (!descend(d, idx, s.v[b], fb, rb)) continue;
         const double fb_obj = objective_at(d, idx, rb.values, rb.free);
+        keep(rb, fb_obj);
         if (fb_obj < f_best) f_best = fb_obj, res = rb;
       }
       return res;

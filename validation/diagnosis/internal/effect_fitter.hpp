@@ -103,7 +103,10 @@ class EffectFitter {
   // whatever its start's -2 ln L; m2logl is its objective at its fit (-2 ln L with the
   // further parameters' priors) plus -2 ln of its prior odds against the default form
   // (kDiscreteGain for any other form, the choice's own Bayes factor). An effect without a
-  // discrete parameter: fit_all's fit alone.
+  // discrete parameter: fit_all's fit alone, or where the descents from its starts end in
+  // distinct valleys (a harmonic's phase on either side of the circle, which 1 and 2 g runs
+  // cannot tell apart), each valley as a form weighted by its objective (no prior odds: one
+  // form's valleys), so that the held-out runs choose between them.
   struct Form {
     Multi mf;
     double m2logl = 0;
@@ -177,7 +180,13 @@ class EffectFitter {
   };
   Starts starts(const Data& d, const std::vector<int>& idx) const;
   // fit_all's steps 3-4 from start `best` (its form's discrete values kept).
-  Multi fit_from(const Data& d, const std::vector<int>& idx, const Starts& s, std::size_t best) const;
+  // valleys (when given): every descent's end as a form (its objective the weight), one per
+  // valley (same_valley), the lower kept.
+  Multi fit_from(const Data& d, const std::vector<int>& idx, const Starts& s, std::size_t best,
+                 std::vector<Form>* valleys = nullptr) const;
+  // The same valley: the same parameters fitted, each within 3 sigma (the larger) of the other
+  // (a periodic one round the circle).
+  bool same_valley(const Multi& a, const Multi& b) const;
   std::vector<Form> fit_forms(const Data& d, const std::vector<int>& idx, const Starts& s) const;
   bool any_discrete() const;                                                         // a further parameter is discrete
   bool discrete_nominal(const std::vector<double>& v) const;                       // every discrete parameter at its nominal
