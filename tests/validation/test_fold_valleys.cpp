@@ -27,6 +27,7 @@
 #include "plant/model1.hpp"
 #include "support/blind_replay.hpp"
 #include "support/diagnosis_lookup.hpp"
+#include "support/two_fold_model.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 #include "validation/diagnosis/effect.hpp"
 #include "validation/diagnosis/internal/effect_fitter.hpp"
@@ -43,14 +44,8 @@ namespace {
 constexpr double kTruthPhase = 1.3, kMirrorPhase = -0.7, kSigma = 0.05;
 
 // 12 training runs (fold key 1) and 12 held-out runs (fold key 4).
-struct Synthetic {
-  Campaign campaign;
-  ResponseCache cache;
-  CampaignModel m{campaign, 0.0, cache};
-  Folds folds;
-};
-
-bool held_out(int k) { return k >= 12; }
+using Synthetic = vrelab::test::TwoFoldModel;
+bool held_out(int k) { return Synthetic::second_fold(k); }
 
 Eigen::VectorXd prediction(const Eigen::VectorXd& f0, double r, double phi) {
   Eigen::VectorXd p = f0;
@@ -62,21 +57,11 @@ Eigen::VectorXd prediction(const Eigen::VectorXd& f0, double r, double phi) {
 }
 
 void make(Synthetic& s, unsigned seed) {
-  const int n = 24, m = vrelab::plant::kNumCoefficients;
+  const int n = Synthetic::kRuns;
   Eigen::VectorXd f0(n);
-  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, m);
-  s.m.data.sigma2 = Eigen::VectorXd::Constant(n, kSigma * kSigma);
-  for (int k = 0; k < n; ++k) {
-    f0(k) = 1e-3 * (k % 12), G(k, 0) = 1;
-    const double key = held_out(k) ? 4.0 : 1.0;
-    s.folds.key.push_back(key);
-    s.folds.test[key].push_back(k);
-    s.m.all.push_back(k);
-  }
-  s.folds.description = "synthetic";
-  s.m.n = n;
-  s.m.data.Sigma = 1e-8 * Eigen::MatrixXd::Identity(m, m);
-  s.m.nominal = {f0, G};
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, vrelab::plant::kNumCoefficients);
+  for (int k = 0; k < n; ++k) f0(k) = 1e-3 * (k % 12), G(k, 0) = 1;
+  s.set(f0, G, kSigma);
   // The training runs exactly as the mirror predicts them (the truth predicts the same), the
   // held-out ones as the truth, with noise.
   const Eigen::VectorXd truth = prediction(f0, 1.0, kTruthPhase), mirror = prediction(f0, 1.0, kMirrorPhase);

@@ -23,6 +23,7 @@
 #include "plant/model1.hpp"
 #include "support/blind_replay.hpp"
 #include "support/diagnosis_lookup.hpp"
+#include "support/two_fold_model.hpp"
 #include "validation/diagnosis/diagnosis_text.hpp"
 #include "validation/diagnosis/effect.hpp"
 #include "validation/diagnosis/internal/effect_fitter.hpp"
@@ -36,42 +37,27 @@ using namespace vrelab::validation::internal;
 
 namespace {
 
-// 24 runs (with kNumCoefficients coefficients): 12 at "1 g" (fold key 1) that barely feel the effect, 12 at "4 g" (fold key 4) that
+// 24 runs: 12 at "1 g" (fold key 1) that barely feel the effect, 12 at "4 g" (fold key 4) that
 // feel it strongly; pred = f0 + S p^2, the truth p = 2 (at "4 g" 16 x 0.05 = 0.8 against a sigma
 // of 0.05, at "1 g" 0.2 sigma).
-struct Synthetic {
-  Campaign campaign;
-  ResponseCache cache;
-  CampaignModel m{campaign, 0.0, cache};
+struct Synthetic : vrelab::test::TwoFoldModel {
   Eigen::VectorXd S;
-  Folds folds;
 };
 
 void make(Synthetic& s, unsigned seed) {
-  const int n = 24;
+  const int n = Synthetic::kRuns;
   s.S.resize(n);
   Eigen::VectorXd f0(n);
   // The coefficients' gradient has the plant's kNumCoefficients columns (the scorer's layout);
   // two carry the runs' shared errors, the others are zero.
-  const int m = vrelab::plant::kNumCoefficients;
-  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, m);
-  s.m.data.sigma2.resize(n);
+  Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n, vrelab::plant::kNumCoefficients);
   for (int k = 0; k < n; ++k) {
-    const bool large = k >= n / 2;
     const double x = 1 + 0.25 * (k % 12);
     f0(k) = 1e-3 * x, G(k, 0) = 1, G(k, 1) = x * x;
-    s.S(k) = large ? 0.05 : 0.0006 * x;
-    s.m.data.sigma2(k) = 0.05 * 0.05;
-    const double key = large ? 4.0 : 1.0;
-    s.folds.key.push_back(key);
-    s.folds.test[key].push_back(k);
-    s.m.all.push_back(k);
+    s.S(k) = Synthetic::second_fold(k) ? 0.05 : 0.0006 * x;
   }
-  s.folds.description = "synthetic";
-  s.m.n = n;
-  s.m.data.Sigma = 1e-8 * Eigen::MatrixXd::Identity(m, m);
+  s.set(f0, G, 0.05);
   s.m.data.Sigma(0, 0) = 1e-6;
-  s.m.nominal = {f0, G};
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> n01;
   s.m.data.measured.resize(n);
