@@ -217,9 +217,10 @@ EffectFitter::Multi EffectFitter::fit_from(const Data& d, const std::vector<int>
       // other start of the same form whose -2 ln L is within kSeen of this one's descends
       // too; the lowest objective wins.
       double f_best = objective_at(d, idx, res.values, res.free);
-      // Each descent's end, a valley unless one found before holds it (the lower kept).
+      // Each descent's end, a valley unless one found before holds it (the lower kept); an end
+      // whose objective is not finite weighs nothing and is left out.
       const auto keep = [&](const Multi& r, double f) {
-        if (!valleys) return;
+        if (!valleys || !std::isfinite(f)) return;
         for (Form& v : *valleys)
           if (same_valley(v.mf, r)) {
             if (f < v.m2logl) v = Form{r, f};
