@@ -542,6 +542,11 @@ class PreparedRandomRectification::PeriodicOnRandom {
         mean_g_(in.mean_g),
         g_(gaussian_parts(rr)),
         b0_(plant::basis(a)) {
+    for (const auto& e : effects_) {
+      p2_ += e->pickoff_p2_per_rad();
+      geometry_ = geometry_ || e->vibropendulous();
+      readout_ = readout_ || e->readout_averaged_in_prediction();
+    }
     struct Tone {
       int h;
       Eigen::Vector3cd F;
@@ -583,13 +588,8 @@ class PreparedRandomRectification::PeriodicOnRandom {
   FrequencyPrediction operator()(const Coefficients& coefficients) const {
     FrequencyPrediction out = periodic_(coefficients);
     out.terms = {};
-    double p2 = 0.0;
-    bool geometry = false, readout = false;
-    for (const auto& e : effects_) {
-      p2 += e->pickoff_p2_per_rad();
-      geometry = geometry || e->vibropendulous();
-      readout = readout || e->readout_averaged_in_prediction();
-    }
+    const double p2 = p2_;
+    const bool geometry = geometry_, readout = readout_;
     out.second_order_left_out = p2 != 0;
     const int points = points_;
     const double dc_gain = out.loop_dc_gain;
@@ -642,6 +642,8 @@ class PreparedRandomRectification::PeriodicOnRandom {
   GaussianParts g_;
   plant::Basis b0_;
   Vec3 a_mean_;
+  double p2_ = 0.0;  // the effects' pickoff p2 (1/rad), summed
+  bool geometry_ = false, readout_ = false;
   int points_ = 0;
   std::vector<Vec3> felt_at_, loop_at_;
   std::vector<double> current_at_;
